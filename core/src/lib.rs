@@ -1,0 +1,43 @@
+//! # volcad-core
+//!
+//! The model every part of Volcad Studio samples. A **design** is a tree of
+//! [`Node`]s built by a Rhai script ([`script`]); for any point p (mm) it
+//! answers the **signed distance** to the surface (negative inside) and,
+//! where p is inside, the **volume fractions** of the base materials of a
+//! [`MaterialTable`]. Everything downstream (preview, slice stacks, meshes,
+//! FEA meshes) samples these two functions.
+//!
+//! Data flow: `script text → (Rhai) → Node tree → Model::prepare → Model →
+//! batches of points → distances + fractions` (and [`sampler`] streams a
+//! grid of them slab by slab).
+//!
+//! ```
+//! use volcad_core::{script, Model};
+//! let design = script::run_script(
+//!     r#"let m = default_materials();
+//!        Sphere(Vec3(0, 0, 0), 10, m.id("red"))"#,
+//!     "doc.rhai",
+//!     &script::ScriptOptions::default(),
+//! ).unwrap();
+//! let model = Model::prepare(&design.root, design.materials.clone()).unwrap();
+//! assert!((model.distance(glam::DVec3::new(12.0, 0.0, 0.0)) - 2.0).abs() < 1e-12);
+//! ```
+#![warn(missing_docs)]
+
+pub mod bounds;
+pub mod expr;
+pub mod interval;
+pub mod lattice;
+pub mod material;
+pub mod mesh;
+pub mod model;
+pub mod node;
+pub mod sampler;
+pub mod script;
+pub mod simfield;
+
+pub use bounds::Aabb;
+pub use glam::DVec3;
+pub use material::{MaterialId, MaterialTable};
+pub use model::{Model, Points, PrepareError};
+pub use node::{Node, NodeKind};

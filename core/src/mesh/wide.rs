@@ -1,0 +1,341 @@
+//! A 4-wide BVH with single-precision boxes for fast queries.
+//!
+//! The binary SAH tree of [`super::bvh`] (built with one primitive per leaf)
+//! is collapsed into nodes of up to four children (Wald, Benthin & Boulos,
+//! "Getting rid of packets", 2008; Dammertz et al., "Shallow bounding volume
+//! hierarchies", 2008): a node repeatedly opens its largest inner child until
+//! it holds four. The four child boxes are stored as structure-of-arrays
+//! `f32` lanes (one 128-byte, cache-aligned node), so one SSE sequence gives
+//! all four box distances or containment tests and the tree is half as deep.
+//! A child is either another node or one primitive (triangle or tetrahedron
+//! slot); queries test primitives in `f64`.
+//!
+//! Boxes are rounded outwards to `f32` and grown by a margin of
+//! `16·ε_f32·max|coordinate|`, which covers rounding the query point and the
+//! single-precision arithmetic: a box is only skipped when its true distance
+//! exceeds the best one found, so results equal a pure `f64` traversal.
+
+use glam::{DVec3, Vec4};
+
+use super::bvh::Bvh;
+
+/// Marks a child slot that holds a primitive (its slot number in the low bits).
+const PRIM: u32 = 1 << 31;
+/// An unused child slot (its box is empty, so no query ever reaches it).
+const EMPTY: u32 = u32::MAX;
+
+/// Four child boxes as lanes, plus the children.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct Node4 {
+    /// Lowest x, y, z of the four child boxes.
+    lo: [Vec4; 3],
+    /// Highest x, y, z of the four child boxes.
+    hi: [Vec4; 3],
+    /// `PRIM | slot`, a node index, or `EMPTY`.
+    child: [u32; 4],
+}
+
+/// What a nearest search proved about the neighbourhood of its query
+/// point: every primitive other than `near[..count]` is at least
+/// `sqrt(rest)` away. By the triangle inequality a later query `q` with
+/// `δ = |q − p|` then has its nearest primitive among `near` whenever the
+/// best of them is within `sqrt(rest) − δ` of `q`.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Certificate {
+    /// The primitives with the smallest exact squared distances.
+    pub near: [(u32, f64); 4],
+    /// How many entries of `near` are used.
+    pub count: usize,
+    /// Lower bound of the squared distance of every other primitive.
+    pub rest: f64,
+}
+
+impl Certificate {
+    /// Records a tested primitive: kept among the four nearest or folded
+    /// into `rest`.
+    #[inline(always)]
+    fn offer(&mut self, slot: u32, d2: f64) {
+        let mut e = (slot, d2);
+        for i in 0..self.count {
+            if e.1 < self.near[i].1 {
+                std::mem::swap(&mut e, &mut self.near[i]);
+            }
+        }
+        if self.count < self.near.len() {
+            self.near[self.count] = e;
+            self.count += 1;
+        } else {
+            self.rest = self.rest.min(e.1);
+        }
+    }
+}
+
+/// The collapsed tree. Node 0 is the root.
+#[derive(Clone, Debug)]
+pub(crate) struct WideBvh {
+    nodes: Vec<Node4>,
+}
+
+/// Largest `f32` not above `x`.
+fn down(x: f64) -> f32 {
+    let f = x as f32;
+    if f as f64 > x { f.next_down() } else { f }
+}
+
+/// Smallest `f32` not below `x`.
+fn up(x: f64) -> f32 {
+    let f = x as f32;
+    if (f as f64) < x { f.next_up() } else { f }
+}
+
+/// Squared `f32` bound that is at least `d2` (so pruning stays conservative).
+#[inline(always)]
+fn bound(d2: f64) -> f32 {
+    up(d2 * (1.0 + 1e-5))
+}
+
+impl WideBvh {
+    /// Collapses `bvh`, whose leaves must hold one primitive each.
+    pub fn new(bvh: &Bvh) -> WideBvh {
+        let root = &bvh.nodes[0];
+        let scale = root.min.abs().max(root.max.abs()).max_element();
+        let margin = 16.0 * f32::EPSILON as f64 * scale;
+        let mut nodes: Vec<Node4> = Vec::with_capacity(bvh.nodes.len() / 2 + 1);
+        // (binary node to collapse, wide node to fill)
+        let mut work = vec![(0usize, 0usize)];
+        nodes.push(Node4 {
+            lo: [Vec4::INFINITY; 3],
+            hi: [Vec4::NEG_INFINITY; 3],
+            child: [EMPTY; 4],
+        });
+        while let Some((bi, wi)) = work.pop() {
+            let b = &bvh.nodes[bi];
+            let mut items: Vec<usize> = if b.is_leaf() {
+                vec![bi]
+            } else {
+                vec![b.first as usize, b.first as usize + 1]
+            };
+            while items.len() < 4 {
+                // Open the inner child with the largest surface area.
+                let area = |i: usize| {
+                    let e = bvh.nodes[i].max - bvh.nodes[i].min;
+                    e.x * e.y + e.y * e.z + e.z * e.x
+                };
+                let Some(k) = (0..items.len())
+                    .filter(|&k| !bvh.nodes[items[k]].is_leaf())
+                    .max_by(|&x, &y| area(items[x]).total_cmp(&area(items[y])))
+                else {
+                    break;
+                };
+                let c = bvh.nodes[items[k]].first as usize;
+                items[k] = c;
+                items.push(c + 1);
+            }
+            for (lane, &it) in items.iter().enumerate() {
+                let n = &bvh.nodes[it];
+                for a in 0..3 {
+                    nodes[wi].lo[a][lane] = down(n.min[a] - margin);
+                    nodes[wi].hi[a][lane] = up(n.max[a] + margin);
+                }
+                nodes[wi].child[lane] = if n.is_leaf() {
+                    PRIM | n.first
+                } else {
+                    nodes.push(Node4 {
+                        lo: [Vec4::INFINITY; 3],
+                        hi: [Vec4::NEG_INFINITY; 3],
+                        child: [EMPTY; 4],
+                    });
+                    work.push((it, nodes.len() - 1));
+                    (nodes.len() - 1) as u32
+                };
+            }
+        }
+        WideBvh { nodes }
+    }
+
+    /// Nearest primitive to `p` closer than `sqrt(max_d2)`: `test(slot, best)`
+    /// returns the squared distance of a primitive, or a lower bound of it
+    /// that is `>= best` when a cheap test already rules it out. `seed` is a
+    /// primitive whose squared distance is already known. Children are
+    /// visited nearest first.
+    ///
+    /// Also fills `cert` (see [`Certificate`]): the up to four primitives
+    /// with the smallest exact distances, and a lower bound of the squared
+    /// distance of every other primitive (the minimum over all pruned boxes
+    /// and rejected primitives).
+    #[inline(always)]
+    pub fn nearest<F: FnMut(u32, f64) -> f64>(
+        &self,
+        p: DVec3,
+        max_d2: f64,
+        seed: Option<(u32, f64)>,
+        cert: &mut Certificate,
+        mut test: F,
+    ) -> Option<(u32, f64)> {
+        let px = Vec4::splat(p.x as f32);
+        let py = Vec4::splat(p.y as f32);
+        let pz = Vec4::splat(p.z as f32);
+        let mut best = max_d2;
+        let mut best_slot = EMPTY;
+        cert.count = 0;
+        cert.rest = f64::INFINITY;
+        if let Some((s, d)) = seed {
+            cert.offer(s, d);
+            if d < best {
+                best = d;
+                best_slot = s;
+            }
+        }
+        let mut best_f = bound(best);
+        // Lower bound (f32) of everything pruned by box distance.
+        let mut pruned = f32::INFINITY;
+        let mut stack = Stack::<(u32, f32)>::new();
+        let mut ni = 0usize;
+        'visit: loop {
+            let n = &self.nodes[ni];
+            let dx = (n.lo[0] - px).max(px - n.hi[0]).max(Vec4::ZERO);
+            let dy = (n.lo[1] - py).max(py - n.hi[1]).max(Vec4::ZERO);
+            let dz = (n.lo[2] - pz).max(pz - n.hi[2]).max(Vec4::ZERO);
+            let d2 = dx * dx + dy * dy + dz * dz;
+            let hit = d2.cmplt(Vec4::splat(best_f));
+            pruned = pruned.min(Vec4::select(hit, Vec4::INFINITY, d2).min_element());
+            let mut mask = hit.bitmask();
+            let d2 = d2.to_array();
+            let mut inner = [(0u32, 0.0f32); 4];
+            let mut ni_count = 0;
+            while mask != 0 {
+                let lane = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let c = n.child[lane];
+                if c & PRIM != 0 {
+                    let s = c & !PRIM;
+                    if Some(s) == seed.map(|x| x.0) {
+                        continue;
+                    }
+                    let d = test(s, best);
+                    if d < best {
+                        best = d;
+                        best_f = bound(d);
+                        best_slot = s;
+                    }
+                    cert.offer(s, d);
+                } else {
+                    inner[ni_count] = (c, d2[lane]);
+                    ni_count += 1;
+                }
+            }
+            // Keep the inner children still in reach, sorted by distance.
+            let mut k = 0;
+            for i in 0..ni_count {
+                let e = inner[i];
+                if e.1 < best_f {
+                    let mut j = k;
+                    while j > 0 && inner[j - 1].1 > e.1 {
+                        inner[j] = inner[j - 1];
+                        j -= 1;
+                    }
+                    inner[j] = e;
+                    k += 1;
+                } else {
+                    pruned = pruned.min(e.1);
+                }
+            }
+            if k > 0 {
+                // Farthest first, so the nearest remaining pops first.
+                for e in inner[1..k].iter().rev() {
+                    stack.push(*e);
+                }
+                ni = inner[0].0 as usize;
+                continue 'visit;
+            }
+            while let Some((node, d)) = stack.pop() {
+                if d < best_f {
+                    ni = node as usize;
+                    continue 'visit;
+                }
+                pruned = pruned.min(d);
+            }
+            break;
+        }
+        // The f32 box bounds were computed on slightly grown boxes, so they
+        // are lower bounds of the true squared distances.
+        cert.rest = cert.rest.min(pruned as f64);
+        (best_slot != EMPTY).then_some((best_slot, best))
+    }
+
+    /// First primitive whose box contains `p` and for which `test(slot)` is
+    /// true.
+    #[inline(always)]
+    pub fn find<F: FnMut(u32) -> bool>(&self, p: DVec3, mut test: F) -> Option<u32> {
+        let px = Vec4::splat(p.x as f32);
+        let py = Vec4::splat(p.y as f32);
+        let pz = Vec4::splat(p.z as f32);
+        let mut stack = Stack::<u32>::new();
+        let mut ni = 0usize;
+        loop {
+            let n = &self.nodes[ni];
+            let inside = px.cmpge(n.lo[0])
+                & px.cmple(n.hi[0])
+                & py.cmpge(n.lo[1])
+                & py.cmple(n.hi[1])
+                & pz.cmpge(n.lo[2])
+                & pz.cmple(n.hi[2]);
+            let mut mask = inside.bitmask();
+            while mask != 0 {
+                let lane = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let c = n.child[lane];
+                if c & PRIM != 0 {
+                    if test(c & !PRIM) {
+                        return Some(c & !PRIM);
+                    }
+                } else {
+                    stack.push(c);
+                }
+            }
+            ni = stack.pop()? as usize;
+        }
+    }
+}
+
+/// Traversal stack: a small inline array (enough for any realistic tree:
+/// three entries per level) that spills to the heap instead of overflowing.
+struct Stack<T: Copy + Default> {
+    inline: [T; 32],
+    len: usize,
+    spill: Vec<T>,
+}
+
+impl<T: Copy + Default> Stack<T> {
+    #[inline(always)]
+    fn new() -> Self {
+        Stack {
+            inline: [T::default(); 32],
+            len: 0,
+            spill: Vec::new(),
+        }
+    }
+
+    #[inline(always)]
+    fn push(&mut self, v: T) {
+        if self.len < self.inline.len() {
+            self.inline[self.len] = v;
+            self.len += 1;
+        } else {
+            self.spill.push(v);
+        }
+    }
+
+    #[inline(always)]
+    fn pop(&mut self) -> Option<T> {
+        if let Some(v) = self.spill.pop() {
+            return Some(v);
+        }
+        if self.len == 0 {
+            return None;
+        }
+        self.len -= 1;
+        Some(self.inline[self.len])
+    }
+}

@@ -1,0 +1,259 @@
+//! Conservative bounds over boxes, for samplers that skip empty space and fill
+//! homogeneous regions without touching every voxel.
+//!
+//! * `interval(b)`: an interval containing the node's value at every point of
+//!   box `b`. Exact SDFs are 1-Lipschitz, so `d(centre) ± half diagonal`
+//!   bounds them; composites combine their children's intervals; math strings
+//!   use interval arithmetic (`Expr::eval_interval`).
+//! * `constant_fractions(b)`: true when the fractions are the same at every
+//!   point of `b` where the node is inside.
+
+use glam::DVec3;
+
+use super::pnode::{COORD_SLOTS, D_SLOT, NAry, PNode, tile_local};
+use crate::bounds::Aabb;
+use crate::interval::Interval;
+
+/// `d(centre) ± half diagonal` for a 1-Lipschitz field.
+#[inline]
+fn lipschitz(node: &PNode, b: &Aabb) -> Interval {
+    let d = node.dist(b.center());
+    let r = b.half_diagonal();
+    Interval::new(d - r, d + r)
+}
+
+/// The box in the child's frame for `q = m·(p − about) + about`.
+fn rotate_box(b: &Aabb, m: &glam::DMat3, about: DVec3) -> Aabb {
+    b.transformed(m, about)
+}
+
+/// The part of a Tile child's domain that box `b` maps to: the mapped box if
+/// `b` lies in one cell, else the whole cell.
+fn tile_box(b: &Aabb, cell: DVec3) -> Aabb {
+    let lo = (b.min / cell).floor();
+    let hi = (b.max / cell).floor();
+    if lo == hi {
+        let q = tile_local(b.min, cell);
+        Aabb::new(q, q + b.size())
+    } else {
+        Aabb::from_center_size(DVec3::ZERO, cell)
+    }
+}
+
+/// Intervals of the coordinate slots over `b` (x y z rho phic r theta phis d).
+pub fn coord_intervals(b: &Aabb, d: Interval) -> [Interval; COORD_SLOTS] {
+    let x = Interval::new(b.min.x, b.max.x);
+    let y = Interval::new(b.min.y, b.max.y);
+    let z = Interval::new(b.min.z, b.max.z);
+    let rho = (x.square() + y.square()).sqrt();
+    let r = (x.square() + y.square() + z.square()).sqrt();
+    let angle = Interval::new(-std::f64::consts::PI, std::f64::consts::PI);
+    let polar = Interval::new(0.0, std::f64::consts::PI);
+    let mut s = [x, y, z, rho, angle, r, angle, polar, d];
+    s[D_SLOT] = d;
+    s
+}
+
+impl PNode {
+    /// A conservative interval of the distance over `b`.
+    pub fn interval(&self, b: &Aabb) -> Interval {
+        match self {
+            PNode::Sphere { .. }
+            | PNode::Box { .. }
+            | PNode::Cylinder { .. }
+            | PNode::Strut { .. }
+            | PNode::Prism { .. }
+            | PNode::Lattice { .. }
+            | PNode::Mesh { .. }
+            | PNode::SimField(_) => lipschitz(self, b),
+            PNode::Function {
+                expr,
+                clip_c,
+                clip_h,
+                ..
+            } => {
+                let slots = coord_intervals(b, Interval::EVERYTHING);
+                let f = expr.eval_interval(&slots);
+                let clip = Aabb::from_center_size(*clip_c, *clip_h * 2.0);
+                let dc = super::sdf::rect_prism(b.center(), clip.center(), *clip_h);
+                let r = b.half_diagonal();
+                f.max(Interval::new(dc - r, dc + r))
+            }
+            PNode::Tpms { t, .. } => t.interval(b),
+            PNode::Translate { t, child } => child.interval(&Aabb::new(b.min - *t, b.max - *t)),
+            PNode::Rotate {
+                to_local,
+                around,
+                child,
+            } => child.interval(&rotate_box(b, to_local, *around)),
+            PNode::Scale { inv, k, child } => {
+                let i = child.interval(&b.scaled(*inv));
+                Interval::new(i.lo * *k, i.hi * *k)
+            }
+            PNode::Union(u) => u.union_interval(b),
+            PNode::Intersection(n) => {
+                let mut i = n.children[0].interval(b);
+                for c in &n.children[1..] {
+                    i = i.max(c.interval(b));
+                }
+                if n.smooth > 0.0 {
+                    i.hi += n.smooth;
+                }
+                i
+            }
+            PNode::Difference {
+                a,
+                b: right,
+                smooth,
+            } => {
+                let mut i = a.interval(b).max(-right.interval(b));
+                if *smooth > 0.0 {
+                    i.hi += *smooth;
+                }
+                i
+            }
+            PNode::Offset { o, child } => child.interval(b) - *o,
+            PNode::Shell { t, child } => {
+                let i = child.interval(b);
+                i.max(Interval::point(-*t) - i)
+            }
+            PNode::Tile { cell, child } => child.interval(&tile_box(b, *cell)),
+            PNode::FGrade(g) => g.child.interval(b),
+            PNode::Blend { child, .. } => child.interval(b),
+        }
+    }
+
+    /// True when the fractions are the same wherever the node is inside `b`.
+    pub fn constant_fractions(&self, b: &Aabb) -> bool {
+        match self {
+            PNode::Sphere { .. }
+            | PNode::Box { .. }
+            | PNode::Cylinder { .. }
+            | PNode::Strut { .. }
+            | PNode::Prism { .. }
+            | PNode::Function { .. }
+            | PNode::Tpms { .. }
+            | PNode::Lattice { .. }
+            | PNode::Mesh { .. } => true,
+            PNode::SimField(_) => false,
+            PNode::Translate { t, child } => {
+                child.constant_fractions(&Aabb::new(b.min - *t, b.max - *t))
+            }
+            PNode::Rotate {
+                to_local,
+                around,
+                child,
+            } => child.constant_fractions(&rotate_box(b, to_local, *around)),
+            PNode::Scale { inv, child, .. } => child.constant_fractions(&b.scaled(*inv)),
+            PNode::Union(u) => u.union_constant(b),
+            PNode::Intersection(n) => {
+                if n.blend {
+                    n.children.iter().all(|c| c.constant_fractions(b)) && n.children.len() == 1
+                } else {
+                    n.children[0].constant_fractions(b)
+                }
+            }
+            PNode::Difference { a, .. } => a.constant_fractions(b),
+            PNode::Offset { child, .. } | PNode::Shell { child, .. } => child.constant_fractions(b),
+            PNode::Tile { cell, child } => child.constant_fractions(&tile_box(b, *cell)),
+            PNode::FGrade(g) => {
+                if !g.child.is_inside_somewhere(b) {
+                    return true;
+                }
+                let d = if g.used & (1 << D_SLOT) != 0 {
+                    g.child.interval(b)
+                } else {
+                    Interval::EVERYTHING
+                };
+                let slots = coord_intervals(b, d);
+                g.exprs.iter().all(|e| {
+                    e.constant().is_some() || {
+                        let i = e.eval_interval(&slots);
+                        i.lo == i.hi
+                    }
+                })
+            }
+            PNode::Blend { .. } => false,
+        }
+    }
+
+    /// False when the node is certainly outside everywhere in `b`.
+    fn is_inside_somewhere(&self, b: &Aabb) -> bool {
+        self.interval(b).lo <= 0.0
+    }
+}
+
+impl NAry {
+    fn union_interval(&self, b: &Aabb) -> Interval {
+        let mut acc = Interval::new(f64::INFINITY, f64::INFINITY);
+        let take = |acc: &mut Interval, i: Interval| {
+            acc.lo = acc.lo.min(i.lo);
+            acc.hi = acc.hi.min(i.hi);
+        };
+        match &self.index {
+            Some(index) => {
+                for &i in index.always() {
+                    take(&mut acc, self.children[i as usize].interval(b));
+                }
+                // Children near `b` first; then every child whose box is
+                // within the current upper bound of `b`. Farther children
+                // cannot lower either end: their values exceed the distance
+                // to their box, which exceeds `hi` everywhere in `b`.
+                index.bvh().overlapping(&b.expand(b.half_diagonal()), |i| {
+                    take(&mut acc, self.children[i as usize].interval(b))
+                });
+                let reach = if acc.hi.is_finite() {
+                    b.expand(acc.hi.max(0.0) + b.half_diagonal())
+                } else {
+                    Aabb::EVERYTHING
+                };
+                index.bvh().overlapping(&reach, |i| {
+                    take(&mut acc, self.children[i as usize].interval(b))
+                });
+            }
+            None => {
+                for c in &self.children {
+                    take(&mut acc, c.interval(b));
+                }
+            }
+        }
+        if self.smooth > 0.0 {
+            acc.lo -= self.smooth;
+        }
+        acc
+    }
+
+    /// Constant when exactly one child can be inside in `b` and it is constant.
+    fn union_constant(&self, b: &Aabb) -> bool {
+        let mut inside: Option<usize> = None;
+        let mut many = false;
+        let mut check = |i: usize| {
+            if many {
+                return;
+            }
+            if self.children[i].interval(b).lo <= 0.0 {
+                if inside.is_some() {
+                    many = true;
+                } else {
+                    inside = Some(i);
+                }
+            }
+        };
+        match &self.index {
+            Some(index) => {
+                for &i in index.always() {
+                    check(i as usize);
+                }
+                index.bvh().overlapping(b, |i| check(i as usize));
+            }
+            None => (0..self.children.len()).for_each(&mut check),
+        }
+        if many || self.smooth > 0.0 && inside.is_some() {
+            return false;
+        }
+        match inside {
+            Some(i) => self.children[i].constant_fractions(b),
+            None => true,
+        }
+    }
+}

@@ -1,0 +1,250 @@
+//! Material volume fractions of the prepared tree (pyvcad's `distribution`).
+//!
+//! `frac(p, out)` writes the fractions at `p` into `out` (one entry per
+//! material the model uses, all zero on entry). Callers ask only where the
+//! node's distance is ≤ 0; the rules per node follow pyvcad 2.3.4
+//! (OPENVCAD.md section 2) except where `docs/PYVCAD.md` says otherwise.
+
+use glam::DVec3;
+
+use super::MAX_MATERIALS;
+use super::pnode::{
+    COORD_SLOTS, D_SLOT, Grade, NAry, PNode, SimGrade, Slot, coord_slots, tile_local,
+};
+use super::union_index::Candidates;
+
+impl PNode {
+    /// Fractions at `p` into `out` (zeroed by the caller).
+    pub fn frac(&self, p: DVec3, out: &mut [f64]) {
+        match self {
+            PNode::Sphere { m, .. }
+            | PNode::Box { m, .. }
+            | PNode::Cylinder { m, .. }
+            | PNode::Strut { m, .. }
+            | PNode::Prism { m, .. }
+            | PNode::Function { m, .. }
+            | PNode::Tpms { m, .. }
+            | PNode::Lattice { m, .. }
+            | PNode::Mesh { m, .. } => out[*m as usize] = 1.0,
+            PNode::Translate { t, child } => child.frac(p - *t, out),
+            PNode::Rotate {
+                to_local,
+                around,
+                child,
+            } => child.frac(*to_local * (p - *around) + *around, out),
+            PNode::Scale { inv, child, .. } => child.frac(p * *inv, out),
+            PNode::Union(u) => u.union_frac(p, out),
+            PNode::Intersection(n) => {
+                if n.blend {
+                    average(n.children.iter().map(|c| &**c), p, out, |_| true);
+                } else {
+                    n.children[0].frac(p, out);
+                }
+            }
+            PNode::Difference { a, .. } => a.frac(p, out),
+            PNode::Offset { child, .. } | PNode::Shell { child, .. } => child.frac(p, out),
+            PNode::Tile { cell, child } => child.frac(tile_local(p, *cell), out),
+            PNode::FGrade(g) => g.frac(p, out),
+            PNode::Blend { r, child } => blend_frac(child, *r, p, out),
+            PNode::SimField(s) => s.frac(p, out),
+        }
+    }
+}
+
+impl NAry {
+    /// `blend = false`: the first child (in order) containing `p` wins.
+    /// `blend = true`: the average over the children containing `p`.
+    /// Where no child contains `p` (the fillet of a smooth union) the nearest
+    /// child's fractions are used, as pyvcad does (d3 in OPENVCAD.md §12).
+    fn union_frac(&self, p: DVec3, out: &mut [f64]) {
+        if let Some(index) = &self.index
+            && let Candidates::Cell { items, always, .. } = index.candidates(p)
+        {
+            let mut ids = merge_sorted(items, always);
+            return self.frac_among(&mut ids, p, out);
+        }
+        let mut all = (0..self.children.len() as u32).map(|i| i as usize);
+        self.frac_among(&mut all, p, out)
+    }
+
+    fn frac_among(&self, ids: &mut dyn Iterator<Item = usize>, p: DVec3, out: &mut [f64]) {
+        let mut nearest = (f64::INFINITY, usize::MAX);
+        if self.blend {
+            let mut acc = [0.0; MAX_MATERIALS];
+            let mut tmp = [0.0; MAX_MATERIALS];
+            let k = out.len();
+            let mut count = 0u32;
+            for i in ids {
+                let c = &self.children[i];
+                let d = c.dist(p);
+                if d <= 0.0 {
+                    tmp[..k].fill(0.0);
+                    c.frac(p, &mut tmp[..k]);
+                    for j in 0..k {
+                        acc[j] += tmp[j];
+                    }
+                    count += 1;
+                } else if d < nearest.0 {
+                    nearest = (d, i);
+                }
+            }
+            if count > 0 {
+                for j in 0..k {
+                    out[j] = acc[j] / count as f64;
+                }
+                return;
+            }
+        } else {
+            for i in ids {
+                let c = &self.children[i];
+                let d = c.dist(p);
+                if d <= 0.0 {
+                    return c.frac(p, out);
+                }
+                if d < nearest.0 {
+                    nearest = (d, i);
+                }
+            }
+        }
+        if nearest.1 != usize::MAX {
+            self.children[nearest.1].frac(p, out);
+        }
+    }
+}
+
+/// Indices of `a` and `b` (both ascending) merged ascending.
+fn merge_sorted<'a>(a: &'a [u32], b: &'a [u32]) -> impl Iterator<Item = usize> + 'a {
+    let mut i = 0;
+    let mut j = 0;
+    std::iter::from_fn(move || {
+        let next = match (a.get(i), b.get(j)) {
+            (Some(&x), Some(&y)) if x <= y => {
+                i += 1;
+                x
+            }
+            (_, Some(&y)) => {
+                j += 1;
+                y
+            }
+            (Some(&x), None) => {
+                i += 1;
+                x
+            }
+            (None, None) => return None,
+        };
+        Some(next as usize)
+    })
+}
+
+/// Average of the fractions of `nodes` that `keep` accepts.
+fn average<'a>(
+    nodes: impl Iterator<Item = &'a PNode>,
+    p: DVec3,
+    out: &mut [f64],
+    keep: impl Fn(&PNode) -> bool,
+) {
+    let k = out.len();
+    let mut tmp = [0.0; MAX_MATERIALS];
+    let mut count = 0u32;
+    for c in nodes {
+        if !keep(c) {
+            continue;
+        }
+        tmp[..k].fill(0.0);
+        c.frac(p, &mut tmp[..k]);
+        for j in 0..k {
+            out[j] += tmp[j];
+        }
+        count += 1;
+    }
+    if count > 1 {
+        let inv = 1.0 / count as f64;
+        for v in out.iter_mut() {
+            *v *= inv;
+        }
+    }
+}
+
+impl Grade {
+    /// Values fᵢ(p) of the expressions (with `d` = the child's distance),
+    /// negatives clamped to 0, then normalised by their sum when it is > 0.
+    /// (pyvcad keeps negative values and normalises only positive sums; a
+    /// negative fraction has no physical meaning, see docs/PYVCAD.md.)
+    fn frac(&self, p: DVec3, out: &mut [f64]) {
+        let mut slots = [0.0; COORD_SLOTS];
+        coord_slots(p, self.used, &mut slots);
+        if self.used & (1 << D_SLOT) != 0 {
+            slots[D_SLOT] = self.child.dist(p);
+        }
+        write_normalised(&self.exprs, &self.mats, &slots, out);
+    }
+}
+
+impl SimGrade {
+    fn frac(&self, p: DVec3, out: &mut [f64]) {
+        let n = COORD_SLOTS + self.field.variable_names().len();
+        let mut slots = [0.0; 64];
+        let slots = &mut slots[..n];
+        coord_slots(p, self.used, slots);
+        if !self.field.sample(p, &mut slots[COORD_SLOTS..]) {
+            return;
+        }
+        write_normalised(&self.exprs, &self.mats, slots, out);
+    }
+}
+
+/// Evaluate `exprs`, clamp negatives to 0, normalise by the sum when > 0,
+/// and add each to its material slot.
+fn write_normalised(
+    exprs: &[std::sync::Arc<crate::expr::Expr>],
+    mats: &[Slot],
+    slots: &[f64],
+    out: &mut [f64],
+) {
+    let mut vals = [0.0; MAX_MATERIALS];
+    let mut sum = 0.0;
+    for (i, e) in exprs.iter().enumerate() {
+        let v = e.eval(slots);
+        let v = if v > 0.0 { v } else { 0.0 }; // also maps NaN to 0
+        vals[i] = v;
+        sum += v;
+    }
+    let inv = if sum > 0.0 { 1.0 / sum } else { 0.0 };
+    for (i, m) in mats.iter().enumerate() {
+        out[*m as usize] += vals[i] * inv;
+    }
+}
+
+/// pyvcad's Blend: the average of the child's fractions over the 5×5×5
+/// stencil `{−r, −0.6r, −0.2r, 0.2r, 0.6r}³` around `p`, over the samples
+/// that have material. (pyvcad's stencil is asymmetric; we keep it for
+/// compatibility and document it in docs/PYVCAD.md.)
+fn blend_frac(child: &PNode, r: f64, p: DVec3, out: &mut [f64]) {
+    const S: [f64; 5] = [-1.0, -0.6, -0.2, 0.2, 0.6];
+    let k = out.len();
+    let mut tmp = [0.0; MAX_MATERIALS];
+    let mut count = 0u32;
+    for dx in S {
+        for dy in S {
+            for dz in S {
+                let q = p + DVec3::new(dx, dy, dz) * r;
+                if child.dist(q) <= 0.0 {
+                    tmp[..k].fill(0.0);
+                    child.frac(q, &mut tmp[..k]);
+                    for j in 0..k {
+                        out[j] += tmp[j];
+                    }
+                    count += 1;
+                }
+            }
+        }
+    }
+    if count == 0 {
+        child.frac(p, out);
+    } else {
+        let inv = 1.0 / count as f64;
+        for v in out.iter_mut() {
+            *v *= inv;
+        }
+    }
+}

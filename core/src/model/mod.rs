@@ -1,0 +1,208 @@
+//! The prepared model: what every consumer (viewport, compilers, CLI) samples.
+//!
+//! `Node tree → Model::prepare → Model` (immutable, `Send + Sync`), then
+//! batches of points → distances and fractions into caller-owned buffers.
+//!
+//! Fractions are dense: a model uses few materials out of a table of many,
+//! so `materials()` lists the ids it uses, ascending, and a point's fractions
+//! are `k = materials().len()` numbers in that order.
+
+mod bound;
+mod fractions;
+mod pnode;
+mod prepare;
+pub mod sdf;
+mod tpms;
+mod union_index;
+
+#[cfg(test)]
+mod tests;
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use glam::DVec3;
+
+use crate::bounds::Aabb;
+use crate::interval::Interval;
+use crate::material::{MaterialId, MaterialTable};
+use crate::node::Node;
+use pnode::PNode;
+
+pub use prepare::rotation;
+
+/// Most distinct materials one design may use (fractions live on the stack).
+pub const MAX_MATERIALS: usize = 64;
+
+/// Why a tree could not be prepared.
+#[derive(Debug, Clone, thiserror::Error, PartialEq)]
+#[error("{node}: {message}")]
+pub struct PrepareError {
+    /// The node, with the script line that made it.
+    pub node: String,
+    /// What is wrong and what would fix it.
+    pub message: String,
+}
+
+/// A prepared design.
+#[derive(Debug, Clone)]
+pub struct Model {
+    root: Arc<PNode>,
+    bbox: Aabb,
+    materials: Vec<MaterialId>,
+    table: Arc<MaterialTable>,
+    node_count: usize,
+    prepare_time: Duration,
+}
+
+/// Points as structure of arrays (mm).
+#[derive(Clone, Copy, Debug)]
+pub struct Points<'a> {
+    /// X coordinates.
+    pub x: &'a [f64],
+    /// Y coordinates.
+    pub y: &'a [f64],
+    /// Z coordinates.
+    pub z: &'a [f64],
+}
+
+impl Points<'_> {
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// True when there are no points.
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+
+    /// Point `i`.
+    #[inline]
+    pub fn get(&self, i: usize) -> DVec3 {
+        DVec3::new(self.x[i], self.y[i], self.z[i])
+    }
+}
+
+impl Model {
+    /// Prepare `root` with the material table its script used.
+    pub fn prepare(root: &Node, table: Arc<MaterialTable>) -> Result<Model, PrepareError> {
+        let start = Instant::now();
+        let materials = prepare::collect_materials(root);
+        let mut p = prepare::Preparer::new(&materials)?;
+        // Structural errors (missing children) first: they explain an
+        // empty material list too.
+        let (root_p, bbox) = p.prepare(root)?;
+        if materials.is_empty() {
+            return Err(PrepareError {
+                node: root.describe(),
+                message: "the design has no material".into(),
+            });
+        }
+        Ok(Model {
+            root: root_p,
+            bbox,
+            materials,
+            table,
+            node_count: root.count_nodes(),
+            prepare_time: start.elapsed(),
+        })
+    }
+
+    /// Bounding box (may be infinite for an unclipped Tile or TPMS).
+    pub fn bbox(&self) -> Aabb {
+        self.bbox
+    }
+
+    /// The material ids the design can return, ascending (fraction order).
+    pub fn materials(&self) -> &[MaterialId] {
+        &self.materials
+    }
+
+    /// The material table the design was written against.
+    pub fn table(&self) -> &MaterialTable {
+        &self.table
+    }
+
+    /// The shared table.
+    pub fn table_arc(&self) -> Arc<MaterialTable> {
+        self.table.clone()
+    }
+
+    /// Distinct nodes in the script's tree.
+    pub fn node_count(&self) -> usize {
+        self.node_count
+    }
+
+    /// How long `prepare` took.
+    pub fn prepare_time(&self) -> Duration {
+        self.prepare_time
+    }
+
+    /// Signed distance at `p` (negative inside; inside ⇔ ≤ 0).
+    #[inline]
+    pub fn distance(&self, p: DVec3) -> f64 {
+        self.root.dist(p)
+    }
+
+    /// Distance at `p`, and fractions into `fracs` (length `materials().len()`;
+    /// all zero outside).
+    #[inline]
+    pub fn eval_into(&self, p: DVec3, fracs: &mut [f64]) -> f64 {
+        fracs.fill(0.0);
+        let d = self.root.dist(p);
+        if d <= 0.0 {
+            self.root.frac(p, fracs);
+        }
+        d
+    }
+
+    /// Convenience: distance and (material id, fraction) pairs at one point;
+    /// empty outside. Allocates; use the batch calls in loops.
+    pub fn eval_point(&self, p: DVec3) -> (f64, Vec<(MaterialId, f64)>) {
+        let mut f = vec![0.0; self.materials.len()];
+        let d = self.eval_into(p, &mut f);
+        let pairs = if d <= 0.0 {
+            self.materials.iter().copied().zip(f).collect()
+        } else {
+            Vec::new()
+        };
+        (d, pairs)
+    }
+
+    /// Distances for a batch of points into `dist` (same length).
+    pub fn distance_batch(&self, pts: Points<'_>, dist: &mut [f64]) {
+        assert_eq!(dist.len(), pts.len(), "distance buffer length");
+        for (i, d) in dist.iter_mut().enumerate() {
+            *d = self.root.dist(pts.get(i));
+        }
+    }
+
+    /// Distances and fractions for a batch: `dist[i]`, and
+    /// `fracs[i*k .. (i+1)*k]` with `k = materials().len()` (zero outside).
+    pub fn eval_batch(&self, pts: Points<'_>, dist: &mut [f64], fracs: &mut [f32]) {
+        let k = self.materials.len();
+        assert_eq!(dist.len(), pts.len(), "distance buffer length");
+        assert_eq!(fracs.len(), pts.len() * k, "fraction buffer length");
+        let mut f = [0.0f64; MAX_MATERIALS];
+        for i in 0..pts.len() {
+            let d = self.eval_into(pts.get(i), &mut f[..k]);
+            dist[i] = d;
+            for (o, v) in fracs[i * k..(i + 1) * k].iter_mut().zip(&f[..k]) {
+                *o = *v as f32;
+            }
+        }
+    }
+
+    /// A conservative interval of the distance over box `b`: every point of
+    /// `b` has a distance inside it. `lo > 0`: empty; `hi < 0`: full.
+    pub fn interval(&self, b: &Aabb) -> Interval {
+        self.root.interval(b)
+    }
+
+    /// True when the fractions are the same at every inside point of `b`
+    /// (samplers then evaluate one point and fill the rest).
+    pub fn constant_fractions(&self, b: &Aabb) -> bool {
+        self.root.constant_fractions(b)
+    }
+}

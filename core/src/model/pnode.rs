@@ -1,0 +1,335 @@
+//! The prepared tree: every node resolved to the data its evaluation needs
+//! (dense material indices, compiled expressions, matrices, spatial indices),
+//! and its signed distance.
+//!
+//! Evaluation is a recursive `match` over this enum: static dispatch, no
+//! allocation, no parsing. Shared subtrees of the script's tree stay shared
+//! (`Arc`), so a unit cell under `Tile` is prepared once.
+
+use std::sync::Arc;
+
+use glam::{DMat3, DVec2, DVec3};
+
+use super::sdf;
+use super::tpms::Tpms;
+use super::union_index::{Candidates, UnionIndex};
+use crate::bounds::Aabb;
+use crate::expr::Expr;
+
+/// Dense material index within one model (position in `Model::materials`).
+pub type Slot = u16;
+
+/// A capsule with precomputed terms.
+#[derive(Clone, Copy, Debug)]
+pub struct Capsule {
+    pub a: DVec3,
+    pub ab: DVec3,
+    pub inv_ab2: f64,
+    pub r: f64,
+}
+
+impl Capsule {
+    pub fn new(a: DVec3, b: DVec3, r: f64) -> Self {
+        let ab = b - a;
+        let l2 = ab.length_squared();
+        Self {
+            a,
+            ab,
+            inv_ab2: if l2 > 0.0 { 1.0 / l2 } else { 0.0 },
+            r,
+        }
+    }
+
+    #[inline]
+    pub fn dist(&self, p: DVec3) -> f64 {
+        sdf::capsule(p, self.a, self.ab, self.inv_ab2, self.r)
+    }
+
+    pub fn bbox(&self) -> Aabb {
+        let b = self.a + self.ab;
+        Aabb::new(self.a.min(b), self.a.max(b)).expand(self.r)
+    }
+}
+
+/// A planar polygon extruded along its normal, in its own frame.
+#[derive(Clone, Debug)]
+pub struct Prism {
+    /// World -> frame rotation (rows: u, v, n).
+    pub to_frame: DMat3,
+    pub origin: DVec3,
+    pub poly: Vec<DVec2>,
+    /// Extent along the normal in frame coordinates.
+    pub w_mid: f64,
+    pub w_half: f64,
+}
+
+impl Prism {
+    #[inline]
+    pub fn dist(&self, p: DVec3) -> f64 {
+        let q = self.to_frame * (p - self.origin);
+        let d2 = sdf::polygon_2d(DVec2::new(q.x, q.y), &self.poly);
+        sdf::extrude(d2, (q.z - self.w_mid).abs() - self.w_half)
+    }
+}
+
+/// One prepared node. Field names follow [`crate::node::NodeKind`].
+#[derive(Debug)]
+pub enum PNode {
+    Sphere {
+        c: DVec3,
+        r: f64,
+        m: Slot,
+    },
+    Box {
+        c: DVec3,
+        h: DVec3,
+        m: Slot,
+    },
+    Cylinder {
+        c: DVec3,
+        r: f64,
+        hh: f64,
+        m: Slot,
+    },
+    Strut {
+        s: Capsule,
+        m: Slot,
+    },
+    Prism {
+        p: Box<Prism>,
+        m: Slot,
+    },
+    /// Raw expression value, clipped to `clip` by `max(f, box sdf)`.
+    Function {
+        expr: Arc<Expr>,
+        clip_c: DVec3,
+        clip_h: DVec3,
+        m: Slot,
+    },
+    Tpms {
+        t: Tpms,
+        m: Slot,
+    },
+    /// Struts, optionally clipped to a centred box of half size `clip_h`.
+    Lattice {
+        struts: Vec<Capsule>,
+        clip_h: Option<DVec3>,
+        m: Slot,
+    },
+    Translate {
+        t: DVec3,
+        child: Arc<PNode>,
+    },
+    /// `child(to_local · (p − around) + around)`.
+    Rotate {
+        to_local: DMat3,
+        around: DVec3,
+        child: Arc<PNode>,
+    },
+    /// `child(p · inv) · k`, k = min |s| keeps the value a distance bound.
+    Scale {
+        inv: DVec3,
+        k: f64,
+        child: Arc<PNode>,
+    },
+    Union(Box<NAry>),
+    Intersection(Box<NAry>),
+    Difference {
+        a: Arc<PNode>,
+        b: Arc<PNode>,
+        smooth: f64,
+    },
+    Offset {
+        o: f64,
+        child: Arc<PNode>,
+    },
+    /// Inner band of thickness `t` (> 0): `max(d, −t − d)`.
+    Shell {
+        t: f64,
+        child: Arc<PNode>,
+    },
+    Tile {
+        cell: DVec3,
+        child: Arc<PNode>,
+    },
+    FGrade(Box<Grade>),
+    Blend {
+        r: f64,
+        child: Arc<PNode>,
+    },
+    Mesh {
+        mesh: Arc<crate::mesh::TriangleMesh>,
+        m: Slot,
+    },
+    SimField(Box<SimGrade>),
+}
+
+/// Union or intersection over many children.
+#[derive(Debug)]
+pub struct NAry {
+    pub children: Vec<Arc<PNode>>,
+    pub boxes: Vec<Aabb>,
+    pub smooth: f64,
+    pub blend: bool,
+    /// Present for large, sharp unions.
+    pub index: Option<UnionIndex>,
+}
+
+/// FGrade: fractions from expressions over the child.
+#[derive(Debug)]
+pub struct Grade {
+    pub exprs: Vec<Arc<Expr>>,
+    pub mats: Vec<Slot>,
+    /// Union of the expressions' used-variable masks.
+    pub used: u64,
+    pub child: Arc<PNode>,
+}
+
+/// SimulationField: fractions from expressions over an FEA result.
+#[derive(Debug)]
+pub struct SimGrade {
+    pub field: Arc<crate::simfield::SimField>,
+    pub exprs: Vec<Arc<Expr>>,
+    pub mats: Vec<Slot>,
+    pub used: u64,
+}
+
+/// Number of standard coordinate slots (x y z rho phic r theta phis d).
+pub const COORD_SLOTS: usize = 9;
+/// Slot of `d`, the child's signed distance.
+pub const D_SLOT: usize = 8;
+/// Mask of the derived coordinate slots (rho .. phis).
+pub const DERIVED_MASK: u64 = 0b0_1111_1000;
+
+impl PNode {
+    /// Signed distance at `p` (negative inside; a conservative bound where
+    /// no closed form exists).
+    pub fn dist(&self, p: DVec3) -> f64 {
+        match self {
+            PNode::Sphere { c, r, .. } => sdf::sphere(p, *c, *r),
+            PNode::Box { c, h, .. } => sdf::rect_prism(p, *c, *h),
+            PNode::Cylinder { c, r, hh, .. } => sdf::cylinder(p, *c, *r, *hh),
+            PNode::Strut { s, .. } => s.dist(p),
+            PNode::Prism { p: prism, .. } => prism.dist(p),
+            PNode::Function {
+                expr,
+                clip_c,
+                clip_h,
+                ..
+            } => {
+                let mut slots = [0.0; COORD_SLOTS];
+                coord_slots(p, expr.used_vars(), &mut slots);
+                expr.eval(&slots).max(sdf::rect_prism(p, *clip_c, *clip_h))
+            }
+            PNode::Tpms { t, .. } => t.dist(p),
+            PNode::Lattice { struts, clip_h, .. } => {
+                let mut d = f64::INFINITY;
+                for s in struts {
+                    d = d.min(s.dist(p));
+                }
+                match clip_h {
+                    Some(h) => d.max(sdf::rect_prism(p, DVec3::ZERO, *h)),
+                    None => d,
+                }
+            }
+            PNode::Translate { t, child } => child.dist(p - *t),
+            PNode::Rotate {
+                to_local,
+                around,
+                child,
+            } => child.dist(*to_local * (p - *around) + *around),
+            PNode::Scale { inv, k, child } => child.dist(p * *inv) * *k,
+            PNode::Union(u) => u.union_dist(p),
+            PNode::Intersection(n) => {
+                let mut d = n.children[0].dist(p);
+                for c in &n.children[1..] {
+                    let e = c.dist(p);
+                    d = if n.smooth > 0.0 {
+                        sdf::smooth_max(d, e, n.smooth)
+                    } else {
+                        d.max(e)
+                    };
+                }
+                d
+            }
+            PNode::Difference { a, b, smooth } => {
+                let (da, db) = (a.dist(p), -b.dist(p));
+                if *smooth > 0.0 {
+                    sdf::smooth_max(da, db, *smooth)
+                } else {
+                    da.max(db)
+                }
+            }
+            PNode::Offset { o, child } => child.dist(p) - *o,
+            PNode::Shell { t, child } => {
+                let d = child.dist(p);
+                d.max(-*t - d)
+            }
+            PNode::Tile { cell, child } => child.dist(tile_local(p, *cell)),
+            PNode::FGrade(g) => g.child.dist(p),
+            PNode::Blend { child, .. } => child.dist(p),
+            PNode::Mesh { mesh, .. } => mesh.signed_distance(p),
+            PNode::SimField(s) => s.field.signed_distance(p),
+        }
+    }
+}
+
+impl NAry {
+    /// Minimum (or pyvcad's smooth minimum, folded in child order).
+    pub fn union_dist(&self, p: DVec3) -> f64 {
+        if let Some(index) = &self.index {
+            return self.indexed_min(index, p);
+        }
+        let mut d = self.children[0].dist(p);
+        for c in &self.children[1..] {
+            let e = c.dist(p);
+            d = if self.smooth > 0.0 {
+                sdf::smooth_min(d, e, self.smooth)
+            } else {
+                d.min(e)
+            };
+        }
+        d
+    }
+
+    /// Sharp minimum through the spatial index (see `union_index`).
+    fn indexed_min(&self, index: &UnionIndex, p: DVec3) -> f64 {
+        let mut best = f64::INFINITY;
+        for &i in index.always() {
+            best = best.min(self.children[i as usize].dist(p));
+        }
+        if let Candidates::Cell { items, margin, .. } = index.candidates(p) {
+            for &i in items {
+                best = best.min(self.children[i as usize].dist(p));
+            }
+            if best < margin {
+                return best;
+            }
+        }
+        index.bvh().nearest(p, best, |i| {
+            let d = self.children[i as usize].dist(p);
+            best = best.min(d);
+            best
+        });
+        best
+    }
+}
+
+/// pyvcad's Tile mapping: `p − c·floor(p/c) − c/2` puts the child's origin
+/// at every cell centre `(k + ½)·c`.
+#[inline]
+pub fn tile_local(p: DVec3, cell: DVec3) -> DVec3 {
+    p - cell * (p / cell).floor() - cell * 0.5
+}
+
+/// Fill the coordinate slots an expression reads: x y z always, the derived
+/// cylindrical and spherical ones only when `used` asks for them.
+#[inline]
+pub fn coord_slots(p: DVec3, used: u64, slots: &mut [f64]) {
+    slots[0] = p.x;
+    slots[1] = p.y;
+    slots[2] = p.z;
+    if used & DERIVED_MASK != 0 {
+        crate::expr::fill_derived_coords(slots);
+    }
+}

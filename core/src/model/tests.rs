@@ -1,0 +1,482 @@
+//! Node semantics: one test per node, pyvcad's cross-check designs
+//! (OPENVCAD.md §12), every deliberate fix (docs/PYVCAD.md), and the
+//! soundness of interval bounds and of the large-union index.
+
+use glam::DVec3;
+
+use crate::Model;
+use crate::bounds::Aabb;
+use crate::script::{ScriptOptions, run_script};
+
+fn model(src: &str) -> Model {
+    let src = format!("let m = default_materials();\n{src}");
+    let d = run_script(&src, "t.rhai", &ScriptOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    Model::prepare(&d.root, d.materials.clone()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn d(m: &Model, x: f64, y: f64, z: f64) -> f64 {
+    m.distance(DVec3::new(x, y, z))
+}
+
+/// Fractions at p by material id (0 for absent).
+fn frac(m: &Model, p: [f64; 3], id: u8) -> f64 {
+    let (_, f) = m.eval_point(DVec3::from_array(p));
+    f.iter().find(|(i, _)| *i == id).map_or(0.0, |x| x.1)
+}
+
+fn close(a: f64, b: f64, tol: f64) {
+    assert!((a - b).abs() <= tol, "{a} vs {b}");
+}
+
+// ---- OPENVCAD.md §12: pyvcad's own values ----
+
+#[test]
+fn d1_csg_priority() {
+    let m = model(
+        "let u = Union(false, [Sphere(Vec3(0,0,0), 5, 1), RectPrism(Vec3(4,0,0), Vec3(6,4,4), 3)]);
+         Difference(u, Cylinder(Vec3(0,0,0), 1.5, 20, 2))",
+    );
+    close(d(&m, 0.0, 0.0, 0.0), 1.5, 1e-12);
+    close(d(&m, 3.0, 0.0, 0.0), -1.5, 1e-12);
+    close(d(&m, 6.5, 1.0, 1.0), -0.5, 1e-12);
+    assert_eq!(frac(&m, [3.0, 0.0, 0.0], 1), 1.0);
+    assert_eq!(frac(&m, [6.5, 1.0, 1.0], 3), 1.0);
+    assert_eq!(
+        m.materials(),
+        &[1, 2, 3],
+        "pyvcad's material_list includes the subtracted green"
+    );
+}
+
+#[test]
+fn d2_fgrade_sees_local_coordinates() {
+    let m = model(
+        "let bar = RectPrism(Vec3(0,0,0), Vec3(10,4,2), 4);
+         let g = FGrade([\"clamp(0, x/10 + 0.5, 1)\", \"1 - clamp(0, x/10 + 0.5, 1)\"], [1, 3], false, bar);
+         Translate(5, 0, 0, g)",
+    );
+    close(d(&m, 5.0, 0.0, 0.0), -1.0, 1e-12);
+    close(frac(&m, [5.0, 0.0, 0.0], 1), 0.5, 1e-12);
+    close(frac(&m, [7.5, 1.0, 0.5], 1), 0.75, 1e-12);
+    close(frac(&m, [7.5, 1.0, 0.5], 3), 0.25, 1e-12);
+    close(d(&m, 11.0, 0.0, 0.0), 1.0, 1e-12);
+}
+
+#[test]
+fn d3_smooth_union() {
+    let m = model("Union(2.0, false, [Sphere(Vec3(-3,0,0), 3, 1), Sphere(Vec3(3,0,0), 3, 2)])");
+    close(d(&m, 0.0, 0.0, 0.0), -2.0, 1e-12);
+    close(d(&m, 0.0, 2.5, 0.0), -1.0948751620466721, 1e-12);
+    close(d(&m, -5.0, 0.0, 0.0), -1.125, 1e-12);
+    // In the fillet no child contains the point: the nearest (first on ties) wins.
+    assert_eq!(frac(&m, [0.0, 2.5, 0.0], 1), 1.0);
+    let b = m.bbox();
+    assert_eq!(
+        (b.min, b.max),
+        (DVec3::new(-8.0, -5.0, -5.0), DVec3::new(8.0, 5.0, 5.0))
+    );
+}
+
+#[test]
+fn d4_bcc_lattice_box() {
+    let m = model(
+        "let cell = GraphLattice(LatticeType::BodyCenteredCubic, Vec3(2,2,2), 0.2, 1);
+         Intersection(false, [Tile(cell), RectPrism(Vec3(0,0,0), Vec3(10,10,10), 3)])",
+    );
+    close(d(&m, 1.0, 1.0, 1.0), -0.2, 1e-7);
+    close(d(&m, 0.5, 0.5, 0.5), -0.2, 1e-7);
+    close(d(&m, 1.3, 1.0, 0.7), 0.044948965311050415, 1e-7);
+    assert_eq!(frac(&m, [1.0, 1.0, 1.0], 1), 1.0);
+}
+
+#[test]
+fn d5_shell_grade_scale() {
+    let m = model(
+        "let shell = Shell(-1.0, Cylinder(Vec3(0,0,0), 5, 10, 1));
+         let g = FGrade([\"clamp(0, -d, 1)\", \"1 - clamp(0, -d, 1)\"], [1, 3], false, shell);
+         Scale(1, 1, 2, g)",
+    );
+    close(d(&m, 4.5, 0.0, 0.0), -0.5, 1e-12);
+    close(frac(&m, [4.5, 0.0, 0.0], 1), 0.5, 1e-12);
+    // pyvcad: -0.2 with fractions 0.2 / 0.8; ours is scaled by min|s| = 1.
+    close(d(&m, 0.0, 4.8, 5.0), -0.2, 1e-12);
+    close(frac(&m, [0.0, 4.8, 5.0], 1), 0.2, 1e-7);
+    close(d(&m, 2.0, 0.0, 0.0), 2.0, 1e-12);
+}
+
+// ---- deliberate fixes (docs/PYVCAD.md) ----
+
+#[test]
+fn rotate_geometry_and_box_agree() {
+    let m = model(
+        "Rotate(0, 0, 90, Vec3(0,0,0), Translate(5, 0, 0, RectPrism(Vec3(0,0,0), Vec3(10,4,2), 1)))",
+    );
+    let b = m.bbox();
+    assert!(
+        (b.min - DVec3::new(-2.0, 0.0, -1.0)).length() < 1e-9,
+        "{b:?}"
+    );
+    assert!(
+        (b.max - DVec3::new(2.0, 10.0, 1.0)).length() < 1e-9,
+        "{b:?}"
+    );
+    // The geometry is where the box is (pyvcad puts it at -y).
+    close(d(&m, 0.0, 5.0, 0.0), -1.0, 1e-9);
+    assert!(d(&m, 0.0, -5.0, 0.0) > 4.0);
+}
+
+#[test]
+fn scale_keeps_distances_metric() {
+    let m = model("Scale(2, 2, 2, Sphere(Vec3(0,0,0), 1, 1))");
+    close(d(&m, 3.0, 0.0, 0.0), 1.0, 1e-12);
+    let m = model("Scale(1, 1, 3, Sphere(Vec3(0,0,0), 1, 1))");
+    // A lower bound of the true distance (0.5 along x) with the right sign.
+    let v = d(&m, 1.5, 0.0, 0.0);
+    assert!(v > 0.0 && v <= 0.5 + 1e-12, "{v}");
+    assert!(d(&m, 0.0, 0.0, 2.9) < 0.0);
+}
+
+#[test]
+fn offset_and_shell_accept_both_signs() {
+    let grow = model("Offset(1.0, Sphere(Vec3(0,0,0), 2, 1))");
+    close(d(&grow, 3.0, 0.0, 0.0), 0.0, 1e-12);
+    let shrink = model("Offset(-1.0, Sphere(Vec3(0,0,0), 2, 1))");
+    close(d(&shrink, 1.0, 0.0, 0.0), 0.0, 1e-12);
+    assert_eq!(shrink.bbox().max.x, 1.0);
+    for t in ["-0.5", "0.5"] {
+        let s = model(&format!("Shell({t}, Sphere(Vec3(0,0,0), 2, 1))"));
+        assert!(d(&s, 1.75, 0.0, 0.0) < 0.0);
+        assert!(d(&s, 1.0, 0.0, 0.0) > 0.0, "hollow inside");
+        close(d(&s, 0.0, 0.0, 0.0), 1.5, 1e-12);
+    }
+}
+
+#[test]
+fn intersection_box_is_tight() {
+    let m = model(
+        "Intersection(false, [Sphere(Vec3(0,0,0), 5, 1), RectPrism(Vec3(4,0,0), Vec3(2,2,2), 1)])",
+    );
+    let b = m.bbox();
+    assert_eq!((b.min.x, b.max.x), (3.0, 5.0));
+    let m = model("Difference(Sphere(Vec3(0,0,0), 5, 1), Sphere(Vec3(20,0,0), 5, 1))");
+    assert_eq!(m.bbox().max.x, 5.0);
+}
+
+#[test]
+fn function_is_clipped_to_its_box() {
+    let m = model("Function(\"x*x + y*y + z*z - 100\", 1, Vec3(-2,-2,-2), Vec3(2,2,2))");
+    assert!(d(&m, 0.0, 0.0, 0.0) < 0.0);
+    assert!(
+        d(&m, 3.0, 0.0, 0.0) > 0.0,
+        "outside the box, although f < 0"
+    );
+}
+
+#[test]
+fn fgrade_clamps_negative_fractions() {
+    let m = model("FGrade([\"-3\", \"1\"], [1, 3], true, Sphere(Vec3(0,0,0), 1, 1))");
+    assert_eq!(frac(&m, [0.0, 0.0, 0.0], 1), 0.0);
+    assert_eq!(frac(&m, [0.0, 0.0, 0.0], 3), 1.0);
+    let m = model("FGrade([\"0.2\", \"0.3\"], [1, 3], true, Sphere(Vec3(0,0,0), 1, 1))");
+    close(frac(&m, [0.0, 0.0, 0.0], 1), 0.4, 1e-12);
+}
+
+// ---- one test per remaining node ----
+
+#[test]
+fn sphere_rectprism_cylinder_strut() {
+    close(
+        d(&model("Sphere(1, 2, 3, 4, 1)"), 1.0, 2.0, 8.0),
+        1.0,
+        1e-12,
+    );
+    close(
+        d(
+            &model("RectPrism(Vec3(0,0,0), Vec3(2,4,6), 1)"),
+            2.0,
+            3.0,
+            4.0,
+        ),
+        3f64.sqrt(),
+        1e-12,
+    );
+    close(
+        d(&model("Cylinder(Vec3(0,0,0), 1, 4, 1)"), 2.0, 0.0, 3.0),
+        2f64.sqrt(),
+        1e-12,
+    );
+    let s = model("Strut(Vec3(0,0,0), Vec3(10,0,0), 0.5, 1)");
+    close(d(&s, 5.0, 1.0, 0.0), 0.5, 1e-12);
+    close(d(&s, -1.0, 0.0, 0.0), 0.5, 1e-12);
+}
+
+#[test]
+fn polygon_extrude() {
+    let m = model(
+        "PolygonExtrude([Vec3(0,0,0), Vec3(4,0,0), Vec3(4,2,0), Vec3(0,2,0)], 3.0, false, 1)",
+    );
+    close(d(&m, 2.0, 1.0, 1.5), -1.0, 1e-12);
+    close(d(&m, 2.0, 1.0, 4.0), 1.0, 1e-12);
+    close(d(&m, 6.0, 1.0, 1.0), 2.0, 1e-12);
+    // Clockwise in XY extrudes toward -Z; symmetric centres it.
+    let cw = model(
+        "PolygonExtrude([Vec3(0,0,0), Vec3(0,2,0), Vec3(4,2,0), Vec3(4,0,0)], 3.0, false, 1)",
+    );
+    assert!(d(&cw, 2.0, 1.0, -1.5) < 0.0 && d(&cw, 2.0, 1.0, 1.5) > 0.0);
+    let sym =
+        model("PolygonExtrude([Vec3(0,0,0), Vec3(4,0,0), Vec3(4,2,0), Vec3(0,2,0)], 3.0, true, 1)");
+    assert!(d(&sym, 2.0, 1.0, -1.4) < 0.0 && d(&sym, 2.0, 1.0, 1.4) < 0.0);
+}
+
+#[test]
+fn function_node() {
+    let m = model("Function(\"x*x + y*y + z*z - 4\", 1)");
+    close(d(&m, 1.0, 0.0, 0.0), -3.0, 1e-12);
+    assert!(d(&m, 3.0, 0.0, 0.0) > 0.0);
+}
+
+#[test]
+fn translate_and_rotate_about_a_point() {
+    close(
+        d(
+            &model("Translate(5, 0, 0, Sphere(Vec3(0,0,0), 1, 1))"),
+            5.0,
+            0.0,
+            0.0,
+        ),
+        -1.0,
+        1e-12,
+    );
+    let r = model("Rotate(0, 0, 90, Vec3(5,0,0), Sphere(Vec3(6,0,0), 0.5, 1))");
+    assert!(d(&r, 5.0, 1.0, 0.0) < -0.49);
+}
+
+#[test]
+fn unions_blend_materials_on_request() {
+    let m = model("Union(true, [Sphere(Vec3(0,0,0), 2, 1), Sphere(Vec3(1,0,0), 2, 3)])");
+    close(frac(&m, [0.5, 0.0, 0.0], 1), 0.5, 1e-12);
+    close(frac(&m, [0.5, 0.0, 0.0], 3), 0.5, 1e-12);
+    let m = model("Intersection(true, [Sphere(Vec3(0,0,0), 2, 1), Sphere(Vec3(1,0,0), 2, 3)])");
+    close(frac(&m, [0.5, 0.0, 0.0], 3), 0.5, 1e-12);
+}
+
+#[test]
+fn smooth_intersection_and_difference() {
+    let i =
+        model("Intersection(1.0, false, [Sphere(Vec3(0,0,0), 2, 1), Sphere(Vec3(1,0,0), 2, 1)])");
+    assert!(d(&i, 0.5, 0.0, 0.0) < 0.0);
+    let df = model("Difference(0.5, Sphere(Vec3(0,0,0), 2, 1), Sphere(Vec3(2,0,0), 1, 1))");
+    assert!(d(&df, -1.0, 0.0, 0.0) < 0.0 && d(&df, 1.5, 0.0, 0.0) > 0.0);
+}
+
+#[test]
+fn tile_replicates_at_cell_centres() {
+    let m = model(
+        "Intersection(false, [Tile(4, 4, 4, Sphere(Vec3(0,0,0), 1, 1)), RectPrism(Vec3(0,0,0), Vec3(20,20,20), 1)])",
+    );
+    // Copies at (k + 1/2) * 4: 2, 6, -2, ...
+    close(d(&m, 2.0, 2.0, 2.0), -1.0, 1e-12);
+    close(d(&m, 6.0, -2.0, 2.0), -1.0, 1e-12);
+    assert!(d(&m, 0.0, 0.0, 0.0) > 0.0);
+    assert!(!model("Tile(Sphere(Vec3(0,0,0), 1, 1))").bbox().is_finite());
+}
+
+#[test]
+fn blend_averages_neighbourhood() {
+    let m = model(
+        "Blend(1.0, Union(false, [RectPrism(Vec3(-5,0,0), Vec3(10,10,10), 1), RectPrism(Vec3(5,0,0), Vec3(10,10,10), 3)]))",
+    );
+    let f1 = frac(&m, [0.0, 0.0, 0.0], 1);
+    assert!(f1 > 0.2 && f1 < 0.8, "{f1}");
+    assert_eq!(frac(&m, [-4.0, 0.0, 0.0], 1), 1.0);
+}
+
+#[test]
+fn graph_lattices() {
+    for t in [
+        "BodyCenteredCubic",
+        "FaceCenteredCubic",
+        "Cubic",
+        "KelvinCell",
+        "Octet",
+    ] {
+        let m = model(&format!(
+            "GraphLattice(LatticeType::{t}, Vec3(4,4,4), 0.3, 1)"
+        ));
+        let b = m.bbox();
+        assert_eq!(b.max, DVec3::splat(2.0), "{t}");
+        assert!(d(&m, 3.0, 0.0, 0.0) > 0.0, "{t}: clipped to the cell");
+    }
+    let c = model("GraphLattice([[Vec3(0,0,0), Vec3(5,0,0)], [Vec3(0,0,0), Vec3(0,5,0)]], 0.5, 1)");
+    close(d(&c, 2.5, 0.0, 1.0), 0.5, 1e-12);
+    assert_eq!(c.bbox().min, DVec3::splat(-0.5), "box grown by the radius");
+}
+
+#[test]
+fn tpms_sheets() {
+    for t in ["Gyroid", "SchwarzP", "Diamond"] {
+        let m = model(&format!(
+            "Intersection(false, [{t}(5.0, 0.5, 1), Sphere(Vec3(0,0,0), 10, 1)])"
+        ));
+        let mut inside = 0;
+        for i in 0..1000 {
+            let p =
+                DVec3::new((i % 10) as f64, ((i / 10) % 10) as f64, (i / 100) as f64) * 0.7 - 3.0;
+            if m.distance(p) <= 0.0 {
+                inside += 1;
+            }
+        }
+        // A 0.5 mm sheet with a 5 mm cell fills a modest share of the volume.
+        assert!(inside > 30 && inside < 500, "{t}: {inside}");
+    }
+}
+
+// ---- soundness of bounds and of the union index ----
+
+const DESIGNS: [&str; 6] = [
+    "Union(false, [Sphere(Vec3(0,0,0), 5, 1), RectPrism(Vec3(4,0,0), Vec3(6,4,4), 3)])",
+    "Intersection(false, [Tile(GraphLattice(LatticeType::BodyCenteredCubic, Vec3(5,5,5), 0.175, 1)), Sphere(Vec3(0,0,0), 10, 3)])",
+    "FGrade([\"x/15+0.5\", \"-x/15+0.5\"], [1, 3], true, RectPrism(Vec3(0,0,0), Vec3(15,10,5), 11))",
+    "Rotate(20, 30, 40, Vec3(1,2,3), Scale(1, 2, 0.5, Shell(-1.0, Cylinder(Vec3(0,0,0), 5, 10, 1))))",
+    "Intersection(false, [Gyroid(Vec3(6,6,6), 0.6, 1), Difference(1.0, Sphere(Vec3(0,0,0), 8, 1), Function(\"x*x+y*y-9\", 1, Vec3(-10,-10,-10), Vec3(10,10,10)))])",
+    "let u = Union(); for i in 0..40 { u.add_child(Strut(Vec3(i % 7, i % 5, i % 3) * 2.0, Vec3(i % 3, i % 7, i % 5) * 2.0, 0.3, 1 + i % 2)); } u",
+];
+
+/// Deterministic pseudo-random numbers in [0, 1).
+fn rng(seed: u64) -> impl FnMut() -> f64 {
+    let mut s = seed | 1;
+    move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+#[test]
+fn intervals_contain_every_sample() {
+    for (n, src) in DESIGNS.iter().enumerate() {
+        let m = model(src);
+        let b = m
+            .bbox()
+            .intersection(&Aabb::new(DVec3::splat(-12.0), DVec3::splat(12.0)));
+        let mut r = rng(n as u64 + 1);
+        for _ in 0..200 {
+            let c = b.min + DVec3::new(r(), r(), r()) * b.size();
+            let size = DVec3::new(r(), r(), r()) * 3.0;
+            let bx = Aabb::from_center_size(c, size);
+            let iv = m.interval(&bx);
+            for _ in 0..20 {
+                let p = bx.min + DVec3::new(r(), r(), r()) * bx.size();
+                let v = m.distance(p);
+                assert!(
+                    iv.lo <= v + 1e-9 && v <= iv.hi + 1e-9,
+                    "design {n}: {v} not in {iv:?} over {bx:?}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn constant_fractions_are_constant() {
+    for (n, src) in DESIGNS.iter().enumerate() {
+        let m = model(src);
+        let b = m
+            .bbox()
+            .intersection(&Aabb::new(DVec3::splat(-12.0), DVec3::splat(12.0)));
+        let mut r = rng(100 + n as u64);
+        for _ in 0..300 {
+            let c = b.min + DVec3::new(r(), r(), r()) * b.size();
+            let bx = Aabb::from_center_size(c, DVec3::new(r(), r(), r()) * 2.0);
+            if !m.constant_fractions(&bx) {
+                continue;
+            }
+            let mut first: Option<Vec<(u8, f64)>> = None;
+            for _ in 0..20 {
+                let p = bx.min + DVec3::new(r(), r(), r()) * bx.size();
+                let (dist, f) = m.eval_point(p);
+                if dist > 0.0 {
+                    continue;
+                }
+                match &first {
+                    None => first = Some(f),
+                    Some(g) => {
+                        for ((_, a), (_, b)) in g.iter().zip(&f) {
+                            assert!((a - b).abs() < 1e-9, "design {n}: fractions vary in {bx:?}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn indexed_union_matches_brute_force() {
+    // 60 struts: indexed. Compare with the min over single-strut models.
+    let mut src = String::from("let u = Union();\n");
+    let mut singles = Vec::new();
+    let mut r = rng(9);
+    for i in 0..60 {
+        let a = DVec3::new(r(), r(), r()) * 20.0 - 10.0;
+        let b = a + DVec3::new(r(), r(), r()) * 6.0 - 3.0;
+        let s = format!(
+            "Strut(Vec3({},{},{}), Vec3({},{},{}), 0.4, {})",
+            a.x,
+            a.y,
+            a.z,
+            b.x,
+            b.y,
+            b.z,
+            1 + i % 3
+        );
+        src.push_str(&format!("u.add_child({s});\n"));
+        singles.push(model(&s));
+    }
+    src.push('u');
+    let m = model(&src);
+    for _ in 0..3000 {
+        let p = DVec3::new(r(), r(), r()) * 30.0 - 15.0;
+        let want = singles
+            .iter()
+            .map(|s| s.distance(p))
+            .fold(f64::INFINITY, f64::min);
+        close(m.distance(p), want, 1e-12);
+        if want <= 0.0 {
+            // First containing strut wins.
+            let first = singles.iter().position(|s| s.distance(p) <= 0.0).unwrap();
+            let id = 1 + (first % 3) as u8;
+            assert_eq!(frac(&m, p.to_array(), id), 1.0);
+        }
+    }
+}
+
+#[test]
+fn prepare_errors() {
+    let d = run_script("Union()", "t", &ScriptOptions::default()).unwrap();
+    let e = Model::prepare(&d.root, d.materials)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("Union") && e.contains("no children"), "{e}");
+    let d = run_script(
+        "Difference(Sphere(), Sphere())",
+        "t",
+        &ScriptOptions::default(),
+    )
+    .unwrap();
+    assert!(Model::prepare(&d.root, d.materials).is_ok());
+    let e = run_script(
+        "PolygonExtrude([Vec3(0,0,0), Vec3(1,0,0), Vec3(2,0,0)], 1.0)",
+        "t",
+        &ScriptOptions::default(),
+    )
+    .map(|d| {
+        Model::prepare(&d.root, d.materials)
+            .map(|_| ())
+            .unwrap_err()
+            .to_string()
+    })
+    .unwrap();
+    assert!(e.contains("collinear"), "{e}");
+}

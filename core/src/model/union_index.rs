@@ -1,0 +1,313 @@
+//! Spatial index over the children of a large union (the 3,286 struts of the
+//! bunny lattice, the 144 swatches of the calibration sheet).
+//!
+//! Two structures over the children's bounding boxes:
+//!
+//! * a **uniform grid**: each cell lists (in child order) the children whose
+//!   box, grown by `margin`, touches the cell. For a point in a cell, a child
+//!   that is not listed is farther than `margin` from the point's cell, so —
+//!   for children whose value is at least the distance to their own box, which
+//!   holds for every exact or conservative SDF here — its value exceeds
+//!   `margin` and it cannot be the minimum when a listed child is below
+//!   `margin`. It also cannot contain the point, so "first child containing p"
+//!   is found among the listed ones.
+//! * a **BVH** for the rest: points outside the grid or with no listed child
+//!   closer than `margin` get the exact minimum by nearest-first traversal
+//!   that prunes subtrees whose box is farther than the best value so far.
+//!
+//! Both are built once at prepare time; queries allocate nothing.
+
+use glam::DVec3;
+
+use crate::bounds::Aabb;
+
+/// Grid + BVH over child boxes. Children with infinite boxes are kept in
+/// `always` and visited for every query.
+#[derive(Debug)]
+pub struct UnionIndex {
+    grid_box: Aabb,
+    dims: [usize; 3],
+    inv_cell: DVec3,
+    /// CSR: children of cell c are `items[offsets[c]..offsets[c+1]]`.
+    offsets: Vec<u32>,
+    items: Vec<u32>,
+    margin: f64,
+    always: Vec<u32>,
+    bvh: Bvh,
+}
+
+/// What a query may visit: the listed children of the point's cell, or
+/// `None` when the caller must fall back to the BVH.
+pub enum Candidates<'a> {
+    /// Children to test, ascending; `margin` bounds the unlisted ones.
+    Cell {
+        /// Listed children (ascending index).
+        items: &'a [u32],
+        /// Children with infinite boxes (ascending index).
+        always: &'a [u32],
+        /// Every unlisted finite child's value exceeds this.
+        margin: f64,
+    },
+    /// The point is outside the grid.
+    Outside,
+}
+
+impl UnionIndex {
+    /// Build over `boxes` (one per child, in child order).
+    pub fn build(boxes: &[Aabb]) -> Self {
+        let mut always = Vec::new();
+        let mut finite: Vec<u32> = Vec::new();
+        let mut grid_box = Aabb::EMPTY;
+        for (i, b) in boxes.iter().enumerate() {
+            if b.is_finite() {
+                finite.push(i as u32);
+                grid_box = grid_box.union(b);
+            } else if !b.is_empty() {
+                always.push(i as u32);
+            }
+        }
+        // About 4 cells per finite child, cubic cells.
+        let n = finite.len().max(1) as f64;
+        let size = grid_box.size().max(DVec3::splat(1e-9));
+        let cell = ((size.x * size.y * size.z) / (4.0 * n)).cbrt();
+        // Mean child size bounds the cell from below so long struts do not
+        // land in hundreds of cells each.
+        let mean_child = finite
+            .iter()
+            .map(|&i| boxes[i as usize].size().min_element())
+            .sum::<f64>()
+            / n;
+        let cell = cell.max(mean_child * 0.5).max(size.max_element() / 256.0);
+        let dims = [
+            ((size.x / cell).ceil() as usize).clamp(1, 256),
+            ((size.y / cell).ceil() as usize).clamp(1, 256),
+            ((size.z / cell).ceil() as usize).clamp(1, 256),
+        ];
+        let cell_size = size / DVec3::new(dims[0] as f64, dims[1] as f64, dims[2] as f64);
+        let margin = cell_size.max_element();
+        let inv_cell = DVec3::ONE / cell_size;
+        let ncells = dims[0] * dims[1] * dims[2];
+        let cell_range = |b: &Aabb| {
+            let lo = ((b.min - grid_box.min) * inv_cell).floor();
+            let hi = ((b.max - grid_box.min) * inv_cell).floor();
+            let clamp = |v: f64, d: usize| (v.max(0.0) as usize).min(d - 1);
+            (
+                [
+                    clamp(lo.x, dims[0]),
+                    clamp(lo.y, dims[1]),
+                    clamp(lo.z, dims[2]),
+                ],
+                [
+                    clamp(hi.x, dims[0]),
+                    clamp(hi.y, dims[1]),
+                    clamp(hi.z, dims[2]),
+                ],
+            )
+        };
+        // Two passes: count, then fill, so items are in child order per cell.
+        let mut counts = vec![0u32; ncells + 1];
+        let visit = |f: &mut dyn FnMut(usize, u32)| {
+            for &i in &finite {
+                let (lo, hi) = cell_range(&boxes[i as usize].expand(margin));
+                for z in lo[2]..=hi[2] {
+                    for y in lo[1]..=hi[1] {
+                        for x in lo[0]..=hi[0] {
+                            f(x + dims[0] * (y + dims[1] * z), i);
+                        }
+                    }
+                }
+            }
+        };
+        visit(&mut |c, _| counts[c + 1] += 1);
+        for c in 0..ncells {
+            counts[c + 1] += counts[c];
+        }
+        let offsets = counts.clone();
+        let mut fill = counts;
+        let mut items = vec![0u32; offsets[ncells] as usize];
+        visit(&mut |c, i| {
+            items[fill[c] as usize] = i;
+            fill[c] += 1;
+        });
+        let bvh = Bvh::build(boxes, &finite);
+        Self {
+            grid_box,
+            dims,
+            inv_cell,
+            offsets,
+            items,
+            margin,
+            always,
+            bvh,
+        }
+    }
+
+    /// The candidates for point `p`.
+    #[inline]
+    pub fn candidates(&self, p: DVec3) -> Candidates<'_> {
+        if !self.grid_box.contains(p) {
+            return Candidates::Outside;
+        }
+        let g = ((p - self.grid_box.min) * self.inv_cell).floor();
+        let x = (g.x as usize).min(self.dims[0] - 1);
+        let y = (g.y as usize).min(self.dims[1] - 1);
+        let z = (g.z as usize).min(self.dims[2] - 1);
+        let c = x + self.dims[0] * (y + self.dims[1] * z);
+        let (a, b) = (self.offsets[c] as usize, self.offsets[c + 1] as usize);
+        Candidates::Cell {
+            items: &self.items[a..b],
+            always: &self.always,
+            margin: self.margin,
+        }
+    }
+
+    /// Children with infinite boxes.
+    pub fn always(&self) -> &[u32] {
+        &self.always
+    }
+
+    /// The BVH over finite children.
+    pub fn bvh(&self) -> &Bvh {
+        &self.bvh
+    }
+}
+
+/// A flattened binary BVH over child boxes (median split on the longest axis).
+#[derive(Debug, Default)]
+pub struct Bvh {
+    nodes: Vec<BvhNode>,
+    /// Child indices, leaves point into ranges of this.
+    order: Vec<u32>,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct BvhNode {
+    bbox: Aabb,
+    /// Leaf: first index into `order`; inner: index of the right child (left is next).
+    first_or_right: u32,
+    /// Leaf: count (> 0); inner: 0.
+    count: u32,
+}
+
+const LEAF_SIZE: usize = 4;
+
+impl Bvh {
+    /// Build over the children `ids` with boxes `boxes[id]`.
+    pub fn build(boxes: &[Aabb], ids: &[u32]) -> Self {
+        let mut order = ids.to_vec();
+        let mut nodes = Vec::with_capacity(2 * ids.len() / LEAF_SIZE + 1);
+        if !order.is_empty() {
+            let n = order.len();
+            build_rec(boxes, &mut order, 0, n, &mut nodes);
+        }
+        Self { nodes, order }
+    }
+
+    /// Visit children in near-to-far-ish order, pruning subtrees whose box is
+    /// farther than the bound `visit` returns (it is called with a child
+    /// index and returns the new pruning distance).
+    pub fn nearest(&self, p: DVec3, mut bound: f64, mut visit: impl FnMut(u32) -> f64) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let mut stack: [u32; 64] = [0; 64];
+        let mut sp = 1usize;
+        while sp > 0 {
+            sp -= 1;
+            let node = &self.nodes[stack[sp] as usize];
+            if node.bbox.distance(p) > bound {
+                continue;
+            }
+            if node.count > 0 {
+                let a = node.first_or_right as usize;
+                for &c in &self.order[a..a + node.count as usize] {
+                    bound = bound.min(visit(c));
+                }
+            } else {
+                let left = stack[sp] + 1;
+                let right = node.first_or_right;
+                let dl = self.nodes[left as usize].bbox.distance_squared(p);
+                let dr = self.nodes[right as usize].bbox.distance_squared(p);
+                // Push the farther first so the nearer is visited first.
+                let (far, near) = if dl < dr {
+                    (right, left)
+                } else {
+                    (left, right)
+                };
+                if sp + 2 <= stack.len() {
+                    stack[sp] = far;
+                    stack[sp + 1] = near;
+                    sp += 2;
+                }
+            }
+        }
+    }
+
+    /// Visit every child whose box overlaps `b`.
+    pub fn overlapping(&self, b: &Aabb, mut visit: impl FnMut(u32)) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let mut stack: [u32; 64] = [0; 64];
+        let mut sp = 1usize;
+        while sp > 0 {
+            sp -= 1;
+            let idx = stack[sp];
+            let node = &self.nodes[idx as usize];
+            if !node.bbox.overlaps(b) {
+                continue;
+            }
+            if node.count > 0 {
+                let a = node.first_or_right as usize;
+                for &c in &self.order[a..a + node.count as usize] {
+                    visit(c);
+                }
+            } else if sp + 2 <= stack.len() {
+                stack[sp] = idx + 1;
+                stack[sp + 1] = node.first_or_right;
+                sp += 2;
+            }
+        }
+    }
+}
+
+fn build_rec(
+    boxes: &[Aabb],
+    order: &mut [u32],
+    start: usize,
+    end: usize,
+    nodes: &mut Vec<BvhNode>,
+) {
+    let mut bbox = Aabb::EMPTY;
+    for &i in &order[start..end] {
+        bbox = bbox.union(&boxes[i as usize]);
+    }
+    let me = nodes.len();
+    nodes.push(BvhNode {
+        bbox,
+        first_or_right: start as u32,
+        count: (end - start) as u32,
+    });
+    if end - start <= LEAF_SIZE {
+        return;
+    }
+    let size = bbox.size();
+    let axis = if size.x >= size.y && size.x >= size.z {
+        0
+    } else if size.y >= size.z {
+        1
+    } else {
+        2
+    };
+    let mid = (start + end) / 2;
+    order[start..end].select_nth_unstable_by(mid - start, |a, b| {
+        let ca = boxes[*a as usize].center()[axis];
+        let cb = boxes[*b as usize].center()[axis];
+        ca.total_cmp(&cb)
+    });
+    build_rec(boxes, order, start, mid, nodes);
+    let right = nodes.len() as u32;
+    build_rec(boxes, order, mid, end, nodes);
+    nodes[me].first_or_right = right;
+    nodes[me].count = 0;
+}

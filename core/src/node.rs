@@ -1,0 +1,305 @@
+//! The design tree as a script builds it.
+//!
+//! A [`Node`] is a cheap handle (`Arc`) to an immutable [`NodeKind`]; children
+//! are shared, so a unit cell used by `Tile` or a strut used a thousand times
+//! exists once. Building is cheap and does no geometry; [`crate::Model::prepare`]
+//! turns the tree into an evaluator. Names and argument orders follow pyvcad
+//! 2.x (OPENVCAD.md section 2).
+
+use std::sync::Arc;
+
+use glam::DVec3;
+
+use crate::expr::Expr;
+use crate::material::MaterialId;
+
+/// Where in the design script a node was made (1-based), for error messages.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Origin {
+    /// Script line.
+    pub line: u32,
+    /// Script column.
+    pub column: u32,
+}
+
+impl std::fmt::Display for Origin {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}:{}", self.line, self.column)
+    }
+}
+
+/// Standard unit cells of [`NodeKind::GraphLattice`] (pyvcad's `LatticeType`,
+/// plus `Octet`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum LatticeType {
+    /// 4 body diagonals.
+    BodyCenteredCubic,
+    /// 12 face diagonals.
+    FaceCenteredCubic,
+    /// 12 cube edges.
+    Cubic,
+    /// Truncated octahedron (36 edges).
+    KelvinCell,
+    /// Octet truss: FCC face diagonals plus the octahedron joining face centres.
+    Octet,
+}
+
+/// Triply periodic minimal surfaces (not in pyvcad 2.x).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum TpmsType {
+    /// Schoen's gyroid: sin x cos y + sin y cos z + sin z cos x.
+    Gyroid,
+    /// Schwarz P: cos x + cos y + cos z.
+    SchwarzP,
+    /// Schwarz D (diamond).
+    Diamond,
+}
+
+/// A handle to a node of the design tree.
+#[derive(Clone, Debug)]
+pub struct Node {
+    pub(crate) kind: Arc<NodeKind>,
+    pub(crate) origin: Option<Origin>,
+}
+
+/// What a node is. Parameters are as the script gave them; validation of
+/// values happens in the constructors in [`crate::script`] and at prepare.
+#[derive(Clone, Debug)]
+#[allow(missing_docs)]
+pub enum NodeKind {
+    /// Exact `|p − c| − r`.
+    Sphere {
+        center: DVec3,
+        radius: f64,
+        material: MaterialId,
+    },
+    /// Box with full side lengths `size` (exact Euclidean distance).
+    RectPrism {
+        center: DVec3,
+        size: DVec3,
+        material: MaterialId,
+    },
+    /// Z-axis capped cylinder centred at `center`.
+    Cylinder {
+        center: DVec3,
+        radius: f64,
+        height: f64,
+        material: MaterialId,
+    },
+    /// Capsule between `a` and `b`.
+    Strut {
+        a: DVec3,
+        b: DVec3,
+        radius: f64,
+        material: MaterialId,
+    },
+    /// Planar polygon extruded along its normal.
+    PolygonExtrude {
+        vertices: Vec<DVec3>,
+        height: f64,
+        symmetric: bool,
+        material: MaterialId,
+    },
+    /// Implicit function of a math string, clipped to its box.
+    Function {
+        expr: Arc<Expr>,
+        material: MaterialId,
+        min: DVec3,
+        max: DVec3,
+    },
+    /// Sheet TPMS with wall thickness, unbounded (intersect it with a shape).
+    Tpms {
+        kind: TpmsType,
+        cell: DVec3,
+        thickness: f64,
+        material: MaterialId,
+    },
+    /// Struts of a unit cell (or a custom edge list), clipped to the cell box.
+    GraphLattice {
+        edges: Vec<(DVec3, DVec3)>,
+        cell: Option<DVec3>,
+        radius: f64,
+        material: MaterialId,
+    },
+    /// `child(p − offset)`.
+    Translate { offset: DVec3, child: Option<Node> },
+    /// Rotation by pitch (X), yaw (Y), roll (Z) degrees about `around`.
+    Rotate {
+        pitch: f64,
+        yaw: f64,
+        roll: f64,
+        around: DVec3,
+        child: Option<Node>,
+    },
+    /// Scale about the origin.
+    Scale { factors: DVec3, child: Option<Node> },
+    /// Min of children; `smooth` > 0 rounds the seams; `blend` averages materials.
+    Union {
+        smooth: f64,
+        blend: bool,
+        children: Vec<Node>,
+    },
+    /// Max of children.
+    Intersection {
+        smooth: f64,
+        blend: bool,
+        children: Vec<Node>,
+    },
+    /// `max(a, −b)`.
+    Difference {
+        smooth: f64,
+        left: Option<Node>,
+        right: Option<Node>,
+    },
+    /// Grow (positive) or shrink (negative) by `distance`.
+    Offset { distance: f64, child: Option<Node> },
+    /// Hollow with wall `thickness` (either sign, inward).
+    Shell { thickness: f64, child: Option<Node> },
+    /// Periodic repetition of the child; cell from the child's box if `None`.
+    Tile {
+        cell: Option<DVec3>,
+        child: Option<Node>,
+    },
+    /// Material fractions from math strings over the child's geometry.
+    FGrade {
+        exprs: Vec<Arc<Expr>>,
+        materials: Vec<MaterialId>,
+        prob: bool,
+        child: Option<Node>,
+    },
+    /// Average of the child's fractions over a neighbourhood of `radius`.
+    Blend { radius: f64, child: Option<Node> },
+    /// A triangle mesh as signed distance (mesh import).
+    Mesh {
+        mesh: Arc<crate::mesh::TriangleMesh>,
+        material: MaterialId,
+    },
+    /// An FEA result field driving fractions (SimulationField).
+    SimulationField {
+        field: Arc<crate::simfield::SimField>,
+        exprs: Vec<Arc<Expr>>,
+        materials: Vec<MaterialId>,
+    },
+}
+
+impl NodeKind {
+    /// pyvcad's class name of this node (for messages and `volcad info`).
+    pub fn type_name(&self) -> &'static str {
+        match self {
+            NodeKind::Sphere { .. } => "Sphere",
+            NodeKind::RectPrism { .. } => "RectPrism",
+            NodeKind::Cylinder { .. } => "Cylinder",
+            NodeKind::Strut { .. } => "Strut",
+            NodeKind::PolygonExtrude { .. } => "PolygonExtrude",
+            NodeKind::Function { .. } => "Function",
+            NodeKind::Tpms { .. } => "TPMS",
+            NodeKind::GraphLattice { .. } => "GraphLattice",
+            NodeKind::Translate { .. } => "Translate",
+            NodeKind::Rotate { .. } => "Rotate",
+            NodeKind::Scale { .. } => "Scale",
+            NodeKind::Union { .. } => "Union",
+            NodeKind::Intersection { .. } => "Intersection",
+            NodeKind::Difference { .. } => "Difference",
+            NodeKind::Offset { .. } => "Offset",
+            NodeKind::Shell { .. } => "Shell",
+            NodeKind::Tile { .. } => "Tile",
+            NodeKind::FGrade { .. } => "FGrade",
+            NodeKind::Blend { .. } => "Blend",
+            NodeKind::Mesh { .. } => "Mesh",
+            NodeKind::SimulationField { .. } => "SimulationField",
+        }
+    }
+
+    /// The children, in order (missing optional children are skipped).
+    pub fn children(&self) -> Vec<&Node> {
+        match self {
+            NodeKind::Translate { child, .. }
+            | NodeKind::Rotate { child, .. }
+            | NodeKind::Scale { child, .. }
+            | NodeKind::Offset { child, .. }
+            | NodeKind::Shell { child, .. }
+            | NodeKind::Tile { child, .. }
+            | NodeKind::FGrade { child, .. }
+            | NodeKind::Blend { child, .. } => child.iter().collect(),
+            NodeKind::Union { children, .. } | NodeKind::Intersection { children, .. } => {
+                children.iter().collect()
+            }
+            NodeKind::Difference { left, right, .. } => left.iter().chain(right.iter()).collect(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// Mutable access to the single child slot of a unary node.
+    pub(crate) fn child_slot(&mut self) -> Option<&mut Option<Node>> {
+        match self {
+            NodeKind::Translate { child, .. }
+            | NodeKind::Rotate { child, .. }
+            | NodeKind::Scale { child, .. }
+            | NodeKind::Offset { child, .. }
+            | NodeKind::Shell { child, .. }
+            | NodeKind::Tile { child, .. }
+            | NodeKind::FGrade { child, .. }
+            | NodeKind::Blend { child, .. } => Some(child),
+            _ => None,
+        }
+    }
+}
+
+impl Node {
+    /// A node with no script origin.
+    pub fn new(kind: NodeKind) -> Self {
+        Self {
+            kind: Arc::new(kind),
+            origin: None,
+        }
+    }
+
+    /// A node made at `origin` in a script.
+    pub fn with_origin(kind: NodeKind, origin: Option<Origin>) -> Self {
+        Self {
+            kind: Arc::new(kind),
+            origin,
+        }
+    }
+
+    /// What this node is.
+    pub fn kind(&self) -> &NodeKind {
+        &self.kind
+    }
+
+    /// Where the script made it.
+    pub fn origin(&self) -> Option<Origin> {
+        self.origin
+    }
+
+    /// "FGrade (line 3:12)" or "FGrade", for error messages.
+    pub fn describe(&self) -> String {
+        match self.origin {
+            Some(o) => format!("{} (made at line {})", self.kind.type_name(), o),
+            None => self.kind.type_name().to_owned(),
+        }
+    }
+
+    /// Number of distinct nodes in the tree (shared subtrees count once).
+    pub fn count_nodes(&self) -> usize {
+        let mut seen = std::collections::HashSet::new();
+        let mut stack = vec![self];
+        while let Some(n) = stack.pop() {
+            if seen.insert(Arc::as_ptr(&n.kind)) {
+                stack.extend(n.kind.children());
+            }
+        }
+        seen.len()
+    }
+
+    /// Mutable access for builder methods (`add_child`, `set_child`): copy on
+    /// write, so other handles to the same node are not changed.
+    pub(crate) fn kind_mut(&mut self) -> &mut NodeKind {
+        Arc::make_mut(&mut self.kind)
+    }
+
+    /// The identity of the shared node (for caches during prepare).
+    pub(crate) fn ptr(&self) -> *const NodeKind {
+        Arc::as_ptr(&self.kind)
+    }
+}

@@ -1,0 +1,481 @@
+//! Design scripts: Rhai with pyvcad's node names (the paper's listings
+//! translate line by line).
+//!
+//! `run_script(text) → Design { root node, material table, parameters, log }`.
+//! The engine is built per run with the run's context (script folder,
+//! parameter overrides, cancel flag), compiled once and evaluated once; it is
+//! `Send + Sync` (Rhai's `sync` feature) so runs happen on worker threads. A
+//! runaway script stops at an operation limit or when its cancel flag is set.
+//! The design is the script's final value, or else a variable named `root`.
+
+mod files_api;
+mod nodes_api;
+mod values;
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+
+use rhai::{Dynamic, Engine, EvalAltResult, NativeCallContext as Ctx, Position, Scope};
+
+use crate::material::MaterialTable;
+use crate::node::{LatticeType, Node, NodeKind};
+pub use values::Vec3;
+use values::{RResult, fail};
+
+/// A slider a script declares with `param(name, default, min, max)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Param {
+    /// Name shown beside the slider.
+    pub name: String,
+    /// The value the script ran with.
+    pub value: f64,
+    /// The declared default.
+    pub default: f64,
+    /// Lower end of the slider.
+    pub min: f64,
+    /// Upper end of the slider.
+    pub max: f64,
+}
+
+/// How to run a script.
+#[derive(Clone, Debug)]
+pub struct ScriptOptions {
+    /// Folder that relative file names (CSV, meshes, tables) resolve in; the
+    /// script may read files only under it. `None`: no file access.
+    pub base_dir: Option<PathBuf>,
+    /// Values for `param(...)` by name, overriding defaults (clamped to range).
+    pub params: HashMap<String, f64>,
+    /// Set to stop the script at its next operation.
+    pub cancel: Option<Arc<AtomicBool>>,
+    /// Operation limit (a runaway loop stops with an error).
+    pub max_operations: u64,
+}
+
+impl Default for ScriptOptions {
+    fn default() -> Self {
+        Self {
+            base_dir: None,
+            params: HashMap::new(),
+            cancel: None,
+            max_operations: 500_000_000,
+        }
+    }
+}
+
+impl ScriptOptions {
+    /// Options for a script file: files resolve in its folder.
+    pub fn for_file(path: &Path) -> Self {
+        Self {
+            base_dir: path.parent().map(|p| {
+                if p.as_os_str().is_empty() {
+                    PathBuf::from(".")
+                } else {
+                    p.to_path_buf()
+                }
+            }),
+            ..Self::default()
+        }
+    }
+}
+
+/// What a script built.
+#[derive(Clone, Debug)]
+pub struct Design {
+    /// The root node.
+    pub root: Node,
+    /// The material table the script used (pyvcad's default if none).
+    pub materials: Arc<MaterialTable>,
+    /// Parameters the script declared, in order.
+    pub params: Vec<Param>,
+    /// Lines the script printed.
+    pub log: Vec<String>,
+    /// Warnings (for example an open mesh).
+    pub warnings: Vec<String>,
+}
+
+/// A script failed: where and why.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{file}:{}: {message}", location(.line, .column))]
+pub struct ScriptError {
+    /// Script name (file name or `<editor>`).
+    pub file: String,
+    /// 1-based line, if known.
+    pub line: Option<usize>,
+    /// 1-based column, if known.
+    pub column: Option<usize>,
+    /// What went wrong, in the script's words.
+    pub message: String,
+}
+
+fn location(line: &Option<usize>, column: &Option<usize>) -> String {
+    match (line, column) {
+        (Some(l), Some(c)) => format!("{l}:{c}"),
+        (Some(l), None) => format!("{l}"),
+        _ => "?".into(),
+    }
+}
+
+/// Mutable state of one run, shared with the registered functions.
+#[derive(Default)]
+pub(crate) struct RunState {
+    pub table: Option<Arc<MaterialTable>>,
+    pub params: Vec<Param>,
+    pub log: Vec<String>,
+    pub warnings: Vec<String>,
+}
+
+/// Context the registered functions read.
+#[derive(Clone)]
+pub(crate) struct RunContext {
+    pub base_dir: Option<PathBuf>,
+    pub overrides: Arc<HashMap<String, f64>>,
+    pub state: Arc<Mutex<RunState>>,
+}
+
+impl RunContext {
+    /// Resolve `name` inside the script's folder, refusing anything outside.
+    pub fn resolve(&self, name: &str, pos: Position) -> RResult<PathBuf> {
+        let Some(base) = &self.base_dir else {
+            return fail(
+                pos,
+                format!(
+                    "cannot read \"{name}\": save the script first; files are read relative to its folder"
+                ),
+            );
+        };
+        let joined = base.join(name);
+        let canon = joined
+            .canonicalize()
+            .or_else(|e| fail(pos, format!("cannot read \"{}\": {e}", joined.display())))?;
+        let base_canon = base
+            .canonicalize()
+            .or_else(|e| fail(pos, format!("script folder {}: {e}", base.display())))?;
+        if !canon.starts_with(&base_canon) {
+            return fail(
+                pos,
+                format!(
+                    "\"{name}\" is outside the script's folder {}; scripts may only read files beside them",
+                    base.display()
+                ),
+            );
+        }
+        Ok(canon)
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, RunState> {
+        // A panic in another registered function cannot leave the state
+        // half-written in a way that matters: take it anyway.
+        self.state.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+/// Run a design script.
+pub fn run_script(source: &str, name: &str, opts: &ScriptOptions) -> Result<Design, ScriptError> {
+    let ctx = RunContext {
+        base_dir: opts.base_dir.clone(),
+        overrides: Arc::new(opts.params.clone()),
+        state: Arc::new(Mutex::new(RunState::default())),
+    };
+    let engine = build_engine(&ctx, opts);
+    let err = |e: &EvalAltResult| to_script_error(e, name);
+    let ast = engine.compile(source).map_err(|e| {
+        let pos = e.position();
+        ScriptError {
+            file: name.to_owned(),
+            line: pos.line(),
+            column: pos.position(),
+            message: e.err_type().to_string(),
+        }
+    })?;
+    let mut scope = Scope::new();
+    let value: Dynamic = engine
+        .eval_ast_with_scope(&mut scope, &ast)
+        .map_err(|e| err(&e))?;
+    let root = match value.try_cast::<Node>() {
+        Some(n) => n,
+        None => match scope.get_value::<Node>("root") {
+            Some(n) => n,
+            None => {
+                return Err(ScriptError {
+                    file: name.to_owned(),
+                    line: None,
+                    column: None,
+                    message: "the script built no design: end it with a node (for example `Union(false, [a, b])`) or assign one to `root`".into(),
+                });
+            }
+        },
+    };
+    let state = std::mem::take(&mut *ctx.lock());
+    let table = state
+        .table
+        .unwrap_or_else(|| Arc::new(MaterialTable::default_table()));
+    check_materials(&root, &table, name)?;
+    Ok(Design {
+        root,
+        materials: table,
+        params: state.params,
+        log: state.log,
+        warnings: state.warnings,
+    })
+}
+
+/// Every material id in the tree must be in the table.
+fn check_materials(root: &Node, table: &MaterialTable, name: &str) -> Result<(), ScriptError> {
+    let mut seen = std::collections::HashSet::new();
+    let mut stack = vec![root];
+    while let Some(n) = stack.pop() {
+        if !seen.insert(n.ptr()) {
+            continue;
+        }
+        let ids: Vec<u8> = match n.kind() {
+            NodeKind::Sphere { material, .. }
+            | NodeKind::RectPrism { material, .. }
+            | NodeKind::Cylinder { material, .. }
+            | NodeKind::Strut { material, .. }
+            | NodeKind::PolygonExtrude { material, .. }
+            | NodeKind::Function { material, .. }
+            | NodeKind::Tpms { material, .. }
+            | NodeKind::GraphLattice { material, .. }
+            | NodeKind::Mesh { material, .. } => vec![*material],
+            NodeKind::FGrade { materials, .. } | NodeKind::SimulationField { materials, .. } => {
+                materials.clone()
+            }
+            _ => vec![],
+        };
+        for id in ids {
+            if let Err(e) = table.check_id(id as i64) {
+                let o = n.origin();
+                return Err(ScriptError {
+                    file: name.to_owned(),
+                    line: o.map(|o| o.line as usize),
+                    column: o.map(|o| o.column as usize),
+                    message: format!("{}: {e} ({})", n.kind().type_name(), table.origin()),
+                });
+            }
+        }
+        stack.extend(n.kind().children());
+    }
+    Ok(())
+}
+
+/// Flatten Rhai's nested "error in function call" wrappers into the inner
+/// message at the innermost known position.
+fn to_script_error(e: &EvalAltResult, file: &str) -> ScriptError {
+    let mut cur = e;
+    let mut pos = e.position();
+    while let EvalAltResult::ErrorInFunctionCall(_, _, inner, p) = cur {
+        if !p.is_none() {
+            pos = *p;
+        }
+        cur = inner;
+    }
+    if !cur.position().is_none() {
+        pos = cur.position();
+    }
+    let message = match cur {
+        EvalAltResult::ErrorRuntime(v, _) => v.to_string(),
+        EvalAltResult::ErrorTerminated(..) => "stopped: the script was cancelled".into(),
+        EvalAltResult::ErrorTooManyOperations(_) => {
+            "stopped: the script ran too many operations (an endless loop?)".into()
+        }
+        other => {
+            let mut s = other.to_string();
+            if let Some(i) = s.rfind(" (line ") {
+                s.truncate(i);
+            }
+            s
+        }
+    };
+    ScriptError {
+        file: file.to_owned(),
+        line: pos.line(),
+        column: pos.position(),
+        message,
+    }
+}
+
+fn build_engine(ctx: &RunContext, opts: &ScriptOptions) -> Engine {
+    let mut engine = Engine::new();
+    engine.set_max_call_levels(256);
+    engine.set_max_expr_depths(512, 256);
+    engine.set_max_operations(opts.max_operations);
+    if let Some(cancel) = opts.cancel.clone() {
+        engine.on_progress(move |_| cancel.load(Ordering::Relaxed).then_some(Dynamic::UNIT));
+    }
+    let log = ctx.clone();
+    engine.on_print(move |s| log.lock().log.push(s.to_owned()));
+    let dbg = ctx.clone();
+    engine.on_debug(move |s, _, pos| dbg.lock().log.push(format!("[{pos}] {s}")));
+
+    register_vec3(&mut engine);
+    register_materials(&mut engine, ctx);
+    register_lattice_types(&mut engine);
+    nodes_api::register_leaves(&mut engine);
+    nodes_api::register_composites(&mut engine);
+    nodes_api::register_methods(&mut engine);
+    files_api::register(&mut engine, ctx);
+
+    let params = ctx.clone();
+    engine.register_fn(
+        "param",
+        move |c: Ctx, name: &str, default: Dynamic, min: Dynamic, max: Dynamic| -> RResult<f64> {
+            let p = c.call_position();
+            let default = values::finite(&default, "param: default", p)?;
+            let (min, max) = (
+                values::finite(&min, "param: min", p)?,
+                values::finite(&max, "param: max", p)?,
+            );
+            if min > max || default < min || default > max {
+                return fail(
+                    p,
+                    format!(
+                        "param \"{name}\": need min ≤ default ≤ max, got {min} ≤ {default} ≤ {max}"
+                    ),
+                );
+            }
+            let value = params
+                .overrides
+                .get(name)
+                .map_or(default, |v| v.clamp(min, max));
+            let mut st = params.lock();
+            if st.params.iter().any(|q| q.name == name) {
+                return fail(p, format!("param \"{name}\" is declared twice"));
+            }
+            st.params.push(Param {
+                name: name.to_owned(),
+                value,
+                default,
+                min,
+                max,
+            });
+            Ok(value)
+        },
+    );
+    engine
+}
+
+fn register_vec3(engine: &mut Engine) {
+    use glam::DVec3;
+    engine.register_type_with_name::<Vec3>("Vec3");
+    engine.register_fn(
+        "Vec3",
+        |c: Ctx, x: Dynamic, y: Dynamic, z: Dynamic| -> RResult<Vec3> {
+            let p = c.call_position();
+            Ok(Vec3(DVec3::new(
+                values::finite(&x, "Vec3: x", p)?,
+                values::finite(&y, "Vec3: y", p)?,
+                values::finite(&z, "Vec3: z", p)?,
+            )))
+        },
+    );
+    engine.register_fn("Vec3", || Vec3(DVec3::ZERO));
+    engine.register_get("x", |v: &mut Vec3| v.0.x);
+    engine.register_get("y", |v: &mut Vec3| v.0.y);
+    engine.register_get("z", |v: &mut Vec3| v.0.z);
+    engine.register_fn("+", |a: Vec3, b: Vec3| Vec3(a.0 + b.0));
+    engine.register_fn("-", |a: Vec3, b: Vec3| Vec3(a.0 - b.0));
+    engine.register_fn("-", |a: Vec3| Vec3(-a.0));
+    engine.register_fn("*", |a: Vec3, s: f64| Vec3(a.0 * s));
+    engine.register_fn("*", |s: f64, a: Vec3| Vec3(a.0 * s));
+    engine.register_fn("*", |a: Vec3, s: i64| Vec3(a.0 * s as f64));
+    engine.register_fn("/", |a: Vec3, s: f64| Vec3(a.0 / s));
+    engine.register_fn("length", |a: &mut Vec3| a.0.length());
+    engine.register_fn("distance", |a: Vec3, b: Vec3| a.0.distance(b.0));
+    engine.register_fn("to_string", |a: &mut Vec3| {
+        format!("Vec3({}, {}, {})", a.0.x, a.0.y, a.0.z)
+    });
+    engine.register_fn("to_debug", |a: &mut Vec3| {
+        format!("Vec3({}, {}, {})", a.0.x, a.0.y, a.0.z)
+    });
+}
+
+/// `materials.id("red")` and friends on a shared table.
+#[derive(Clone)]
+struct Materials(Arc<MaterialTable>);
+
+fn register_materials(engine: &mut Engine, ctx: &RunContext) {
+    engine.register_type_with_name::<Materials>("MaterialDefs");
+    let set = |ctx: &RunContext, t: Arc<MaterialTable>| {
+        let mut st = ctx.lock();
+        let previous = st.table.as_ref().map(|o| o.origin().to_owned());
+        if let Some(old) = previous
+            && old != t.origin()
+        {
+            st.warnings.push(format!(
+                "the script made two material tables ({old} and {}); the design uses the last",
+                t.origin()
+            ));
+        }
+        st.table = Some(t.clone());
+        Materials(t)
+    };
+    let c1 = ctx.clone();
+    engine.register_fn("default_materials", move || {
+        set(&c1, Arc::new(MaterialTable::default_table()))
+    });
+    let c2 = ctx.clone();
+    engine.register_fn("j750_materials", move || {
+        set(&c2, Arc::new(MaterialTable::j750()))
+    });
+    let c3 = ctx.clone();
+    engine.register_fn(
+        "load_materials",
+        move |c: Ctx, path: &str| -> RResult<Materials> {
+            let p = c.call_position();
+            let full = c3.resolve(path, p)?;
+            let t = MaterialTable::load(&full).or_else(|e| fail(p, e.to_string()))?;
+            Ok(set(&c3, Arc::new(t)))
+        },
+    );
+    engine.register_fn(
+        "id",
+        |c: Ctx, m: &mut Materials, name: &str| -> RResult<i64> {
+            m.0.id(name)
+                .map(i64::from)
+                .or_else(|e| fail(c.call_position(), e.to_string()))
+        },
+    );
+    engine.register_fn(
+        "name",
+        |c: Ctx, m: &mut Materials, id: i64| -> RResult<String> {
+            let id =
+                m.0.check_id(id)
+                    .or_else(|e| fail(c.call_position(), e.to_string()))?;
+            Ok(m.0.name(id).to_owned())
+        },
+    );
+    engine.register_fn("contains", |m: &mut Materials, name: &str| {
+        m.0.id(name).is_ok()
+    });
+    engine.register_fn("num_materials", |m: &mut Materials| m.0.len() as i64 - 1);
+    engine.register_fn(
+        "color",
+        |c: Ctx, m: &mut Materials, id: i64| -> RResult<rhai::Array> {
+            let id =
+                m.0.check_id(id)
+                    .or_else(|e| fail(c.call_position(), e.to_string()))?;
+            let rgba = m.0.get(id).map(|m| m.rgba()).unwrap_or_default();
+            Ok(rgba.iter().map(|v| Dynamic::from(*v as i64)).collect())
+        },
+    );
+}
+
+fn register_lattice_types(engine: &mut Engine) {
+    engine.register_type_with_name::<LatticeType>("LatticeType");
+    let mut module = rhai::Module::new();
+    for (name, t) in [
+        ("BodyCenteredCubic", LatticeType::BodyCenteredCubic),
+        ("FaceCenteredCubic", LatticeType::FaceCenteredCubic),
+        ("Cubic", LatticeType::Cubic),
+        ("KelvinCell", LatticeType::KelvinCell),
+        ("Octet", LatticeType::Octet),
+    ] {
+        module.set_var(name, t);
+    }
+    engine.register_static_module("LatticeType", module.into());
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,797 @@
+//! The node constructors scripts call, with pyvcad 2.x names and argument
+//! orders (OPENVCAD.md section 2). Every constructor checks its arguments
+//! and fails at the call's line and column; math strings are compiled here,
+//! so an expression's syntax error points at the `FGrade` call that holds it.
+
+use std::sync::Arc;
+
+use glam::DVec3;
+use rhai::{Dynamic, Engine, NativeCallContext as Ctx, Position};
+
+use super::values::*;
+use crate::expr::{COORD_VARS, Expr};
+use crate::lattice::unit_cell_edges;
+use crate::node::{LatticeType, Node, NodeKind, TpmsType};
+
+fn mk(kind: NodeKind, pos: Position) -> Node {
+    Node::with_origin(kind, origin(pos))
+}
+
+fn compile(src: &str, vars: &[&str], what: &str, pos: Position) -> RResult<Arc<Expr>> {
+    Expr::compile(src, vars)
+        .map(Arc::new)
+        .or_else(|e| fail(pos, format!("{what}: {e}")))
+}
+
+fn optional_child(v: Option<&Dynamic>, what: &str, pos: Position) -> RResult<Option<Node>> {
+    v.map(|v| node(v, what, pos)).transpose()
+}
+
+/// Register leaf constructors.
+pub fn register_leaves(engine: &mut Engine) {
+    // Sphere
+    engine.register_fn("Sphere", |c: Ctx| -> RResult<Node> {
+        Ok(mk(
+            NodeKind::Sphere {
+                center: DVec3::ZERO,
+                radius: 1.0,
+                material: 1,
+            },
+            c.call_position(),
+        ))
+    });
+    let sphere = |c: &Ctx, center: &Dynamic, r: &Dynamic, m: Option<&Dynamic>| -> RResult<Node> {
+        let p = c.call_position();
+        Ok(mk(
+            NodeKind::Sphere {
+                center: vec3(center, "Sphere: center", p)?,
+                radius: positive(r, "Sphere: radius", p)?,
+                material: m.map_or(Ok(1), |m| material(m, p))?,
+            },
+            p,
+        ))
+    };
+    engine.register_fn("Sphere", move |c: Ctx, a: Dynamic, r: Dynamic| {
+        sphere(&c, &a, &r, None)
+    });
+    engine.register_fn(
+        "Sphere",
+        move |c: Ctx, a: Dynamic, r: Dynamic, m: Dynamic| sphere(&c, &a, &r, Some(&m)),
+    );
+    engine.register_fn(
+        "Sphere",
+        move |c: Ctx,
+              x: Dynamic,
+              y: Dynamic,
+              z: Dynamic,
+              r: Dynamic,
+              m: Dynamic|
+              -> RResult<Node> {
+            let p = c.call_position();
+            let center = DVec3::new(
+                finite(&x, "Sphere: cx", p)?,
+                finite(&y, "Sphere: cy", p)?,
+                finite(&z, "Sphere: cz", p)?,
+            );
+            sphere(&c, &Dynamic::from(Vec3(center)), &r, Some(&m))
+        },
+    );
+
+    // RectPrism
+    engine.register_fn("RectPrism", |c: Ctx| -> RResult<Node> {
+        Ok(mk(
+            NodeKind::RectPrism {
+                center: DVec3::ZERO,
+                size: DVec3::ONE,
+                material: 1,
+            },
+            c.call_position(),
+        ))
+    });
+    let prism = |c: &Ctx, center: &Dynamic, size: &Dynamic, m: Option<&Dynamic>| -> RResult<Node> {
+        let p = c.call_position();
+        let size = vec3(size, "RectPrism: size", p)?;
+        if size.min_element() <= 0.0 {
+            return fail(
+                p,
+                format!(
+                    "RectPrism: size must be > 0 on every axis, got ({}, {}, {})",
+                    size.x, size.y, size.z
+                ),
+            );
+        }
+        Ok(mk(
+            NodeKind::RectPrism {
+                center: vec3(center, "RectPrism: center", p)?,
+                size,
+                material: m.map_or(Ok(1), |m| material(m, p))?,
+            },
+            p,
+        ))
+    };
+    engine.register_fn("RectPrism", move |c: Ctx, a: Dynamic, s: Dynamic| {
+        prism(&c, &a, &s, None)
+    });
+    engine.register_fn(
+        "RectPrism",
+        move |c: Ctx, a: Dynamic, s: Dynamic, m: Dynamic| prism(&c, &a, &s, Some(&m)),
+    );
+
+    // Cylinder
+    engine.register_fn("Cylinder", |c: Ctx| -> RResult<Node> {
+        Ok(mk(
+            NodeKind::Cylinder {
+                center: DVec3::ZERO,
+                radius: 1.0,
+                height: 1.0,
+                material: 1,
+            },
+            c.call_position(),
+        ))
+    });
+    let cyl = |c: &Ctx,
+               center: &Dynamic,
+               r: &Dynamic,
+               h: &Dynamic,
+               m: Option<&Dynamic>|
+     -> RResult<Node> {
+        let p = c.call_position();
+        Ok(mk(
+            NodeKind::Cylinder {
+                center: vec3(center, "Cylinder: center", p)?,
+                radius: positive(r, "Cylinder: radius", p)?,
+                height: positive(h, "Cylinder: height", p)?,
+                material: m.map_or(Ok(1), |m| material(m, p))?,
+            },
+            p,
+        ))
+    };
+    engine.register_fn(
+        "Cylinder",
+        move |c: Ctx, a: Dynamic, r: Dynamic, h: Dynamic| cyl(&c, &a, &r, &h, None),
+    );
+    engine.register_fn(
+        "Cylinder",
+        move |c: Ctx, a: Dynamic, r: Dynamic, h: Dynamic, m: Dynamic| cyl(&c, &a, &r, &h, Some(&m)),
+    );
+
+    // Strut
+    let strut =
+        |c: &Ctx, a: &Dynamic, b: &Dynamic, r: &Dynamic, m: Option<&Dynamic>| -> RResult<Node> {
+            let p = c.call_position();
+            Ok(mk(
+                NodeKind::Strut {
+                    a: vec3(a, "Strut: start", p)?,
+                    b: vec3(b, "Strut: end", p)?,
+                    radius: positive(r, "Strut: radius", p)?,
+                    material: m.map_or(Ok(1), |m| material(m, p))?,
+                },
+                p,
+            ))
+        };
+    engine.register_fn(
+        "Strut",
+        move |c: Ctx, a: Dynamic, b: Dynamic, r: Dynamic| strut(&c, &a, &b, &r, None),
+    );
+    engine.register_fn(
+        "Strut",
+        move |c: Ctx, a: Dynamic, b: Dynamic, r: Dynamic, m: Dynamic| {
+            strut(&c, &a, &b, &r, Some(&m))
+        },
+    );
+
+    // PolygonExtrude
+    let poly = |c: &Ctx,
+                v: &Dynamic,
+                h: &Dynamic,
+                sym: Option<&Dynamic>,
+                m: Option<&Dynamic>|
+     -> RResult<Node> {
+        let p = c.call_position();
+        let Some(arr) = v.clone().try_cast::<rhai::Array>() else {
+            return fail(p, "PolygonExtrude: vertices must be an array of Vec3");
+        };
+        let vertices = arr
+            .iter()
+            .enumerate()
+            .map(|(i, v)| vec3(v, &format!("PolygonExtrude: vertex {i}"), p))
+            .collect::<RResult<Vec<_>>>()?;
+        if vertices.len() < 3 {
+            return fail(
+                p,
+                format!(
+                    "PolygonExtrude: needs at least 3 vertices, got {}",
+                    vertices.len()
+                ),
+            );
+        }
+        let height = finite(h, "PolygonExtrude: height", p)?;
+        if height == 0.0 {
+            return fail(p, "PolygonExtrude: height must not be 0");
+        }
+        Ok(mk(
+            NodeKind::PolygonExtrude {
+                vertices,
+                height,
+                symmetric: sym.map_or(Ok(false), |s| boolean(s, "PolygonExtrude: symmetric", p))?,
+                material: m.map_or(Ok(1), |m| material(m, p))?,
+            },
+            p,
+        ))
+    };
+    engine.register_fn("PolygonExtrude", move |c: Ctx, v: Dynamic, h: Dynamic| {
+        poly(&c, &v, &h, None, None)
+    });
+    engine.register_fn(
+        "PolygonExtrude",
+        move |c: Ctx, v: Dynamic, h: Dynamic, s: Dynamic| poly(&c, &v, &h, Some(&s), None),
+    );
+    engine.register_fn(
+        "PolygonExtrude",
+        move |c: Ctx, v: Dynamic, h: Dynamic, s: Dynamic, m: Dynamic| {
+            poly(&c, &v, &h, Some(&s), Some(&m))
+        },
+    );
+
+    // Function
+    let func = |c: &Ctx,
+                e: &Dynamic,
+                m: Option<&Dynamic>,
+                lo: Option<&Dynamic>,
+                hi: Option<&Dynamic>|
+     -> RResult<Node> {
+        let p = c.call_position();
+        let Ok(src) = e.clone().into_string() else {
+            return fail(
+                p,
+                "Function: the first argument must be a math string such as \"x*x + y*y - 4\"",
+            );
+        };
+        let expr = compile(&src, &COORD_VARS[..8], "Function", p)?;
+        let min = lo.map_or(Ok(DVec3::splat(-10.0)), |v| vec3(v, "Function: min", p))?;
+        let max = hi.map_or(Ok(DVec3::splat(10.0)), |v| vec3(v, "Function: max", p))?;
+        if min.cmpge(max).any() {
+            return fail(p, "Function: min must be below max on every axis");
+        }
+        Ok(mk(
+            NodeKind::Function {
+                expr,
+                material: m.map_or(Ok(1), |m| material(m, p))?,
+                min,
+                max,
+            },
+            p,
+        ))
+    };
+    engine.register_fn("Function", move |c: Ctx, e: Dynamic| {
+        func(&c, &e, None, None, None)
+    });
+    engine.register_fn("Function", move |c: Ctx, e: Dynamic, m: Dynamic| {
+        func(&c, &e, Some(&m), None, None)
+    });
+    engine.register_fn(
+        "Function",
+        move |c: Ctx, e: Dynamic, m: Dynamic, lo: Dynamic, hi: Dynamic| {
+            func(&c, &e, Some(&m), Some(&lo), Some(&hi))
+        },
+    );
+
+    // TPMS sheets (ours; pyvcad 2.x has none).
+    for (name, kind) in [
+        ("Gyroid", TpmsType::Gyroid),
+        ("SchwarzP", TpmsType::SchwarzP),
+        ("Diamond", TpmsType::Diamond),
+    ] {
+        engine.register_fn(
+            name,
+            move |c: Ctx, cell: Dynamic, t: Dynamic, m: Dynamic| -> RResult<Node> {
+                let p = c.call_position();
+                let cell = if cell.is_float() || cell.is_int() {
+                    DVec3::splat(positive(&cell, &format!("{name}: cell size"), p)?)
+                } else {
+                    vec3(&cell, &format!("{name}: cell size"), p)?
+                };
+                if cell.min_element() <= 0.0 {
+                    return fail(p, format!("{name}: cell size must be > 0 on every axis"));
+                }
+                Ok(mk(
+                    NodeKind::Tpms {
+                        kind,
+                        cell,
+                        thickness: positive(&t, &format!("{name}: wall thickness"), p)?,
+                        material: material(&m, p)?,
+                    },
+                    p,
+                ))
+            },
+        );
+    }
+
+    // GraphLattice
+    engine.register_fn(
+        "GraphLattice",
+        |c: Ctx, t: LatticeType, cell: Dynamic, r: Dynamic, m: Dynamic| -> RResult<Node> {
+            let p = c.call_position();
+            let cell = vec3(&cell, "GraphLattice: cell size", p)?;
+            if cell.min_element() <= 0.0 {
+                return fail(p, "GraphLattice: cell size must be > 0 on every axis");
+            }
+            Ok(mk(
+                NodeKind::GraphLattice {
+                    edges: unit_cell_edges(t, cell),
+                    cell: Some(cell),
+                    radius: positive(&r, "GraphLattice: radius", p)?,
+                    material: material(&m, p)?,
+                },
+                p,
+            ))
+        },
+    );
+    engine.register_fn(
+        "GraphLattice",
+        |c: Ctx, edges: rhai::Array, r: Dynamic, m: Dynamic| -> RResult<Node> {
+            let p = c.call_position();
+            let mut out = Vec::with_capacity(edges.len());
+            for (i, e) in edges.iter().enumerate() {
+                let pair = e.clone().try_cast::<rhai::Array>().filter(|a| a.len() == 2);
+                let Some(pair) = pair else {
+                    return fail(p, format!("GraphLattice: edge {i} must be [Vec3, Vec3]"));
+                };
+                out.push((
+                    vec3(&pair[0], &format!("GraphLattice: edge {i} start"), p)?,
+                    vec3(&pair[1], &format!("GraphLattice: edge {i} end"), p)?,
+                ));
+            }
+            if out.is_empty() {
+                return fail(p, "GraphLattice: the edge list is empty");
+            }
+            Ok(mk(
+                NodeKind::GraphLattice {
+                    edges: out,
+                    cell: None,
+                    radius: positive(&r, "GraphLattice: radius", p)?,
+                    material: material(&m, p)?,
+                },
+                p,
+            ))
+        },
+    );
+}
+
+/// Register transforms, booleans and material nodes.
+pub fn register_composites(engine: &mut Engine) {
+    // Translate / Scale: (), (x,y,z), (x,y,z,child)
+    type Make = fn(DVec3, Option<Node>) -> NodeKind;
+    let translate: Make = |v, child| NodeKind::Translate { offset: v, child };
+    let scale: Make = |v, child| NodeKind::Scale { factors: v, child };
+    for (name, make, zero) in [
+        ("Translate", translate, DVec3::ZERO),
+        ("Scale", scale, DVec3::ONE),
+    ] {
+        let three = move |c: &Ctx,
+                          x: &Dynamic,
+                          y: &Dynamic,
+                          z: &Dynamic,
+                          child: Option<&Dynamic>|
+              -> RResult<Node> {
+            let p = c.call_position();
+            let v = DVec3::new(
+                finite(x, &format!("{name}: x"), p)?,
+                finite(y, &format!("{name}: y"), p)?,
+                finite(z, &format!("{name}: z"), p)?,
+            );
+            if name == "Scale" && v.cmpeq(DVec3::ZERO).any() {
+                return fail(p, "Scale: factors must not be 0");
+            }
+            Ok(mk(
+                make(v, optional_child(child, &format!("{name}: child"), p)?),
+                p,
+            ))
+        };
+        engine.register_fn(name, move |c: Ctx| -> RResult<Node> {
+            Ok(mk(make(zero, None), c.call_position()))
+        });
+        engine.register_fn(name, move |c: Ctx, x: Dynamic, y: Dynamic, z: Dynamic| {
+            three(&c, &x, &y, &z, None)
+        });
+        engine.register_fn(
+            name,
+            move |c: Ctx, x: Dynamic, y: Dynamic, z: Dynamic, ch: Dynamic| {
+                three(&c, &x, &y, &z, Some(&ch))
+            },
+        );
+    }
+
+    // Rotate(pitch, yaw, roll[, around[, child]])
+    let rot = |c: &Ctx,
+               a: [&Dynamic; 3],
+               around: Option<&Dynamic>,
+               child: Option<&Dynamic>|
+     -> RResult<Node> {
+        let p = c.call_position();
+        let around = match around {
+            None => DVec3::ZERO,
+            Some(v) if v.is_int() || v.is_float() => DVec3::splat(finite(v, "Rotate: around", p)?),
+            Some(v) => vec3(v, "Rotate: around", p)?,
+        };
+        Ok(mk(
+            NodeKind::Rotate {
+                pitch: finite(a[0], "Rotate: pitch", p)?,
+                yaw: finite(a[1], "Rotate: yaw", p)?,
+                roll: finite(a[2], "Rotate: roll", p)?,
+                around,
+                child: optional_child(child, "Rotate: child", p)?,
+            },
+            p,
+        ))
+    };
+    engine.register_fn(
+        "Rotate",
+        move |c: Ctx, x: Dynamic, y: Dynamic, z: Dynamic| rot(&c, [&x, &y, &z], None, None),
+    );
+    engine.register_fn(
+        "Rotate",
+        move |c: Ctx, x: Dynamic, y: Dynamic, z: Dynamic, a: Dynamic| {
+            if a.is::<Node>() {
+                rot(&c, [&x, &y, &z], None, Some(&a))
+            } else {
+                rot(&c, [&x, &y, &z], Some(&a), None)
+            }
+        },
+    );
+    engine.register_fn(
+        "Rotate",
+        move |c: Ctx, x: Dynamic, y: Dynamic, z: Dynamic, a: Dynamic, ch: Dynamic| {
+            rot(&c, [&x, &y, &z], Some(&a), Some(&ch))
+        },
+    );
+
+    // Union / Intersection: (), (blend), (blend, children), (k, blend), (k, blend, children)
+    type MakeN = fn(f64, bool, Vec<Node>) -> NodeKind;
+    let union: MakeN = |smooth, blend, children| NodeKind::Union {
+        smooth,
+        blend,
+        children,
+    };
+    let inter: MakeN = |smooth, blend, children| NodeKind::Intersection {
+        smooth,
+        blend,
+        children,
+    };
+    for (name, make) in [("Union", union), ("Intersection", inter)] {
+        engine.register_fn(name, move |c: Ctx| -> RResult<Node> {
+            Ok(mk(make(0.0, false, vec![]), c.call_position()))
+        });
+        engine.register_fn(name, move |c: Ctx, b: Dynamic| -> RResult<Node> {
+            let p = c.call_position();
+            Ok(mk(
+                make(
+                    0.0,
+                    boolean(&b, &format!("{name}: blend materials flag"), p)?,
+                    vec![],
+                ),
+                p,
+            ))
+        });
+        engine.register_fn(
+            name,
+            move |c: Ctx, a: Dynamic, b: Dynamic| -> RResult<Node> {
+                let p = c.call_position();
+                if a.is_bool() {
+                    Ok(mk(
+                        make(
+                            0.0,
+                            boolean(&a, name, p)?,
+                            nodes(&b, &format!("{name}: children"), p)?,
+                        ),
+                        p,
+                    ))
+                } else {
+                    let k = non_negative(&a, &format!("{name}: smoothing radius"), p)?;
+                    Ok(mk(
+                        make(
+                            k,
+                            boolean(&b, &format!("{name}: blend materials flag"), p)?,
+                            vec![],
+                        ),
+                        p,
+                    ))
+                }
+            },
+        );
+        engine.register_fn(
+            name,
+            move |c: Ctx, k: Dynamic, b: Dynamic, ch: Dynamic| -> RResult<Node> {
+                let p = c.call_position();
+                Ok(mk(
+                    make(
+                        non_negative(&k, &format!("{name}: smoothing radius"), p)?,
+                        boolean(&b, &format!("{name}: blend materials flag"), p)?,
+                        nodes(&ch, &format!("{name}: children"), p)?,
+                    ),
+                    p,
+                ))
+            },
+        );
+    }
+
+    // Difference: (), (L, R), (k), (k, L, R)
+    engine.register_fn("Difference", |c: Ctx| -> RResult<Node> {
+        Ok(mk(
+            NodeKind::Difference {
+                smooth: 0.0,
+                left: None,
+                right: None,
+            },
+            c.call_position(),
+        ))
+    });
+    engine.register_fn("Difference", |c: Ctx, k: Dynamic| -> RResult<Node> {
+        let p = c.call_position();
+        Ok(mk(
+            NodeKind::Difference {
+                smooth: non_negative(&k, "Difference: smoothing radius", p)?,
+                left: None,
+                right: None,
+            },
+            p,
+        ))
+    });
+    engine.register_fn(
+        "Difference",
+        |c: Ctx, l: Dynamic, r: Dynamic| -> RResult<Node> {
+            let p = c.call_position();
+            Ok(mk(
+                NodeKind::Difference {
+                    smooth: 0.0,
+                    left: Some(node(&l, "Difference: left", p)?),
+                    right: Some(node(&r, "Difference: right", p)?),
+                },
+                p,
+            ))
+        },
+    );
+    engine.register_fn(
+        "Difference",
+        |c: Ctx, k: Dynamic, l: Dynamic, r: Dynamic| -> RResult<Node> {
+            let p = c.call_position();
+            Ok(mk(
+                NodeKind::Difference {
+                    smooth: non_negative(&k, "Difference: smoothing radius", p)?,
+                    left: Some(node(&l, "Difference: left", p)?),
+                    right: Some(node(&r, "Difference: right", p)?),
+                },
+                p,
+            ))
+        },
+    );
+
+    // Offset(o[, child]) and Shell(t[, child]): both signs accepted.
+    engine.register_fn("Offset", |c: Ctx| -> RResult<Node> {
+        Ok(mk(
+            NodeKind::Offset {
+                distance: 0.0,
+                child: None,
+            },
+            c.call_position(),
+        ))
+    });
+    for arity in [1usize, 2] {
+        let off = move |c: &Ctx, o: &Dynamic, ch: Option<&Dynamic>| -> RResult<Node> {
+            let p = c.call_position();
+            Ok(mk(
+                NodeKind::Offset {
+                    distance: finite(o, "Offset: distance", p)?,
+                    child: optional_child(ch, "Offset: child", p)?,
+                },
+                p,
+            ))
+        };
+        let shell = move |c: &Ctx, t: &Dynamic, ch: Option<&Dynamic>| -> RResult<Node> {
+            let p = c.call_position();
+            let t = finite(t, "Shell: thickness", p)?;
+            if t == 0.0 {
+                return fail(p, "Shell: thickness must not be 0");
+            }
+            Ok(mk(
+                NodeKind::Shell {
+                    thickness: t,
+                    child: optional_child(ch, "Shell: child", p)?,
+                },
+                p,
+            ))
+        };
+        if arity == 1 {
+            engine.register_fn("Offset", move |c: Ctx, o: Dynamic| off(&c, &o, None));
+            engine.register_fn("Shell", move |c: Ctx, t: Dynamic| shell(&c, &t, None));
+        } else {
+            engine.register_fn("Offset", move |c: Ctx, o: Dynamic, ch: Dynamic| {
+                off(&c, &o, Some(&ch))
+            });
+            engine.register_fn("Shell", move |c: Ctx, t: Dynamic, ch: Dynamic| {
+                shell(&c, &t, Some(&ch))
+            });
+        }
+    }
+
+    // Tile: (), (child), (cx, cy, cz), (cx, cy, cz, child)
+    engine.register_fn("Tile", |c: Ctx| -> RResult<Node> {
+        Ok(mk(
+            NodeKind::Tile {
+                cell: None,
+                child: None,
+            },
+            c.call_position(),
+        ))
+    });
+    engine.register_fn("Tile", |c: Ctx, ch: Dynamic| -> RResult<Node> {
+        let p = c.call_position();
+        Ok(mk(
+            NodeKind::Tile {
+                cell: None,
+                child: Some(node(&ch, "Tile: child", p)?),
+            },
+            p,
+        ))
+    });
+    let tile =
+        |c: &Ctx, x: &Dynamic, y: &Dynamic, z: &Dynamic, ch: Option<&Dynamic>| -> RResult<Node> {
+            let p = c.call_position();
+            let cell = DVec3::new(
+                positive(x, "Tile: cell x", p)?,
+                positive(y, "Tile: cell y", p)?,
+                positive(z, "Tile: cell z", p)?,
+            );
+            Ok(mk(
+                NodeKind::Tile {
+                    cell: Some(cell),
+                    child: optional_child(ch, "Tile: child", p)?,
+                },
+                p,
+            ))
+        };
+    engine.register_fn("Tile", move |c: Ctx, x: Dynamic, y: Dynamic, z: Dynamic| {
+        tile(&c, &x, &y, &z, None)
+    });
+    engine.register_fn(
+        "Tile",
+        move |c: Ctx, x: Dynamic, y: Dynamic, z: Dynamic, ch: Dynamic| {
+            tile(&c, &x, &y, &z, Some(&ch))
+        },
+    );
+
+    // FGrade(exprs, materials, prob[, child])
+    let fgrade = |c: &Ctx,
+                  e: &Dynamic,
+                  m: &Dynamic,
+                  prob: &Dynamic,
+                  ch: Option<&Dynamic>|
+     -> RResult<Node> {
+        let p = c.call_position();
+        let srcs = strings(e, "FGrade: expressions", p)?;
+        let mats = materials(m, "FGrade: materials", p)?;
+        if srcs.len() != mats.len() || srcs.is_empty() {
+            return fail(
+                p,
+                format!(
+                    "FGrade: {} expressions but {} materials; give one expression per material",
+                    srcs.len(),
+                    mats.len()
+                ),
+            );
+        }
+        let exprs = srcs
+            .iter()
+            .enumerate()
+            .map(|(i, s)| compile(s, &COORD_VARS, &format!("FGrade: expression {}", i + 1), p))
+            .collect::<RResult<Vec<_>>>()?;
+        Ok(mk(
+            NodeKind::FGrade {
+                exprs,
+                materials: mats,
+                prob: boolean(prob, "FGrade: probabilistic flag", p)?,
+                child: optional_child(ch, "FGrade: child", p)?,
+            },
+            p,
+        ))
+    };
+    engine.register_fn(
+        "FGrade",
+        move |c: Ctx, e: Dynamic, m: Dynamic, b: Dynamic| fgrade(&c, &e, &m, &b, None),
+    );
+    engine.register_fn(
+        "FGrade",
+        move |c: Ctx, e: Dynamic, m: Dynamic, b: Dynamic, ch: Dynamic| {
+            fgrade(&c, &e, &m, &b, Some(&ch))
+        },
+    );
+
+    // Blend(radius[, child])
+    let blend = |c: &Ctx, r: &Dynamic, ch: Option<&Dynamic>| -> RResult<Node> {
+        let p = c.call_position();
+        Ok(mk(
+            NodeKind::Blend {
+                radius: positive(r, "Blend: radius", p)?,
+                child: optional_child(ch, "Blend: child", p)?,
+            },
+            p,
+        ))
+    };
+    engine.register_fn("Blend", move |c: Ctx, r: Dynamic| blend(&c, &r, None));
+    engine.register_fn("Blend", move |c: Ctx, r: Dynamic, ch: Dynamic| {
+        blend(&c, &r, Some(&ch))
+    });
+}
+
+/// Register builder methods: add_child, set_child, set_left, set_right, type.
+pub fn register_methods(engine: &mut Engine) {
+    engine.register_fn(
+        "add_child",
+        |c: Ctx, n: &mut Node, child: Node| -> RResult<bool> {
+            match n.kind_mut() {
+                NodeKind::Union { children, .. } | NodeKind::Intersection { children, .. } => {
+                    children.push(child);
+                    Ok(true)
+                }
+                k => fail(
+                    c.call_position(),
+                    format!(
+                        "{}: add_child is for Union and Intersection; use set_child",
+                        k.type_name()
+                    ),
+                ),
+            }
+        },
+    );
+    engine.register_fn(
+        "set_child",
+        |c: Ctx, n: &mut Node, child: Node| -> RResult<()> {
+            let name = n.kind().type_name();
+            match n.kind_mut().child_slot() {
+                Some(slot) => {
+                    *slot = Some(child);
+                    Ok(())
+                }
+                None => fail(
+                    c.call_position(),
+                    format!("{name}: set_child is for single-child nodes"),
+                ),
+            }
+        },
+    );
+    engine.register_fn(
+        "set_left",
+        |c: Ctx, n: &mut Node, child: Node| -> RResult<()> {
+            match n.kind_mut() {
+                NodeKind::Difference { left, .. } => {
+                    *left = Some(child);
+                    Ok(())
+                }
+                k => fail(
+                    c.call_position(),
+                    format!("{}: set_left is for Difference", k.type_name()),
+                ),
+            }
+        },
+    );
+    engine.register_fn(
+        "set_right",
+        |c: Ctx, n: &mut Node, child: Node| -> RResult<()> {
+            match n.kind_mut() {
+                NodeKind::Difference { right, .. } => {
+                    *right = Some(child);
+                    Ok(())
+                }
+                k => fail(
+                    c.call_position(),
+                    format!("{}: set_right is for Difference", k.type_name()),
+                ),
+            }
+        },
+    );
+    engine.register_fn("type", |n: &mut Node| n.kind().type_name().to_string());
+    engine.register_fn("num_children", |n: &mut Node| {
+        n.kind().children().len() as i64
+    });
+    engine.register_fn("to_string", |n: &mut Node| n.describe());
+}

@@ -1,0 +1,175 @@
+//! Conversions between Rhai values and model values, each failing with a
+//! message in the script's words ("Sphere: radius must be a number, got
+//! string").
+
+use glam::DVec3;
+use rhai::{Dynamic, EvalAltResult, Position};
+
+use crate::node::{Node, Origin};
+
+/// A Rhai error at `pos`.
+pub type RResult<T> = Result<T, Box<EvalAltResult>>;
+
+/// `Vec3(x, y, z)` in scripts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Vec3(pub DVec3);
+
+/// A runtime error with the script position of the call.
+pub fn fail<T>(pos: Position, msg: impl Into<String>) -> RResult<T> {
+    Err(Box::new(EvalAltResult::ErrorRuntime(
+        Dynamic::from(msg.into()),
+        pos,
+    )))
+}
+
+/// The script origin for nodes made at `pos`.
+pub fn origin(pos: Position) -> Option<Origin> {
+    Some(Origin {
+        line: pos.line()? as u32,
+        column: pos.position().unwrap_or(0) as u32,
+    })
+}
+
+/// A number (integer or float) named `what` for messages.
+pub fn num(v: &Dynamic, what: &str, pos: Position) -> RResult<f64> {
+    if let Ok(f) = v.as_float() {
+        Ok(f)
+    } else if let Ok(i) = v.as_int() {
+        Ok(i as f64)
+    } else {
+        fail(
+            pos,
+            format!("{what} must be a number, got {}", v.type_name()),
+        )
+    }
+}
+
+/// A finite number.
+pub fn finite(v: &Dynamic, what: &str, pos: Position) -> RResult<f64> {
+    let f = num(v, what, pos)?;
+    if f.is_finite() {
+        Ok(f)
+    } else {
+        fail(pos, format!("{what} must be finite, got {f}"))
+    }
+}
+
+/// A number > 0.
+pub fn positive(v: &Dynamic, what: &str, pos: Position) -> RResult<f64> {
+    let f = finite(v, what, pos)?;
+    if f > 0.0 {
+        Ok(f)
+    } else {
+        fail(pos, format!("{what} must be > 0, got {f}"))
+    }
+}
+
+/// A number ≥ 0.
+pub fn non_negative(v: &Dynamic, what: &str, pos: Position) -> RResult<f64> {
+    let f = finite(v, what, pos)?;
+    if f >= 0.0 {
+        Ok(f)
+    } else {
+        fail(pos, format!("{what} must be ≥ 0, got {f}"))
+    }
+}
+
+/// A Vec3 (or a 3-element array of numbers, as pyvcad's Vec3-from-list).
+pub fn vec3(v: &Dynamic, what: &str, pos: Position) -> RResult<DVec3> {
+    if let Some(v) = v.clone().try_cast::<Vec3>() {
+        return Ok(v.0);
+    }
+    if let Some(a) = v.clone().try_cast::<rhai::Array>()
+        && a.len() == 3
+    {
+        return Ok(DVec3::new(
+            finite(&a[0], what, pos)?,
+            finite(&a[1], what, pos)?,
+            finite(&a[2], what, pos)?,
+        ));
+    }
+    fail(pos, format!("{what} must be a Vec3, got {}", v.type_name()))
+}
+
+/// A material id (0..=255); whether the table has it is checked when the
+/// script finishes, against the table it used.
+pub fn material(v: &Dynamic, pos: Position) -> RResult<u8> {
+    let Ok(i) = v.as_int() else {
+        return fail(
+            pos,
+            format!(
+                "material must be an id from materials.id(\"name\"), got {}",
+                v.type_name()
+            ),
+        );
+    };
+    if (0..=255).contains(&i) {
+        Ok(i as u8)
+    } else {
+        fail(pos, format!("material id {i} is out of range 0..=255"))
+    }
+}
+
+/// A node argument.
+pub fn node(v: &Dynamic, what: &str, pos: Position) -> RResult<Node> {
+    v.clone().try_cast::<Node>().map_or_else(
+        || fail(pos, format!("{what} must be a node, got {}", v.type_name())),
+        Ok,
+    )
+}
+
+/// An array of nodes.
+pub fn nodes(v: &Dynamic, what: &str, pos: Position) -> RResult<Vec<Node>> {
+    let Some(a) = v.clone().try_cast::<rhai::Array>() else {
+        return fail(
+            pos,
+            format!("{what} must be an array of nodes, got {}", v.type_name()),
+        );
+    };
+    a.iter()
+        .enumerate()
+        .map(|(i, n)| node(n, &format!("{what}[{i}]"), pos))
+        .collect()
+}
+
+/// A bool.
+pub fn boolean(v: &Dynamic, what: &str, pos: Position) -> RResult<bool> {
+    v.as_bool().or_else(|_| {
+        fail(
+            pos,
+            format!("{what} must be true or false, got {}", v.type_name()),
+        )
+    })
+}
+
+/// An array of strings.
+pub fn strings(v: &Dynamic, what: &str, pos: Position) -> RResult<Vec<String>> {
+    let Some(a) = v.clone().try_cast::<rhai::Array>() else {
+        return fail(
+            pos,
+            format!("{what} must be an array of strings, got {}", v.type_name()),
+        );
+    };
+    a.iter()
+        .enumerate()
+        .map(|(i, s)| {
+            s.clone()
+                .into_string()
+                .or_else(|t| fail(pos, format!("{what}[{i}] must be a string, got {t}")))
+        })
+        .collect()
+}
+
+/// An array of material ids.
+pub fn materials(v: &Dynamic, what: &str, pos: Position) -> RResult<Vec<u8>> {
+    let Some(a) = v.clone().try_cast::<rhai::Array>() else {
+        return fail(
+            pos,
+            format!(
+                "{what} must be an array of material ids, got {}",
+                v.type_name()
+            ),
+        );
+    };
+    a.iter().map(|m| material(m, pos)).collect()
+}

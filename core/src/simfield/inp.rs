@@ -1,0 +1,291 @@
+//! Reading the tetrahedral mesh of an Abaqus / CalculiX `.inp` deck.
+//!
+//! Only `*NODE` and `*ELEMENT` blocks are read; every other keyword block
+//! (`*NSET`, `*ELSET`, `*MATERIAL`, `*STEP`, `*NODE PRINT`, …) is skipped, so
+//! a complete analysis deck loads as well as a bare mesh. Keywords and
+//! parameters are case-insensitive, `**` starts a comment line, data lines
+//! are comma-separated and an element may continue on the next line after a
+//! trailing comma (Abaqus Keywords Reference, "Input syntax rules").
+//!
+//! Tetrahedra: `C3D4*` (4 nodes) and `C3D10*` (10 nodes, of which the first
+//! four are the corners; the field is then interpolated linearly). Other
+//! element types are skipped with a warning. Node ids may come in any order
+//! and need not be contiguous; nodes are kept in file order, which is the
+//! row order of a headerless PointMap CSV.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use glam::DVec3;
+
+use super::SimFieldError;
+
+/// The mesh part of a deck.
+#[derive(Debug, Default)]
+pub(crate) struct InpMesh {
+    /// Node ids in file order.
+    pub node_ids: Vec<u64>,
+    /// Node positions in file order.
+    pub nodes: Vec<DVec3>,
+    /// 1-based line of each node.
+    pub node_lines: Vec<usize>,
+    /// Node id → index into `nodes`.
+    pub index_of: HashMap<u64, u32>,
+    /// Tetrahedra as node indices (corner nodes only).
+    pub tets: Vec<[u32; 4]>,
+    /// Element id of each tetrahedron.
+    pub elem_ids: Vec<u64>,
+    /// 1-based (first) line of each tetrahedron.
+    pub elem_lines: Vec<usize>,
+    /// Skipped element types and the like.
+    pub warnings: Vec<String>,
+}
+
+/// What the current keyword block holds.
+enum Block {
+    /// Not in a block we read.
+    Skip,
+    /// `*NODE` data lines.
+    Node,
+    /// `*ELEMENT` with `n` nodes per element (corner nodes are the first 4).
+    Tets { n: usize },
+    /// `*ELEMENT` of a type we ignore.
+    Ignored { kind: String },
+}
+
+/// Parses the deck at `path`.
+pub(crate) fn parse(path: &Path) -> Result<InpMesh, SimFieldError> {
+    let bytes = std::fs::read(path).map_err(|e| SimFieldError::Io {
+        path: path.to_path_buf(),
+        msg: e.to_string(),
+    })?;
+    let text = String::from_utf8_lossy(&bytes);
+    let err = |line: usize, msg: String| SimFieldError::Inp {
+        path: path.to_path_buf(),
+        line,
+        msg,
+    };
+    let mut mesh = InpMesh::default();
+    // Raw elements: (element id, corner node ids, line).
+    let mut raw: Vec<(u64, [u64; 4], usize)> = Vec::new();
+    let mut ignored: Vec<(String, usize)> = Vec::new();
+    let mut c3d10 = 0usize;
+    let mut block = Block::Skip;
+    // An element whose node list continues on the next line.
+    let mut pending: Vec<String> = Vec::new();
+    let mut pending_line = 0;
+
+    for (i, raw_line) in text.lines().enumerate() {
+        let ln = i + 1;
+        let line = raw_line.trim();
+        if line.is_empty() || line.starts_with("**") {
+            continue;
+        }
+        if line.starts_with('*') {
+            if !pending.is_empty() {
+                return Err(err(
+                    pending_line,
+                    format!(
+                        "element `{}` ends with a comma but no continuation line follows",
+                        pending.join(",")
+                    ),
+                ));
+            }
+            let mut parts = line[1..].split(',');
+            let keyword = parts
+                .next()
+                .unwrap_or("")
+                .split_whitespace()
+                .collect::<Vec<_>>()
+                .join(" ")
+                .to_ascii_uppercase();
+            let param = |name: &str| {
+                line[1..].split(',').skip(1).find_map(|p| {
+                    let (k, v) = p.split_once('=')?;
+                    k.trim()
+                        .eq_ignore_ascii_case(name)
+                        .then(|| v.trim().to_ascii_uppercase())
+                })
+            };
+            block = match keyword.as_str() {
+                "NODE" => Block::Node,
+                "ELEMENT" => {
+                    let Some(kind) = param("TYPE") else {
+                        return Err(err(
+                            ln,
+                            "`*ELEMENT` needs a `TYPE=` parameter (e.g. TYPE=C3D4)".into(),
+                        ));
+                    };
+                    if kind.starts_with("C3D4") {
+                        Block::Tets { n: 4 }
+                    } else if kind.starts_with("C3D10") {
+                        Block::Tets { n: 10 }
+                    } else {
+                        Block::Ignored { kind }
+                    }
+                }
+                "INCLUDE" => {
+                    mesh.warnings.push(format!(
+                        "{}:{ln}: `*INCLUDE` is not followed; put the mesh in one file",
+                        path.display()
+                    ));
+                    Block::Skip
+                }
+                _ => Block::Skip,
+            };
+            continue;
+        }
+        match &block {
+            Block::Skip => {}
+            Block::Node => {
+                let fields: Vec<&str> = split_fields(line);
+                if fields.len() < 4 {
+                    return Err(err(
+                        ln,
+                        format!("expected a node line `id, x, y, z`, found `{line}`"),
+                    ));
+                }
+                let id = parse_id(fields[0]).ok_or_else(|| {
+                    err(
+                        ln,
+                        format!("node id `{}` is not a positive integer", fields[0]),
+                    )
+                })?;
+                let mut xyz = [0.0; 3];
+                for (k, f) in fields[1..4].iter().enumerate() {
+                    xyz[k] = f
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|v| v.is_finite())
+                        .ok_or_else(|| {
+                            err(
+                                ln,
+                                format!("node {id}: coordinate `{f}` is not a finite number"),
+                            )
+                        })?;
+                }
+                if let Some(&prev) = mesh.index_of.get(&id) {
+                    return Err(SimFieldError::DuplicateNode {
+                        path: path.to_path_buf(),
+                        line: ln,
+                        id,
+                        first_line: mesh.node_lines[prev as usize],
+                    });
+                }
+                mesh.index_of.insert(id, mesh.nodes.len() as u32);
+                mesh.node_ids.push(id);
+                mesh.nodes.push(DVec3::from_array(xyz));
+                mesh.node_lines.push(ln);
+            }
+            Block::Tets { n } => {
+                if pending.is_empty() {
+                    pending_line = ln;
+                }
+                pending.extend(split_fields(line).into_iter().map(str::to_string));
+                if pending.len() < n + 1 && line.ends_with(',') {
+                    continue; // continuation line follows
+                }
+                let fields = std::mem::take(&mut pending);
+                if fields.len() != n + 1 {
+                    return Err(err(
+                        pending_line,
+                        format!(
+                            "expected an element line `id, n1, …, n{n}` ({} fields), found {} fields",
+                            n + 1,
+                            fields.len()
+                        ),
+                    ));
+                }
+                let id = parse_id(&fields[0]).ok_or_else(|| {
+                    err(
+                        pending_line,
+                        format!("element id `{}` is not a positive integer", fields[0]),
+                    )
+                })?;
+                let mut corners = [0u64; 4];
+                for (k, f) in fields[1..5].iter().enumerate() {
+                    corners[k] = parse_id(f).ok_or_else(|| {
+                        err(
+                            pending_line,
+                            format!("element {id}: node id `{f}` is not a positive integer"),
+                        )
+                    })?;
+                }
+                if *n == 10 {
+                    c3d10 += 1;
+                }
+                raw.push((id, corners, pending_line));
+            }
+            Block::Ignored { kind } => match ignored.iter_mut().find(|(k, _)| k == kind) {
+                Some((_, count)) => *count += 1,
+                None => ignored.push((kind.clone(), 1)),
+            },
+        }
+    }
+    if !pending.is_empty() {
+        return Err(err(
+            pending_line,
+            "the last element ends with a comma but the file ends".into(),
+        ));
+    }
+    if mesh.nodes.is_empty() {
+        return Err(SimFieldError::NoNodes {
+            path: path.to_path_buf(),
+        });
+    }
+    for (kind, count) in &ignored {
+        mesh.warnings.push(format!(
+            "{}: ignored {count} data lines of element type {kind} (only C3D4 and C3D10 tetrahedra are used)",
+            path.display()
+        ));
+    }
+    if raw.is_empty() {
+        return Err(SimFieldError::NoTets {
+            path: path.to_path_buf(),
+            ignored: ignored
+                .iter()
+                .map(|(k, _)| k.clone())
+                .collect::<Vec<_>>()
+                .join(", "),
+        });
+    }
+    if c3d10 > 0 {
+        mesh.warnings.push(format!(
+            "{}: {c3d10} C3D10 elements are interpolated linearly from their 4 corner nodes",
+            path.display()
+        ));
+    }
+    for (id, corners, line) in raw {
+        let mut tet = [0u32; 4];
+        for (k, node) in corners.iter().enumerate() {
+            tet[k] = *mesh.index_of.get(node).ok_or(SimFieldError::UnknownNode {
+                path: path.to_path_buf(),
+                line,
+                element: id,
+                node: *node,
+            })?;
+        }
+        mesh.tets.push(tet);
+        mesh.elem_ids.push(id);
+        mesh.elem_lines.push(line);
+    }
+    Ok(mesh)
+}
+
+/// Comma-separated fields, trimmed, without the empty field a trailing comma
+/// leaves.
+fn split_fields(line: &str) -> Vec<&str> {
+    let mut f: Vec<&str> = line.split(',').map(str::trim).collect();
+    if f.last() == Some(&"") {
+        f.pop();
+    }
+    f
+}
+
+/// A node or element id: a positive integer (`12` or `12.0`).
+pub(crate) fn parse_id(s: &str) -> Option<u64> {
+    s.parse::<u64>().ok().or_else(|| {
+        let v = s.parse::<f64>().ok()?;
+        (v.fract() == 0.0 && v >= 0.0 && v < 1.8e19).then_some(v as u64)
+    })
+}

@@ -1,0 +1,370 @@
+//! Tests of [`crate::simfield`] on the seat dataset and small hand-made
+//! inputs.
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+
+use super::{SimField, SimFieldError};
+use crate::mesh::tests::{Rng, temp_path};
+
+const SEAT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/seat/");
+
+fn seat(name: &str) -> PathBuf {
+    Path::new(SEAT).join(name)
+}
+
+/// The CSV rows as (x, y, z, dx, dy, dz), in node order.
+fn csv_rows() -> Vec<[f64; 6]> {
+    std::fs::read_to_string(seat("seat_displacement.csv"))
+        .unwrap()
+        .lines()
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|c| c.trim().parse().unwrap()).collect();
+            [v[0], v[1], v[2], v[3], v[4], v[5]]
+        })
+        .collect()
+}
+
+fn check_seat(f: &SimField) {
+    assert_eq!(f.node_count(), 10679);
+    assert_eq!(f.tet_count(), 50105);
+    assert_eq!(f.variable_names(), ["dx", "dy", "dz", "len"]);
+    assert!(f.boundary_mesh().is_closed_manifold(), "{:?}", f.warnings());
+    assert_eq!(f.boundary_mesh().triangle_count(), 10176);
+    assert!((f.boundary_mesh().volume() - 658_174.0).abs() < 1000.0);
+    let rows = csv_rows();
+    let mut out = [0.0; 4];
+    let mut max_len: f64 = 0.0;
+    for (n, r) in rows.iter().enumerate() {
+        let p = f.nodes()[n];
+        assert!(f.sample(p, &mut out), "node {n} at {p} not located");
+        for k in 0..3 {
+            assert!(
+                (out[k] - r[3 + k]).abs() < 1e-6,
+                "node {n}: {out:?} vs {r:?}"
+            );
+        }
+        max_len = max_len.max(out[3]);
+    }
+    assert!((max_len - 7.354).abs() < 1e-3, "{max_len}");
+    let (_, hi) = f.variable_range(3).unwrap();
+    assert!((hi - 7.354).abs() < 1e-3);
+}
+
+#[test]
+fn seat_headerless_and_table_agree() {
+    let a = SimField::load(&seat("seat.inp"), &seat("seat_displacement.csv")).unwrap();
+    check_seat(&a);
+    assert!(a.warnings().is_empty(), "{:?}", a.warnings());
+    let b = SimField::load(&seat("seat.inp"), &seat("seat_displacement_table.csv")).unwrap();
+    check_seat(&b);
+    // The full CalculiX deck: sets, material, step … are skipped.
+    let c = SimField::load(&seat("seat_ccx.inp"), &seat("seat_displacement_table.csv")).unwrap();
+    assert_eq!((c.node_count(), c.tet_count()), (10679, 50105));
+    let mut rng = Rng::new(5);
+    let (mut oa, mut oc) = ([0.0; 4], [0.0; 4]);
+    for _ in 0..200 {
+        let p = rng.in_box(&a.bbox());
+        assert_eq!(a.sample(p, &mut oa), c.sample(p, &mut oc));
+        assert_eq!(oa, oc);
+    }
+}
+
+#[test]
+fn seat_linear_field_is_exact_and_inside_agrees_with_distance() {
+    let base = SimField::load(&seat("seat.inp"), &seat("seat_displacement.csv")).unwrap();
+    let f_of = |p: DVec3| 2.0 * p.x - p.y + 3.0 * p.z + 1.0;
+    let values: Vec<f64> = base.nodes().iter().map(|&p| f_of(p)).collect();
+    let f = SimField::from_parts(
+        base.nodes().to_vec(),
+        base.tets().to_vec(),
+        vec![("f".into(), values)],
+    )
+    .unwrap();
+    assert_eq!(f.variable_names(), ["f"]);
+    let mut rng = Rng::new(11);
+    let mut inside = 0;
+    let mut out = [0.0];
+    for _ in 0..5000 {
+        let p = rng.in_box(&f.bbox());
+        let d = f.signed_distance(p);
+        let found = f.sample(p, &mut out);
+        if d.abs() > 1e-6 {
+            assert_eq!(found, d < 0.0, "{p}: d = {d}");
+        }
+        if found {
+            inside += 1;
+            assert!(
+                (out[0] - f_of(p)).abs() < 1e-9,
+                "{p}: {} vs {}",
+                out[0],
+                f_of(p)
+            );
+            let (t, w) = f.locate(p).unwrap();
+            let q: DVec3 = (0..4)
+                .map(|k| f.nodes()[f.tets()[t as usize][k] as usize] * w[k])
+                .sum();
+            assert!((q - p).length() < 1e-9);
+        }
+    }
+    assert!(inside > 1000, "{inside}");
+    assert!(!f.sample(DVec3::new(-50.0, 0.0, 0.0), &mut out));
+    assert!(!f.sample(DVec3::NAN, &mut out));
+}
+
+/// Two tetrahedra sharing the face (1, 2, 3); the second one is inverted.
+fn two_tets() -> (Vec<DVec3>, Vec<[u32; 4]>) {
+    let nodes = vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z, DVec3::ONE];
+    (nodes, vec![[0, 1, 2, 3], [4, 1, 2, 3]])
+}
+
+#[test]
+fn two_tets_from_parts() {
+    let (nodes, tets) = two_tets();
+    let cols = vec![
+        ("dx".to_string(), vec![0.0, 3.0, 0.0, 0.0, 1.0]),
+        ("dy".to_string(), vec![0.0, 0.0, 4.0, 0.0, 1.0]),
+        ("dz".to_string(), vec![0.0, 0.0, 0.0, 0.0, 1.0]),
+        ("x".to_string(), nodes.iter().map(|p| p.x).collect()),
+    ];
+    let f = SimField::from_parts(nodes, tets, cols).unwrap();
+    assert_eq!(f.variable_names(), ["dx", "dy", "dz", "len"]);
+    assert_eq!((f.node_count(), f.tet_count()), (5, 2));
+    assert!(
+        f.warnings().iter().any(|w| w.contains("inverted")),
+        "{:?}",
+        f.warnings()
+    );
+    assert!(f.boundary_mesh().is_closed_manifold(), "{:?}", f.warnings());
+    assert_eq!(f.boundary_mesh().triangle_count(), 6);
+    let mut out = [0.0; 4];
+    // Midpoint of nodes 1 and 2: dx = 1.5, dy = 2, len = 2.5.
+    assert!(f.sample(DVec3::new(0.5, 0.5, 0.0), &mut out));
+    assert!((out[0] - 1.5).abs() < 1e-12 && (out[1] - 2.0).abs() < 1e-12);
+    assert!((out[3] - 2.5).abs() < 1e-12);
+    // Inside the second tet.
+    let p = DVec3::new(0.5, 0.5, 0.5) * 0.5 + DVec3::ONE * 0.5 * 0.5 + DVec3::new(0.1, 0.1, 0.1);
+    let (t, w) = f.locate(p).unwrap();
+    assert_eq!(t, 1);
+    assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+    assert!(f.signed_distance(p) < 0.0);
+    assert!(f.signed_distance(DVec3::splat(2.0)) > 0.0);
+    assert!(f.locate(DVec3::new(0.9, 0.9, -0.1)).is_none());
+    // A short `out` gets the first variables only.
+    let mut short = [0.0; 1];
+    assert!(f.sample(DVec3::new(0.5, 0.5, 0.0), &mut short));
+    assert!((short[0] - 1.5).abs() < 1e-12);
+}
+
+#[test]
+fn from_parts_rejects_bad_input() {
+    let (nodes, tets) = two_tets();
+    let e = SimField::from_parts(nodes.clone(), vec![[0, 1, 2, 7]], vec![]).unwrap_err();
+    assert!(e.to_string().contains("node 7"), "{e}");
+    let e = SimField::from_parts(nodes.clone(), tets.clone(), vec![("a".into(), vec![1.0])])
+        .unwrap_err();
+    assert!(e.to_string().contains("1 values for 5 nodes"), "{e}");
+    let e =
+        SimField::from_parts(nodes.clone(), vec![[0, 1, 2, 3], [0, 1, 2, 0]], vec![]).unwrap_err();
+    assert!(e.to_string().contains("tet 1 is degenerate"), "{e}");
+    let e = SimField::from_parts(nodes, vec![], vec![]).unwrap_err();
+    assert!(matches!(e, SimFieldError::Parts { .. }));
+}
+
+const TINY_INP: &str = "\
+** two tets, ids out of order
+*Heading
+ tiny
+*Node, nset=all
+10, 0, 0, 0
+2, 1, 0, 0
+3, 0, 1, 0
+4, 0, 0, 1
+5, 1, 1, 1
+*ELEMENT, TYPE=C3D8R, ELSET=bricks
+99, 10, 2, 3, 4, 5, 10, 2,
+    3
+*element, type=c3d4, elset=tets
+1, 10, 2, 3, 4
+2, 5, 2,
+ 3, 4
+*NSET, NSET=fixed
+10, 2
+*STEP
+*STATIC
+*END STEP
+";
+
+fn write(name: &str, text: &str) -> PathBuf {
+    let p = temp_path(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+const TINY_CSV: &str = "node_id, x, y, z, dx, dy, dz, \"S.Mises\"\n\
+5,1,1,1,1,1,1,9\n10,0,0,0,0,0,0,1\n2,1,0,0,3,0,0,2\n3,0,1,0,0,4,0,3\n4,0,0,1,0,0,0,4\n";
+
+#[test]
+fn tiny_deck_ids_continuations_and_skipped_types() {
+    let inp = write("tiny.inp", TINY_INP);
+    let csv = write("tiny.csv", TINY_CSV);
+    let f = SimField::load(&inp, &csv).unwrap();
+    assert_eq!((f.node_count(), f.tet_count()), (5, 2));
+    assert_eq!(f.variable_names(), ["dx", "dy", "dz", "S_Mises", "len"]);
+    let w = f.warnings();
+    assert!(w.iter().any(|w| w.contains("C3D8R")), "{w:?}");
+    assert!(w.iter().any(|w| w.contains("S_Mises")), "{w:?}");
+    let mut out = [0.0; 5];
+    assert!(f.sample(DVec3::new(0.5, 0.5, 0.0), &mut out));
+    assert!(
+        (out[3] - 2.5).abs() < 1e-12 && (out[4] - 2.5).abs() < 1e-12,
+        "{out:?}"
+    );
+    for p in [inp, csv] {
+        let _ = std::fs::remove_file(p);
+    }
+}
+
+/// Asserts that loading fails with a message containing `what` (and the
+/// file:line prefix when `line` is given).
+fn expect_error(inp_text: &str, csv_text: &str, line: Option<(&str, usize)>, what: &str) {
+    let inp = write("case.inp", inp_text);
+    let csv = write("case.csv", csv_text);
+    let e = SimField::load(&inp, &csv).unwrap_err().to_string();
+    assert!(e.contains(what), "{e}");
+    if let Some((file, l)) = line {
+        let path = if file == "inp" { &inp } else { &csv };
+        assert!(e.contains(&format!("{}:{l}:", path.display())), "{e}");
+    }
+    for p in [inp, csv] {
+        let _ = std::fs::remove_file(p);
+    }
+}
+
+#[test]
+fn errors_name_file_and_line() {
+    let good_csv = TINY_CSV;
+    // Missing node row.
+    let missing = good_csv.replace("3,0,1,0,0,4,0,3\n", "");
+    expect_error(
+        TINY_INP,
+        &missing,
+        None,
+        "no row for node 3 (defined at .inp line 7)",
+    );
+    // Unknown node id.
+    let unknown = good_csv.replace("3,0,1,0", "33,0,1,0");
+    expect_error(
+        TINY_INP,
+        &unknown,
+        Some(("csv", 5)),
+        "node 33 is not in the mesh",
+    );
+    // Broken number.
+    let broken = good_csv.replace("0,4,0,3", "0,4,zero,3");
+    expect_error(TINY_INP, &broken, Some(("csv", 5)), "column `dz`: `zero`");
+    // Duplicate row.
+    let dup = format!("{good_csv}2,1,0,0,3,0,0,2\n");
+    expect_error(
+        TINY_INP,
+        &dup,
+        Some(("csv", 7)),
+        "node 2 already has a row at line 4",
+    );
+    // Headerless row count mismatch.
+    let rows = "0,0,0,0,0,0\n1,0,0,0,0,0\n0,1,0,0,0,0\n0,0,1,0,0,0\n";
+    expect_error(
+        TINY_INP,
+        rows,
+        Some(("csv", 4)),
+        "4 data rows for 5 mesh nodes",
+    );
+    // Headerless wrong column count.
+    let seven = "0,0,0,0,0,0,0\n".repeat(5);
+    expect_error(TINY_INP, &seven, Some(("csv", 1)), "expected 6 numbers");
+    // Degenerate tet (node 4 moved into the plane of 10, 2, 3).
+    let flat = TINY_INP.replace("4, 0, 0, 1\n", "4, 0.3, 0.3, 0\n");
+    expect_error(
+        &flat,
+        good_csv,
+        Some(("inp", 14)),
+        "element 1 is degenerate",
+    );
+    // Element with an undefined node.
+    let undefined = TINY_INP.replace("1, 10, 2, 3, 4", "1, 10, 2, 3, 44");
+    expect_error(&undefined, good_csv, Some(("inp", 14)), "refers to node 44");
+    // Broken node coordinate.
+    let bad_node = TINY_INP.replace("3, 0, 1, 0", "3, 0, 1e, 0");
+    expect_error(
+        &bad_node,
+        good_csv,
+        Some(("inp", 7)),
+        "`1e` is not a finite number",
+    );
+    // Wrong element field count.
+    let short = TINY_INP.replace("1, 10, 2, 3, 4", "1, 10, 2, 3");
+    expect_error(
+        &short,
+        good_csv,
+        Some(("inp", 14)),
+        "expected an element line",
+    );
+    // No tetrahedra at all.
+    let no_tets = TINY_INP.replace("type=c3d4", "type=S3");
+    expect_error(&no_tets, good_csv, None, "no tetrahedral elements");
+    // Missing file.
+    let e = SimField::load(&temp_path("none.inp"), &temp_path("none.csv")).unwrap_err();
+    assert!(matches!(e, SimFieldError::Io { .. }), "{e}");
+}
+
+/// Sampling throughput on the seat at interior points (release build):
+/// `cargo test -p volcad-core --release --lib simfield::tests::perf -- --ignored --nocapture`
+#[test]
+#[ignore]
+fn perf_seat_sample() {
+    let f = SimField::load(&seat("seat.inp"), &seat("seat_displacement.csv")).unwrap();
+    let mut rng = Rng::new(3);
+    let mut out = [0.0; 4];
+    let mut pts = Vec::new();
+    while pts.len() < 1_000_000 {
+        let p = rng.in_box(&f.bbox());
+        if f.locate(p).is_some() {
+            pts.push(p);
+        }
+    }
+    // A voxel grid in scan order, as a sampler visits it.
+    let b = f.bbox();
+    let h = 0.5;
+    let n = (b.size() / h).ceil().as_uvec3();
+    let mut all = Vec::new();
+    for k in 0..n.z {
+        for j in 0..n.y {
+            for i in 0..n.x {
+                all.push(b.min + (DVec3::new(i as f64, j as f64, k as f64) + 0.5) * h);
+            }
+        }
+    }
+    let grid: Vec<DVec3> = all
+        .iter()
+        .copied()
+        .filter(|&p| f.locate(p).is_some())
+        .collect();
+    for (name, pts) in [
+        ("random interior", &pts),
+        ("voxel-grid interior", &grid),
+        ("voxel-grid whole box", &all),
+    ] {
+        let t0 = std::time::Instant::now();
+        let mut acc = 0.0;
+        for &p in pts.iter() {
+            f.sample(p, &mut out);
+            acc += out[3];
+        }
+        let dt = t0.elapsed().as_secs_f64();
+        println!(
+            "seat sample ({name} points): {:.2} M samples/s (1 core) [{acc:.1}]",
+            pts.len() as f64 / dt / 1e6
+        );
+    }
+}
