@@ -24,6 +24,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod bench;
 pub mod bounds;
 pub mod expr;
 pub mod interval;

@@ -29,8 +29,10 @@ fn data(name: &str) -> Value {
 }
 
 fn model(src: &str) -> Model {
-    let mut opts = ScriptOptions::default();
-    opts.base_dir = Some(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets/data"));
+    let opts = ScriptOptions {
+        base_dir: Some(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets/examples/data")),
+        ..ScriptOptions::default()
+    };
     let d = run_script(src, "reference.rhai", &opts).unwrap_or_else(|e| panic!("{e}"));
     Model::prepare(&d.root, d.materials.clone()).unwrap_or_else(|e| panic!("{e}"))
 }

@@ -4,7 +4,6 @@ use glam::DVec3;
 
 use super::TriangleMesh;
 use super::triangle::Feature;
-use super::wide::Certificate;
 use crate::bounds::Aabb;
 use crate::interval::Interval;
 
@@ -14,61 +13,39 @@ impl TriangleMesh {
     /// the squared distance to the triangle's plane is a cheap lower bound
     /// that skips most triangles before the full Ericson test.
     ///
-    /// Samplers query neighbouring points one after the other. Each search
-    /// leaves a [`Certificate`] for its point `p0` (the nearest few triangles
-    /// and a lower bound `L` of the distance of all others), kept per thread
-    /// and mesh. For the next point `p`, `δ = |p − p0|`: every other triangle
-    /// is at least `L − δ` away, so if the best of the few is within
-    /// `L − δ` it is the answer without any traversal; otherwise it seeds
-    /// the search with a tight upper bound. Results are identical either way.
+    /// Samplers query neighbouring points one after the other, whose nearest
+    /// triangles are usually the same: the previous answer of this thread for
+    /// this mesh seeds the search with a true upper bound, so the traversal
+    /// prunes from the start. The seed only tightens the initial bound; the
+    /// result is the same without it.
     #[inline]
     fn nearest(&self, p: DVec3, max_d2: f64) -> Option<(usize, f64)> {
         let tris = &self.tris;
         let key = tris.as_ptr() as usize;
+        let mut best = max_d2;
         let mut seed = None;
-        if let Some(c) = cache::get(key) {
-            let mut b = (u32::MAX, f64::INFINITY);
-            for &(s, _) in &c.near[..c.count] {
-                if let Some(t) = tris.get(s as usize) {
-                    let d2 = t.distance_squared(p);
-                    if d2 < b.1 {
-                        b = (s, d2);
-                    }
-                }
-            }
-            if b.0 != u32::MAX {
-                let margin = c.rest_sqrt - p.distance(c.p);
-                TRIES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                if margin > 0.0 {
-                    MARG.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                }
-                if margin > 0.0 && b.1.sqrt() <= margin {
-                    HITS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                    return (b.1 < max_d2).then_some((b.0 as usize, b.1));
-                }
-                seed = Some(b);
+        if let Some(s) = seed::get(key).filter(|&s| (s as usize) < tris.len()) {
+            let d2 = tris[s as usize].distance_squared(p);
+            if d2 < best {
+                best = d2;
+                seed = Some((s, d2));
             }
         }
-        let mut cert = Certificate::default();
-        let found = self.wide.nearest(p, max_d2, seed, &mut cert, |s, best| {
-            let t = &tris[s as usize];
-            let h = t.n.dot(p - t.a);
-            let h2 = h * h;
-            if h2 >= best {
-                h2
-            } else {
-                t.distance_squared(p)
-            }
-        });
-        cache::set(
-            key,
-            cache::Entry {
-                p,
-                near: cert.near,
-                count: cert.count,
-                rest_sqrt: cert.rest.sqrt(),
-            },
-        );
+        let found = self
+            .wide
+            .nearest(p, best, |s, best| {
+                let t = &tris[s as usize];
+                let h = t.n.dot(p - t.a);
+                if h * h >= best {
+                    f64::INFINITY
+                } else {
+                    t.distance_squared(p)
+                }
+            })
+            .or(seed);
+        if let Some((s, _)) = found {
+            seed::set(key, s);
+        }
         found.map(|(s, d2)| (s as usize, d2))
     }
 
@@ -112,7 +89,6 @@ impl TriangleMesh {
             if let Some(found) = self.nearest(p, upper * upper) {
                 return Some(found);
             }
-            HITS.fetch_add(1 << 40, std::sync::atomic::Ordering::Relaxed);
         }
         self.nearest(p, f64::INFINITY)
     }
@@ -124,8 +100,7 @@ impl TriangleMesh {
             return f64::NAN;
         }
         match self.nearest_any(p) {
-            Some((_, d2)) if d2 == 0.0 => 0.0,
-            Some((slot, d2)) => d2.sqrt() * self.sign_at(p, slot),
+            Some((slot, d2)) => signed(d2, || self.sign_at(p, slot)),
             // Squared distances overflowed: astronomically far, so outside.
             None => (p - self.bbox.center()).length(),
         }
@@ -182,8 +157,7 @@ impl TriangleMesh {
             }
         }
         match self.nearest(p, max_dist * max_dist) {
-            Some((_, d2)) if d2 == 0.0 => 0.0,
-            Some((slot, d2)) => d2.sqrt() * self.sign_at(p, slot),
+            Some((slot, d2)) => signed(d2, || self.sign_at(p, slot)),
             // Nothing within max_dist: the side is known, or the exact value
             // (a valid lower bound) settles it.
             None if side != 0.0 => max_dist * side,
@@ -245,46 +219,39 @@ impl TriangleMesh {
     }
 }
 
-/// Per-thread memory of the last search certificate of the few most
-/// recently queried meshes (keyed by the address of their triangle data; a
-/// stale key of a dropped mesh only costs a few wasted triangle tests).
-mod cache {
-    use std::cell::RefCell;
+/// `sqrt(d2)` with the sign from `sign` (not asked on the surface, `d2 = 0`).
+#[inline]
+fn signed(d2: f64, sign: impl FnOnce() -> f64) -> f64 {
+    if d2 == 0.0 { 0.0 } else { d2.sqrt() * sign() }
+}
 
-    use glam::DVec3;
+/// Per-thread memory of the last nearest triangle of the few most recently
+/// queried meshes (keyed by the address of their triangle data). A stale key
+/// (a dropped mesh whose memory was reused) only gives a poor seed.
+mod seed {
+    use std::cell::Cell;
 
     const WAYS: usize = 4;
 
-    /// A certificate for the query point `p`.
-    #[derive(Clone, Copy, Debug, Default)]
-    pub struct Entry {
-        pub p: DVec3,
-        pub near: [(u32, f64); 4],
-        pub count: usize,
-        pub rest_sqrt: f64,
-    }
-
     thread_local! {
-        static LAST: RefCell<[(usize, Entry); WAYS]> = RefCell::new([(0, Entry::default()); WAYS]);
+        static LAST: Cell<[(usize, u32); WAYS]> = const { Cell::new([(0, 0); WAYS]) };
     }
 
-    /// The certificate remembered for mesh `key`.
+    /// The remembered slot for mesh `key`.
     #[inline]
-    pub fn get(key: usize) -> Option<Entry> {
-        LAST.with_borrow(|a| a.iter().find(|e| e.0 == key).map(|e| e.1))
+    pub fn get(key: usize) -> Option<u32> {
+        LAST.with(|c| c.get().iter().find(|e| e.0 == key).map(|e| e.1))
     }
 
-    /// Remembers `entry` for mesh `key` (most recent first).
+    /// Remembers `slot` for mesh `key` (most recent first).
     #[inline]
-    pub fn set(key: usize, entry: Entry) {
-        LAST.with_borrow_mut(|a| {
+    pub fn set(key: usize, slot: u32) {
+        LAST.with(|c| {
+            let mut a = c.get();
             let i = a.iter().position(|e| e.0 == key).unwrap_or(WAYS - 1);
             a.copy_within(0..i, 1);
-            a[0] = (key, entry);
+            a[0] = (key, slot);
+            c.set(a);
         })
     }
 }
-
-pub static HITS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-pub static TRIES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-pub static MARG: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);

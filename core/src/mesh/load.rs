@@ -83,6 +83,9 @@ pub(crate) fn weld(vertices: &[DVec3], triangles: &[[u32; 3]]) -> (Vec<DVec3>, V
 type Soup = (Vec<DVec3>, Vec<[u32; 3]>);
 
 fn load_obj(path: &Path) -> Result<Soup, MeshError> {
+    // Spelled out field by field; `..Default::default()` keeps it compiling
+    // when a tobj feature adds options.
+    #[allow(clippy::needless_update)]
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: false,

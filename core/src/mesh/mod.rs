@@ -4,22 +4,25 @@
 //! (OPENVCAD.md §2: distances clamped to the band, resolution-dependent).
 //! Volcad instead answers every query exactly from the triangles:
 //!
-//! * **distance**: nearest triangle through a flattened SAH BVH
-//!   ([`bvh`]), nearest child first, pruning on squared distances, with
-//!   Ericson's closest-point-on-triangle ([`triangle`]);
+//! * **distance**: nearest triangle through a binned-SAH BVH (`bvh.rs`)
+//!   collapsed to 4-wide nodes with `f32` SIMD boxes (`wide.rs`), nearest
+//!   child first, pruning on squared distances, with Ericson's
+//!   closest-point-on-triangle (`triangle.rs`). A per-thread seed (the last
+//!   answer for this mesh) and a coarse grid of exact distances (`coarse.rs`)
+//!   give the search a tight starting radius;
 //! * **sign**: for a closed, consistently oriented 2-manifold the
 //!   angle-weighted pseudo-normal of the closest feature (face, edge or
 //!   vertex; Bærentzen & Aanæs 2005): `p` is outside iff
 //!   `(p − c)·n_feature > 0`. Any other mesh (holes, flipped or degenerate
 //!   triangles, non-manifold edges) uses the generalised winding number
-//!   ([`winding`]), `inside ⇔ w > 1/2` (Jacobson et al. 2013).
+//!   (`winding.rs`), `inside ⇔ w > 1/2` (Jacobson et al. 2013).
 //!
 //! The result is a true Euclidean SDF (1-Lipschitz), so interval bounds over
 //! boxes follow from one evaluation at the centre.
 
 pub(crate) mod bvh;
 mod coarse;
-pub mod distance;
+mod distance;
 mod load;
 mod topology;
 mod triangle;

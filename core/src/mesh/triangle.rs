@@ -58,7 +58,7 @@ impl Tri {
         let len = cross.length();
         // |ab × ac|² = |ab|²|ac|² − (ab·ac)²; relative threshold on the sine
         // of the corner angle so the Ericson denominators stay meaningful.
-        let flat = !(len > 1e-12 * (ab2 * ac2).sqrt()) || ab2 == 0.0 || ac2 == 0.0;
+        let flat = len.is_nan() || len <= 1e-12 * (ab2 * ac2).sqrt() || ab2 == 0.0 || ac2 == 0.0;
         Tri {
             a,
             ab,

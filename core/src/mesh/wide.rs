@@ -36,41 +36,6 @@ struct Node4 {
     child: [u32; 4],
 }
 
-/// What a nearest search proved about the neighbourhood of its query
-/// point: every primitive other than `near[..count]` is at least
-/// `sqrt(rest)` away. By the triangle inequality a later query `q` with
-/// `δ = |q − p|` then has its nearest primitive among `near` whenever the
-/// best of them is within `sqrt(rest) − δ` of `q`.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct Certificate {
-    /// The primitives with the smallest exact squared distances.
-    pub near: [(u32, f64); 4],
-    /// How many entries of `near` are used.
-    pub count: usize,
-    /// Lower bound of the squared distance of every other primitive.
-    pub rest: f64,
-}
-
-impl Certificate {
-    /// Records a tested primitive: kept among the four nearest or folded
-    /// into `rest`.
-    #[inline(always)]
-    fn offer(&mut self, slot: u32, d2: f64) {
-        let mut e = (slot, d2);
-        for i in 0..self.count {
-            if e.1 < self.near[i].1 {
-                std::mem::swap(&mut e, &mut self.near[i]);
-            }
-        }
-        if self.count < self.near.len() {
-            self.near[self.count] = e;
-            self.count += 1;
-        } else {
-            self.rest = self.rest.min(e.1);
-        }
-    }
-}
-
 /// The collapsed tree. Node 0 is the root.
 #[derive(Clone, Debug)]
 pub(crate) struct WideBvh {
@@ -155,41 +120,23 @@ impl WideBvh {
     }
 
     /// Nearest primitive to `p` closer than `sqrt(max_d2)`: `test(slot, best)`
-    /// returns the squared distance of a primitive, or a lower bound of it
-    /// that is `>= best` when a cheap test already rules it out. `seed` is a
-    /// primitive whose squared distance is already known. Children are
-    /// visited nearest first.
-    ///
-    /// Also fills `cert` (see [`Certificate`]): the up to four primitives
-    /// with the smallest exact distances, and a lower bound of the squared
-    /// distance of every other primitive (the minimum over all pruned boxes
-    /// and rejected primitives).
+    /// returns the squared distance of a primitive (or anything `>= best`
+    /// when a cheap bound already rules it out). Returns the slot and its
+    /// squared distance. Children are visited nearest first; the stack holds
+    /// at most three entries per level.
     #[inline(always)]
     pub fn nearest<F: FnMut(u32, f64) -> f64>(
         &self,
         p: DVec3,
         max_d2: f64,
-        seed: Option<(u32, f64)>,
-        cert: &mut Certificate,
         mut test: F,
     ) -> Option<(u32, f64)> {
         let px = Vec4::splat(p.x as f32);
         let py = Vec4::splat(p.y as f32);
         let pz = Vec4::splat(p.z as f32);
         let mut best = max_d2;
-        let mut best_slot = EMPTY;
-        cert.count = 0;
-        cert.rest = f64::INFINITY;
-        if let Some((s, d)) = seed {
-            cert.offer(s, d);
-            if d < best {
-                best = d;
-                best_slot = s;
-            }
-        }
         let mut best_f = bound(best);
-        // Lower bound (f32) of everything pruned by box distance.
-        let mut pruned = f32::INFINITY;
+        let mut best_slot = EMPTY;
         let mut stack = Stack::<(u32, f32)>::new();
         let mut ni = 0usize;
         'visit: loop {
@@ -198,9 +145,7 @@ impl WideBvh {
             let dy = (n.lo[1] - py).max(py - n.hi[1]).max(Vec4::ZERO);
             let dz = (n.lo[2] - pz).max(pz - n.hi[2]).max(Vec4::ZERO);
             let d2 = dx * dx + dy * dy + dz * dz;
-            let hit = d2.cmplt(Vec4::splat(best_f));
-            pruned = pruned.min(Vec4::select(hit, Vec4::INFINITY, d2).min_element());
-            let mut mask = hit.bitmask();
+            let mut mask = d2.cmplt(Vec4::splat(best_f)).bitmask();
             let d2 = d2.to_array();
             let mut inner = [(0u32, 0.0f32); 4];
             let mut ni_count = 0;
@@ -210,16 +155,12 @@ impl WideBvh {
                 let c = n.child[lane];
                 if c & PRIM != 0 {
                     let s = c & !PRIM;
-                    if Some(s) == seed.map(|x| x.0) {
-                        continue;
-                    }
                     let d = test(s, best);
                     if d < best {
                         best = d;
                         best_f = bound(d);
                         best_slot = s;
                     }
-                    cert.offer(s, d);
                 } else {
                     inner[ni_count] = (c, d2[lane]);
                     ni_count += 1;
@@ -237,8 +178,6 @@ impl WideBvh {
                     }
                     inner[j] = e;
                     k += 1;
-                } else {
-                    pruned = pruned.min(e.1);
                 }
             }
             if k > 0 {
@@ -254,13 +193,9 @@ impl WideBvh {
                     ni = node as usize;
                     continue 'visit;
                 }
-                pruned = pruned.min(d);
             }
             break;
         }
-        // The f32 box bounds were computed on slightly grown boxes, so they
-        // are lower bounds of the true squared distances.
-        cert.rest = cert.rest.min(pruned as f64);
         (best_slot != EMPTY).then_some((best_slot, best))
     }
 

@@ -14,6 +14,31 @@ use super::pnode::{
 use super::union_index::Candidates;
 
 impl PNode {
+    /// Distance at `p`, and the fractions into `out` (zeroed by the caller)
+    /// when it is ≤ 0. One pass where a node can share work between the two
+    /// (a union finds its minimum and the first child containing `p` in the
+    /// same loop over its candidates).
+    pub fn eval(&self, p: DVec3, out: &mut [f64]) -> f64 {
+        match self {
+            PNode::Union(u) if !u.blend && u.smooth <= 0.0 => u.union_eval(p, out),
+            PNode::Translate { t, child } => child.eval(p - *t, out),
+            PNode::FGrade(g) => {
+                let d = g.child.dist(p);
+                if d <= 0.0 {
+                    g.frac_with_d(p, d, out);
+                }
+                d
+            }
+            _ => {
+                let d = self.dist(p);
+                if d <= 0.0 {
+                    self.frac(p, out);
+                }
+                d
+            }
+        }
+    }
+
     /// Fractions at `p` into `out` (zeroed by the caller).
     pub fn frac(&self, p: DVec3, out: &mut [f64]) {
         match self {
@@ -52,6 +77,52 @@ impl PNode {
 }
 
 impl NAry {
+    /// Sharp, non-blending union: minimum and first containing child at once.
+    fn union_eval(&self, p: DVec3, out: &mut [f64]) -> f64 {
+        let mut best = f64::INFINITY;
+        let mut first = usize::MAX;
+        let visit = |i: usize, best: &mut f64, first: &mut usize| {
+            let d = self.child_dist(i, p);
+            if d <= 0.0 && i < *first {
+                *first = i;
+            }
+            if d < *best {
+                *best = d;
+            }
+        };
+        match &self.index {
+            Some(index) => {
+                for &i in index.always() {
+                    visit(i as usize, &mut best, &mut first);
+                }
+                let mut done = false;
+                if let Candidates::Cell { items, margin, .. } = index.candidates(p) {
+                    for &i in items {
+                        visit(i as usize, &mut best, &mut first);
+                    }
+                    done = best < margin;
+                }
+                if !done {
+                    // Exact minimum through the BVH; a containing child is
+                    // always among the visited ones (its box holds p).
+                    index.bvh().nearest(p, best, |i| {
+                        visit(i as usize, &mut best, &mut first);
+                        best
+                    });
+                }
+            }
+            None => {
+                for i in 0..self.children.len() {
+                    visit(i, &mut best, &mut first);
+                }
+            }
+        }
+        if best <= 0.0 && first != usize::MAX {
+            self.children[first].frac(p, out);
+        }
+        best
+    }
+
     /// `blend = false`: the first child (in order) containing `p` wins.
     /// `blend = true`: the average over the children containing `p`.
     /// Where no child contains `p` (the fillet of a smooth union) the nearest
@@ -171,18 +242,26 @@ impl Grade {
     /// (pyvcad keeps negative values and normalises only positive sums; a
     /// negative fraction has no physical meaning, see docs/PYVCAD.md.)
     fn frac(&self, p: DVec3, out: &mut [f64]) {
+        let d = if self.used & (1 << D_SLOT) != 0 {
+            self.child.dist(p)
+        } else {
+            0.0
+        };
+        self.frac_with_d(p, d, out);
+    }
+
+    /// Fractions when the child's distance `d` is already known.
+    fn frac_with_d(&self, p: DVec3, d: f64, out: &mut [f64]) {
         let mut slots = [0.0; COORD_SLOTS];
         coord_slots(p, self.used, &mut slots);
-        if self.used & (1 << D_SLOT) != 0 {
-            slots[D_SLOT] = self.child.dist(p);
-        }
+        slots[D_SLOT] = d;
         write_normalised(&self.exprs, &self.mats, &slots, out);
     }
 }
 
 impl SimGrade {
     fn frac(&self, p: DVec3, out: &mut [f64]) {
-        let n = COORD_SLOTS + self.field.variable_names().len();
+        let n = COORD_SLOTS + self.field.variable_count();
         let mut slots = [0.0; 64];
         let slots = &mut slots[..n];
         coord_slots(p, self.used, slots);

@@ -47,7 +47,7 @@ pub struct PrepareError {
 /// A prepared design.
 #[derive(Debug, Clone)]
 pub struct Model {
-    root: Arc<PNode>,
+    pub(crate) root: Arc<PNode>,
     bbox: Aabb,
     materials: Vec<MaterialId>,
     table: Arc<MaterialTable>,
@@ -150,11 +150,7 @@ impl Model {
     #[inline]
     pub fn eval_into(&self, p: DVec3, fracs: &mut [f64]) -> f64 {
         fracs.fill(0.0);
-        let d = self.root.dist(p);
-        if d <= 0.0 {
-            self.root.frac(p, fracs);
-        }
-        d
+        self.root.eval(p, fracs)
     }
 
     /// Convenience: distance and (material id, fraction) pairs at one point;

@@ -173,6 +173,9 @@ pub struct NAry {
     pub blend: bool,
     /// Present for large, sharp unions.
     pub index: Option<UnionIndex>,
+    /// Children whose distance is a capsule (a strut, or a graded strut),
+    /// evaluated inline in the candidate loop without pointer chasing.
+    pub capsules: Vec<Option<Capsule>>,
 }
 
 /// FGrade: fractions from expressions over the child.
@@ -275,6 +278,27 @@ impl PNode {
 }
 
 impl NAry {
+    /// The capsule a child's distance reduces to, if any.
+    pub fn capsule_of(child: &PNode) -> Option<Capsule> {
+        match child {
+            PNode::Strut { s, .. } => Some(*s),
+            PNode::FGrade(g) => match &*g.child {
+                PNode::Strut { s, .. } => Some(*s),
+                _ => None,
+            },
+            _ => None,
+        }
+    }
+
+    /// Distance of child `i` (inline for capsules).
+    #[inline]
+    pub fn child_dist(&self, i: usize, p: DVec3) -> f64 {
+        match &self.capsules[i] {
+            Some(c) => c.dist(p),
+            None => self.children[i].dist(p),
+        }
+    }
+
     /// Minimum (or pyvcad's smooth minimum, folded in child order).
     pub fn union_dist(&self, p: DVec3) -> f64 {
         if let Some(index) = &self.index {
@@ -296,18 +320,18 @@ impl NAry {
     fn indexed_min(&self, index: &UnionIndex, p: DVec3) -> f64 {
         let mut best = f64::INFINITY;
         for &i in index.always() {
-            best = best.min(self.children[i as usize].dist(p));
+            best = best.min(self.child_dist(i as usize, p));
         }
         if let Candidates::Cell { items, margin, .. } = index.candidates(p) {
             for &i in items {
-                best = best.min(self.children[i as usize].dist(p));
+                best = best.min(self.child_dist(i as usize, p));
             }
             if best < margin {
                 return best;
             }
         }
         index.bvh().nearest(p, best, |i| {
-            let d = self.children[i as usize].dist(p);
+            let d = self.child_dist(i as usize, p);
             best = best.min(d);
             best
         });

@@ -427,7 +427,8 @@ impl Preparer {
             bbox = bbox.union(&b);
         }
         let index = (is_union && smooth <= 0.0 && children.len() >= INDEX_MIN_CHILDREN)
-            .then(|| UnionIndex::build(&boxes));
+            .then(|| UnionIndex::build(&boxes, |i, cell| nodes[i].interval(cell).lo));
+        let capsules = nodes.iter().map(|n| NAry::capsule_of(n)).collect();
         Ok((
             NAry {
                 children: nodes,
@@ -435,6 +436,7 @@ impl Preparer {
                 smooth: smooth.max(0.0),
                 blend,
                 index,
+                capsules,
             },
             bbox,
         ))

@@ -4,13 +4,12 @@
 //! Two structures over the children's bounding boxes:
 //!
 //! * a **uniform grid**: each cell lists (in child order) the children whose
-//!   box, grown by `margin`, touches the cell. For a point in a cell, a child
-//!   that is not listed is farther than `margin` from the point's cell, so —
-//!   for children whose value is at least the distance to their own box, which
-//!   holds for every exact or conservative SDF here — its value exceeds
-//!   `margin` and it cannot be the minimum when a listed child is below
-//!   `margin`. It also cannot contain the point, so "first child containing p"
-//!   is found among the listed ones.
+//!   interval over the cell has a lower end below `margin` (two cell sizes).
+//!   For a point in a cell, an unlisted child's value exceeds `margin`, so it
+//!   cannot be the minimum when a listed child is below `margin`, and it
+//!   cannot contain the point: "first child containing p" is found among the
+//!   listed ones. Using the child's own interval (not its box) keeps long
+//!   diagonal struts out of the cells they only pass near.
 //! * a **BVH** for the rest: points outside the grid or with no listed child
 //!   closer than `margin` get the exact minimum by nearest-first traversal
 //!   that prunes subtrees whose box is farther than the best value so far.
@@ -53,8 +52,12 @@ pub enum Candidates<'a> {
 }
 
 impl UnionIndex {
-    /// Build over `boxes` (one per child, in child order).
-    pub fn build(boxes: &[Aabb]) -> Self {
+    /// Build over `boxes` (one per child, in child order). `lower_bound(i,
+    /// cell)` must return a lower bound of child `i`'s value over `cell` (its
+    /// interval's `lo`); a child is listed in a cell when that bound is below
+    /// the margin, so an unlisted child's value exceeds the margin anywhere in
+    /// the cell (this needs only sound intervals, no Lipschitz assumption).
+    pub fn build(boxes: &[Aabb], lower_bound: impl Fn(usize, &Aabb) -> f64 + Sync) -> Self {
         let mut always = Vec::new();
         let mut finite: Vec<u32> = Vec::new();
         let mut grid_box = Aabb::EMPTY;
@@ -66,25 +69,19 @@ impl UnionIndex {
                 always.push(i as u32);
             }
         }
-        // About 4 cells per finite child, cubic cells.
+        // About 64 cubic cells per finite child, at most 2 million cells.
         let n = finite.len().max(1) as f64;
         let size = grid_box.size().max(DVec3::splat(1e-9));
-        let cell = ((size.x * size.y * size.z) / (4.0 * n)).cbrt();
-        // Mean child size bounds the cell from below so long struts do not
-        // land in hundreds of cells each.
-        let mean_child = finite
-            .iter()
-            .map(|&i| boxes[i as usize].size().min_element())
-            .sum::<f64>()
-            / n;
-        let cell = cell.max(mean_child * 0.5).max(size.max_element() / 256.0);
+        let volume = size.x * size.y * size.z;
+        let cell = (volume / (64.0 * n)).cbrt().max((volume / 2.0e6).cbrt());
         let dims = [
-            ((size.x / cell).ceil() as usize).clamp(1, 256),
-            ((size.y / cell).ceil() as usize).clamp(1, 256),
-            ((size.z / cell).ceil() as usize).clamp(1, 256),
+            ((size.x / cell).ceil() as usize).clamp(1, 1024),
+            ((size.y / cell).ceil() as usize).clamp(1, 1024),
+            ((size.z / cell).ceil() as usize).clamp(1, 1024),
         ];
         let cell_size = size / DVec3::new(dims[0] as f64, dims[1] as f64, dims[2] as f64);
-        let margin = cell_size.max_element();
+        // Two cells: points within two cells of a child never need the BVH.
+        let margin = 2.0 * cell_size.max_element();
         let inv_cell = DVec3::ONE / cell_size;
         let ncells = dims[0] * dims[1] * dims[2];
         let cell_range = |b: &Aabb| {
@@ -104,31 +101,64 @@ impl UnionIndex {
                 ],
             )
         };
-        // Two passes: count, then fill, so items are in child order per cell.
-        let mut counts = vec![0u32; ncells + 1];
-        let visit = |f: &mut dyn FnMut(usize, u32)| {
-            for &i in &finite {
+        let cell_box = |x: usize, y: usize, z: usize| {
+            let lo = grid_box.min + DVec3::new(x as f64, y as f64, z as f64) * cell_size;
+            Aabb::new(lo, lo + cell_size)
+        };
+        // Per child (in parallel), the cells it is listed in; then CSR in
+        // child order per cell.
+        use rayon::prelude::*;
+        let lists: Vec<Vec<u32>> = finite
+            .par_iter()
+            .map(|&i| {
                 let (lo, hi) = cell_range(&boxes[i as usize].expand(margin));
-                for z in lo[2]..=hi[2] {
-                    for y in lo[1]..=hi[1] {
-                        for x in lo[0]..=hi[0] {
-                            f(x + dims[0] * (y + dims[1] * z), i);
+                let mut cells = Vec::new();
+                // Blocks of 4³ cells first: a block whose bound is already
+                // above the margin is skipped whole (long diagonal struts
+                // touch few of the cells in their box).
+                const B: usize = 4;
+                for bz in (lo[2]..=hi[2]).step_by(B) {
+                    for by in (lo[1]..=hi[1]).step_by(B) {
+                        for bx in (lo[0]..=hi[0]).step_by(B) {
+                            let ex = (bx + B - 1).min(hi[0]);
+                            let ey = (by + B - 1).min(hi[1]);
+                            let ez = (bz + B - 1).min(hi[2]);
+                            let block = cell_box(bx, by, bz).union(&cell_box(ex, ey, ez));
+                            if lower_bound(i as usize, &block) >= margin {
+                                continue;
+                            }
+                            for z in bz..=ez {
+                                for y in by..=ey {
+                                    for x in bx..=ex {
+                                        if lower_bound(i as usize, &cell_box(x, y, z)) < margin {
+                                            cells.push((x + dims[0] * (y + dims[1] * z)) as u32);
+                                        }
+                                    }
+                                }
+                            }
                         }
                     }
                 }
+                cells
+            })
+            .collect();
+        let mut offsets = vec![0u32; ncells + 1];
+        for l in &lists {
+            for &c in l {
+                offsets[c as usize + 1] += 1;
             }
-        };
-        visit(&mut |c, _| counts[c + 1] += 1);
-        for c in 0..ncells {
-            counts[c + 1] += counts[c];
         }
-        let offsets = counts.clone();
-        let mut fill = counts;
+        for c in 0..ncells {
+            offsets[c + 1] += offsets[c];
+        }
+        let mut fill = offsets.clone();
         let mut items = vec![0u32; offsets[ncells] as usize];
-        visit(&mut |c, i| {
-            items[fill[c] as usize] = i;
-            fill[c] += 1;
-        });
+        for (&i, l) in finite.iter().zip(&lists) {
+            for &c in l {
+                items[fill[c as usize] as usize] = i;
+                fill[c as usize] += 1;
+            }
+        }
         let bvh = Bvh::build(boxes, &finite);
         Self {
             grid_box,

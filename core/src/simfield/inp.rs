@@ -81,7 +81,7 @@ pub(crate) fn parse(path: &Path) -> Result<InpMesh, SimFieldError> {
         if line.is_empty() || line.starts_with("**") {
             continue;
         }
-        if line.starts_with('*') {
+        if let Some(keyword_line) = line.strip_prefix('*') {
             if !pending.is_empty() {
                 return Err(err(
                     pending_line,
@@ -91,7 +91,7 @@ pub(crate) fn parse(path: &Path) -> Result<InpMesh, SimFieldError> {
                     ),
                 ));
             }
-            let mut parts = line[1..].split(',');
+            let mut parts = keyword_line.split(',');
             let keyword = parts
                 .next()
                 .unwrap_or("")
@@ -100,7 +100,7 @@ pub(crate) fn parse(path: &Path) -> Result<InpMesh, SimFieldError> {
                 .join(" ")
                 .to_ascii_uppercase();
             let param = |name: &str| {
-                line[1..].split(',').skip(1).find_map(|p| {
+                keyword_line.split(',').skip(1).find_map(|p| {
                     let (k, v) = p.split_once('=')?;
                     k.trim()
                         .eq_ignore_ascii_case(name)
@@ -286,6 +286,6 @@ fn split_fields(line: &str) -> Vec<&str> {
 pub(crate) fn parse_id(s: &str) -> Option<u64> {
     s.parse::<u64>().ok().or_else(|| {
         let v = s.parse::<f64>().ok()?;
-        (v.fract() == 0.0 && v >= 0.0 && v < 1.8e19).then_some(v as u64)
+        (v.fract() == 0.0 && (0.0..1.8e19).contains(&v)).then_some(v as u64)
     })
 }

@@ -1,12 +1,13 @@
 //! FEA results as a field: the paper's *SimulationField*, pyvcad's `PointMap`.
 //!
-//! A tetrahedral mesh (Abaqus/CalculiX `.inp`, [`inp`]) carries nodal values
-//! (CSV, [`csv`]). Inside a tetrahedron every value is interpolated linearly
+//! A tetrahedral mesh (Abaqus/CalculiX `.inp`, `inp.rs`) carries nodal
+//! values (CSV, `csv.rs`). Inside a tetrahedron every value is interpolated linearly
 //! with the point's barycentric weights, `f(p) = Σ λi f(vi)` (exact for
-//! linear elements such as C3D4), found through a BVH ([`tet_bvh`]).
+//! linear elements such as C3D4), found by a walk from a coarse start grid with a BVH
+//! fallback (`tet_bvh.rs`).
 //! Displacements give the derived variable `len = |(dx, dy, dz)(p)|`: the
 //! vector is interpolated first and its magnitude taken afterwards, as in
-//! OpenVCAD (OPENVCAD.md §6). The mesh's outer surface ([`boundary`]) is a
+//! OpenVCAD (OPENVCAD.md §6). The mesh's outer surface (`boundary.rs`) is a
 //! [`TriangleMesh`], which gives the field an exact signed distance.
 
 mod boundary;
@@ -209,8 +210,15 @@ enum BuildError {
 }
 
 impl SimField {
-    /// Loads a tetrahedral `.inp` mesh and a nodal-results CSV (see the
-    /// [`inp`] and [`csv`] module docs for the accepted layouts).
+    /// Loads a tetrahedral `.inp` mesh and a nodal-results CSV.
+    ///
+    /// `.inp`: `*NODE` and `*ELEMENT, TYPE=C3D4` (or C3D10, corners used)
+    /// blocks, keywords case-insensitive, `**` comments, node ids in any
+    /// order; other blocks (sets, materials, steps) are skipped, other element
+    /// types skipped with a warning. CSV: with a header, a `node_id` (or
+    /// `id`, `node`) column maps rows to nodes and the other columns are
+    /// values by name; headerless (pyvcad `PointMap`), rows `x,y,z,u,v,w` in
+    /// node order, exposed as `x,y,z,dx,dy,dz`. Every node needs one row.
     pub fn load(inp: &Path, csv: &Path) -> Result<SimField, SimFieldError> {
         let mesh = inp::parse(inp)?;
         let (columns, csv_warnings) = csv::parse(csv, &mesh)?;

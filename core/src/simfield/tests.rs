@@ -6,12 +6,18 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 
 use super::{SimField, SimFieldError};
-use crate::mesh::tests::{Rng, temp_path};
+use crate::mesh::tests::{Rng, temp_path, throughput};
 
 const SEAT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/seat/");
+/// The mesh and the table CSV ship with the bicycle-seat example.
+const EXAMPLE_DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/examples/data/");
 
 fn seat(name: &str) -> PathBuf {
-    Path::new(SEAT).join(name)
+    if name == "seat.inp" || name == "seat_displacement_table.csv" {
+        Path::new(EXAMPLE_DATA).join(name)
+    } else {
+        Path::new(SEAT).join(name)
+    }
 }
 
 /// The CSV rows as (x, y, z, dx, dy, dz), in node order.
@@ -355,16 +361,9 @@ fn perf_seat_sample() {
         ("voxel-grid interior", &grid),
         ("voxel-grid whole box", &all),
     ] {
-        let t0 = std::time::Instant::now();
-        let mut acc = 0.0;
-        for &p in pts.iter() {
+        throughput(&format!("seat sample, {name}"), pts, |p| {
             f.sample(p, &mut out);
-            acc += out[3];
-        }
-        let dt = t0.elapsed().as_secs_f64();
-        println!(
-            "seat sample ({name} points): {:.2} M samples/s (1 core) [{acc:.1}]",
-            pts.len() as f64 / dt / 1e6
-        );
+            out[3]
+        });
     }
 }
