@@ -1,0 +1,12 @@
+//! The `volcad` command line: `main → run(parse())`; errors print `{:#}`
+//! on stderr and exit 1 (2 for usage errors, from clap).
+
+use clap::Parser;
+
+fn main() {
+    let cli = volcad_studio::cli::Cli::parse();
+    if let Err(e) = volcad_studio::cli::run(cli) {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}

@@ -1,0 +1,259 @@
+//! `volcad export png|mesh|fea` and `volcad fea-result`: run an export job
+//! with a progress bar; Ctrl-C cancels cleanly (nothing is left behind).
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+use anyhow::{Context, bail};
+use glam::DVec3;
+use volcad_compilers::fea::{Element, FeaParams, Sizing, StepParams};
+use volcad_compilers::job::{self, design_hash};
+use volcad_compilers::mesh::{MeshFormats, MeshParams, SegmentBy};
+use volcad_compilers::png_stack::{self, Dither, PngParams};
+
+use super::DesignArgs;
+use super::design::load_design;
+
+/// What to export.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// Inkjet slice stack: one PNG per layer.
+    Png,
+    /// Segmented meshes: STL + OBJ per segment and one 3MF.
+    Mesh,
+    /// FEA mesh for Abaqus/CalculiX (.inp).
+    Fea,
+}
+
+/// `volcad export` options (spelled as scripts rely on them).
+#[derive(clap::Args, Debug)]
+pub struct ExportArgs {
+    /// png, mesh or fea.
+    #[arg(value_enum)]
+    pub kind: Kind,
+    /// The design.
+    #[command(flatten)]
+    pub design: DesignArgs,
+    /// Output folder (written to a staging folder and renamed when complete).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Voxel size in mm: one value, or X,Y,Z.
+    #[arg(long, allow_hyphen_values = true)]
+    pub voxel: Option<String>,
+    /// Printer preset for the voxel size (png): j750.
+    #[arg(long)]
+    pub preset: Option<String>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Seed of the material draw (same seed, same bytes).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// png: only layers A..B (global indices kept in file names).
+    #[arg(long)]
+    pub layers: Option<String>,
+    /// png: random or diffusion.
+    #[arg(long, default_value = "random")]
+    pub dither: String,
+    /// png: also write 1-bit stacks, one folder per material.
+    #[arg(long)]
+    pub bitmaps: bool,
+    /// mesh: number of fraction ranges.
+    #[arg(long, default_value_t = 4)]
+    pub segments: usize,
+    /// mesh: material whose fraction splits the part, or `dominant`.
+    #[arg(long)]
+    pub by: Option<String>,
+    /// mesh: 3MF infill percent as a math string of f (the segment's mid fraction).
+    #[arg(long)]
+    pub infill: Option<String>,
+    /// fea: c3d8r (bricks) or c3d4 (adaptive tets).
+    #[arg(long, default_value = "c3d8r")]
+    pub element: String,
+    /// fea: smallest tet cell (mm).
+    #[arg(long)]
+    pub min_cell: Option<f64>,
+    /// fea: largest tet cell (mm).
+    #[arg(long)]
+    pub max_cell: Option<f64>,
+    /// fea: cell size as a math string of h (heterogeneity) instead of the linear rule.
+    #[arg(long)]
+    pub sizing: Option<String>,
+    /// fea: append a static step: bottom fixed, top displaced by this many mm in z.
+    #[arg(long, allow_negative_numbers = true)]
+    pub step: Option<f64>,
+}
+
+fn parse_voxel(s: &str) -> anyhow::Result<DVec3> {
+    let parts: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>().with_context(|| format!("--voxel {s}: {p:?} is not a number")))
+        .collect::<anyhow::Result<_>>()?;
+    let v = match parts.as_slice() {
+        [a] => DVec3::splat(*a),
+        [a, b, c] => DVec3::new(*a, *b, *c),
+        _ => bail!("--voxel {s}: give one size or three (X,Y,Z) in mm"),
+    };
+    if !(v.cmpgt(DVec3::ZERO).all() && v.is_finite()) {
+        bail!("--voxel {s}: voxel sizes must be > 0");
+    }
+    Ok(v)
+}
+
+fn parse_layers(s: &str) -> anyhow::Result<std::ops::Range<usize>> {
+    let (a, b) = s.split_once("..").with_context(|| format!("--layers {s}: expected A..B, e.g. 100..200"))?;
+    let a: usize = a.trim().parse().with_context(|| format!("--layers {s}: bad start"))?;
+    let b: usize = b.trim().parse().with_context(|| format!("--layers {s}: bad end"))?;
+    if a >= b {
+        bail!("--layers {s}: the start must be below the end");
+    }
+    Ok(a..b)
+}
+
+/// Run `volcad export`.
+pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
+    let l = load_design(&a.design)?;
+    let model = l.model.clone();
+    let voxel = match (&a.voxel, &a.preset) {
+        (Some(v), _) => Some(parse_voxel(v)?),
+        (None, Some(p)) => Some(
+            png_stack::presets()
+                .iter()
+                .find(|q| q.name == p.as_str())
+                .map(|q| q.voxel)
+                .with_context(|| {
+                    let names: Vec<&str> = png_stack::presets().iter().map(|q| q.name).collect();
+                    format!("--preset {p}: unknown; known presets: {}", names.join(", "))
+                })?,
+        ),
+        (None, None) => None,
+    };
+    let hash = design_hash(&[l.source.as_bytes(), format!("{:?}", a.design.params).as_bytes()]);
+    if let Some(t) = a.threads
+        && t == 0
+    {
+        bail!("--threads must be at least 1");
+    }
+    let threads = a.threads;
+    let dest = a.out.clone();
+    let handle = match a.kind {
+        Kind::Png => {
+            let dither = match a.dither.as_str() {
+                "random" => Dither::Random,
+                "diffusion" => Dither::Diffusion,
+                d => bail!("--dither {d}: expected random or diffusion"),
+            };
+            let p = PngParams {
+                voxel: voxel.context("--voxel or --preset is required for png (e.g. --voxel 0.1 or --preset j750)")?,
+                seed: a.seed,
+                dither,
+                layers: a.layers.as_deref().map(parse_layers).transpose()?,
+                per_material_bitmaps: a.bitmaps,
+                threads,
+            };
+            let est = png_stack::estimate(&model, &p)?;
+            let [nx, ny, nz] = est.grid.dims;
+            eprintln!(
+                "grid {nx} x {ny} x {nz}; layers {}..{} ({} voxels); about {:.1} MB on disk, {:.1} MB working memory",
+                est.layers.start,
+                est.layers.end,
+                est.voxels,
+                est.disk_bytes as f64 / 1e6,
+                est.memory_bytes as f64 / 1e6
+            );
+            job::spawn(dest, hash, move |ctx| png_stack::export_png_stack(&model, &p, ctx))
+        }
+        Kind::Mesh => {
+            let by = match a.by.as_deref() {
+                None | Some("dominant") => SegmentBy::Dominant,
+                Some(name) => SegmentBy::Material(model.table().id(name).context("--by")?),
+            };
+            let p = MeshParams {
+                voxel: voxel.context("--voxel is required for mesh (e.g. --voxel 0.25)")?,
+                segments: a.segments,
+                by,
+                formats: MeshFormats { stl: true, obj: true, threemf: true },
+                infill_expr: a.infill.clone(),
+                threads,
+            };
+            job::spawn(dest, hash, move |ctx| volcad_compilers::mesh::export_meshes(&model, &p, ctx))
+        }
+        Kind::Fea => {
+            let element = match a.element.as_str() {
+                "c3d8r" | "C3D8R" => Element::C3D8R,
+                "c3d4" | "C3D4" => Element::C3D4,
+                e => bail!("--element {e}: expected c3d8r or c3d4"),
+            };
+            let voxel = voxel.map(|v| v.min_element());
+            let size = model.bbox().size().min_element();
+            let min_cell = a.min_cell.or(voxel).unwrap_or(size / 10.0);
+            let p = FeaParams {
+                element,
+                voxel: voxel.unwrap_or(min_cell),
+                min_cell,
+                max_cell: a.max_cell.unwrap_or(min_cell * 4.0),
+                sizing: a.sizing.clone().map_or(Sizing::Heterogeneity, Sizing::Expr),
+                seed: a.seed,
+                step: a.step.map(|d| StepParams { top_displacement: d }),
+                threads,
+            };
+            job::spawn(dest, hash, move |ctx| volcad_compilers::fea::export_fea(&model, &p, ctx))
+        }
+    };
+    follow(handle)
+}
+
+/// Show progress until the job ends; Ctrl-C cancels it.
+fn follow(handle: job::JobHandle) -> anyhow::Result<()> {
+    let interrupted = Arc::new(AtomicBool::new(false));
+    let flag = interrupted.clone();
+    // A second handler cannot be installed (e.g. in tests running several
+    // exports in one process); the job then simply runs to its end.
+    let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
+    let bar = indicatif::ProgressBar::new(1000);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} {msg:<24} [{bar:30}] {percent:>3}% eta {eta}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let dest = handle.destination().to_path_buf();
+    while !handle.is_finished() {
+        if interrupted.load(Ordering::Relaxed) {
+            handle.cancel();
+        }
+        while let Ok(p) = handle.progress.try_recv() {
+            bar.set_message(p.stage.clone());
+            bar.set_position((p.fraction * 1000.0) as u64);
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    bar.finish_and_clear();
+    let summary = handle.join()?;
+    println!("{}: {} files in {}", summary.kind, summary.files.len(), dest.display());
+    for (name, count) in &summary.counts {
+        println!("  {name:<16} {count}");
+    }
+    if summary.seconds > 0.0 && summary.units > 0 {
+        println!(
+            "  {} {} in {:.2} s ({:.3e} {}/s)",
+            summary.units,
+            summary.unit,
+            summary.seconds,
+            summary.units as f64 / summary.seconds,
+            summary.unit
+        );
+    }
+    for n in &summary.notes {
+        println!("  {n}");
+    }
+    Ok(())
+}
+
+/// `volcad fea-result JOB.frd --inp JOB.inp --out result.csv`.
+pub fn fea_result(frd: &Path, inp: &Path, out: &Path) -> anyhow::Result<()> {
+    let r = volcad_compilers::fea::read_frd(frd)?;
+    volcad_compilers::fea::write_result_csv(&r, Some(inp), out)?;
+    eprintln!("{} nodes -> {}", r.displacements.len(), out.display());
+    Ok(())
+}

@@ -1,0 +1,174 @@
+//! The `volcad` binary end to end: every command, and bad input giving a
+//! clear message and a non-zero exit (never a panic).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn volcad(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_volcad"))
+        .args(args)
+        .env("XDG_RUNTIME_DIR", runtime_dir())
+        .output()
+        .expect("run volcad")
+}
+
+fn runtime_dir() -> PathBuf {
+    let d = std::env::temp_dir().join(format!("volcad-xdg-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let _ = std::fs::set_permissions(&d, std::fs::Permissions::from_mode(0o700));
+    }
+    d
+}
+
+fn example(name: &str) -> String {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../assets/examples")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("volcad-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn ok(o: &Output) -> String {
+    assert!(
+        o.status.success(),
+        "exit {:?}\nstdout: {}\nstderr: {}",
+        o.status,
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8_lossy(&o.stdout).to_string()
+}
+
+fn fails(o: &Output) -> String {
+    assert!(!o.status.success(), "expected failure, got success");
+    assert!(matches!(o.status.code(), Some(1) | Some(2)), "exit {:?}", o.status);
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(!err.contains("panicked"), "{err}");
+    err
+}
+
+#[test]
+fn info_reports_box_materials_and_params() {
+    let out = ok(&volcad(&["info", &example("graded_bar.rhai")]));
+    assert!(out.contains("[-7.5000, -5.0000, -2.5000] .. [7.5000, 5.0000, 2.5000]"), "{out}");
+    assert!(out.contains("red (1), blue (3)"), "{out}");
+    assert!(out.contains("param:       length = 15"), "{out}");
+    let out = ok(&volcad(&["info", &example("graded_bar.rhai"), "--param", "length=30"]));
+    assert!(out.contains("[-15.0000"), "{out}");
+}
+
+#[test]
+fn eval_prints_distance_and_fractions_by_name() {
+    let out = ok(&volcad(&["eval", &example("graded_bar.rhai"), "3.75", "0", "0"]));
+    assert!(out.contains("distance: -2.5"), "{out}");
+    assert!(out.contains("red: 0.75"), "{out}");
+    assert!(out.contains("blue: 0.25"), "{out}");
+    let out = ok(&volcad(&["eval", &example("graded_bar.rhai"), "--", "-20", "0", "0"]));
+    assert!(out.contains("outside"), "{out}");
+}
+
+#[test]
+fn sample_writes_one_column_per_material() {
+    let d = tmp("sample");
+    let pts = d.join("in.csv");
+    std::fs::write(&pts, "x,y,z\n0,0,0\n7.5,0,0\n100,0,0\n").unwrap();
+    let out = d.join("out.csv");
+    ok(&volcad(&[
+        "sample",
+        &example("graded_bar.rhai"),
+        "--points",
+        pts.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    let text = std::fs::read_to_string(&out).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[0], "x,y,z,distance,red,blue");
+    assert_eq!(lines[1], "0,0,0,-2.5,0.5,0.5");
+    assert!(lines[2].starts_with("7.5,0,0,0,1,0"), "{}", lines[2]);
+    assert!(lines[3].ends_with(",0,0"), "outside is 0: {}", lines[3]);
+}
+
+#[test]
+fn bad_input_is_a_clear_error() {
+    let err = fails(&volcad(&["info", "/no/such/design.rhai"]));
+    assert!(err.contains("cannot read /no/such/design.rhai"), "{err}");
+
+    let d = tmp("bad");
+    let bad = d.join("bad.rhai");
+    std::fs::write(&bad, "let m = default_materials();\nSphere(Vec3(0,0,0), 1, m.id(\"rde\"))\n").unwrap();
+    let err = fails(&volcad(&["info", bad.to_str().unwrap()]));
+    assert!(err.contains("bad.rhai:2:"), "{err}");
+    assert!(err.contains("did you mean \"red\""), "{err}");
+
+    let pts = d.join("pts.csv");
+    std::fs::write(&pts, "x,y,z\n1,2,3\n1,oops,3\n").unwrap();
+    let err = fails(&volcad(&[
+        "sample",
+        &example("hello_cube.rhai"),
+        "--points",
+        pts.to_str().unwrap(),
+        "--out",
+        d.join("o.csv").to_str().unwrap(),
+    ]));
+    assert!(err.contains("pts.csv:3: `y` = \"oops\" is not a finite number"), "{err}");
+
+    let err = fails(&volcad(&["export", "png", &example("hello_cube.rhai"), "--out", d.join("x").to_str().unwrap(), "--voxel", "-1"]));
+    assert!(err.contains("--voxel -1: voxel sizes must be > 0"), "{err}");
+    assert!(!d.join("x").exists());
+
+    let err = fails(&volcad(&["export", "png", &example("gyroid.rhai"), "--out", d.join("y").to_str().unwrap(), "--voxel", "0.5", "--param", "cell"]));
+    assert!(err.contains("expected NAME=VALUE"), "{err}");
+}
+
+#[test]
+fn unbounded_design_refuses_to_export() {
+    let d = tmp("unbounded");
+    let s = d.join("tile.rhai");
+    std::fs::write(&s, "Tile(4, 4, 4, Sphere(Vec3(0,0,0), 1, 1))").unwrap();
+    let err = fails(&volcad(&["export", "png", s.to_str().unwrap(), "--out", d.join("o").to_str().unwrap(), "--voxel", "0.5"]));
+    assert!(err.contains("unbounded"), "{err}");
+    assert!(!d.join("o").exists());
+}
+
+fn files_in(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn export_png_mesh_and_fea() {
+    let d = tmp("export");
+    let png = d.join("png");
+    let out = ok(&volcad(&["export", "png", &example("graded_bar.rhai"), "--out", png.to_str().unwrap(), "--voxel", "0.5", "--seed", "3"]));
+    assert!(out.contains("red") && out.contains("blue"), "{out}");
+    let files = files_in(&png);
+    assert!(files.contains(&"manifest.json".to_string()));
+    assert_eq!(files.iter().filter(|f| f.ends_with(".png")).count(), 10, "5 mm / 0.5 mm layers: {files:?}");
+
+    let mesh = d.join("mesh");
+    ok(&volcad(&["export", "mesh", &example("graded_bar.rhai"), "--out", mesh.to_str().unwrap(), "--voxel", "0.5", "--segments", "2", "--by", "red"]));
+    let files = files_in(&mesh);
+    assert!(files.iter().any(|f| f.ends_with(".3mf")), "{files:?}");
+    assert!(files.iter().filter(|f| f.ends_with(".stl")).count() >= 2, "{files:?}");
+
+    let fea = d.join("fea");
+    ok(&volcad(&["export", "fea", &example("graded_bar.rhai"), "--out", fea.to_str().unwrap(), "--voxel", "1", "--step", "-0.1"]));
+    let inp = std::fs::read_to_string(fea.join("model.inp")).unwrap();
+    assert!(inp.contains("*ELEMENT") || inp.contains("*Element"), "{inp}");
+    assert!(inp.to_uppercase().contains("NSET=NBOTTOM"));
+}
