@@ -1,0 +1,345 @@
+//! The job runner: every export runs as a job on a background thread,
+//! reports progress through a channel, stops promptly on cancel, and writes
+//! into a temporary folder beside the destination that is renamed into place
+//! only when the job completes. A cancelled, failed or crashed job therefore
+//! never leaves something that looks finished.
+//!
+//! Pipeline: `spawn(name, dest, work)` → thread → `work(&JobContext)` writes
+//! files under `ctx.staging()` and calls `ctx.progress(..)` /
+//! `ctx.check_cancel()?` → on `Ok(summary)` the manifest is written and the
+//! staging folder renamed to `dest` → the handle's `join()` returns the summary.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use serde::Serialize;
+
+/// One progress report.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Progress {
+    /// Stage name ("sampling", "writing PNG", "marching cubes", ...).
+    pub stage: String,
+    /// Fraction of the whole job done, 0..=1.
+    pub fraction: f64,
+    /// Units done (voxels, layers or elements, see `unit`).
+    pub done: u64,
+    /// Units in total.
+    pub total: u64,
+    /// What `done` counts.
+    pub unit: &'static str,
+    /// Time since the job started.
+    pub elapsed: Duration,
+    /// Estimated time left (from the rate so far).
+    pub eta: Option<Duration>,
+}
+
+/// Why a job did not complete.
+#[derive(Debug, thiserror::Error)]
+pub enum ExportError {
+    /// The user cancelled; nothing was left at the destination.
+    #[error("cancelled; no output was written")]
+    Cancelled,
+    /// A parameter is wrong: which one and why.
+    #[error("{param}: {message}")]
+    BadParameter {
+        /// Parameter name as the CLI spells it (`--voxel`, `--segments`).
+        param: String,
+        /// What is wrong and what is allowed.
+        message: String,
+    },
+    /// Writing failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file or folder.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The destination exists and is not a folder we may replace.
+    #[error("{0}: the destination exists and is not an export folder; choose another or remove it")]
+    DestinationExists(PathBuf),
+    /// The job panicked (a bug); nothing was left at the destination.
+    #[error("internal error: {0}")]
+    Panicked(String),
+    /// Anything else, with context.
+    #[error("{0}")]
+    Other(String),
+}
+
+impl ExportError {
+    /// An I/O error at `path`.
+    pub fn io(path: &Path, source: std::io::Error) -> Self {
+        ExportError::Io { path: path.to_owned(), source }
+    }
+
+    /// A bad parameter.
+    pub fn param(param: &str, message: impl Into<String>) -> Self {
+        ExportError::BadParameter { param: param.to_owned(), message: message.into() }
+    }
+}
+
+/// What a finished job reports, and what goes into `manifest.json`.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Summary {
+    /// Export kind ("png", "mesh", "fea").
+    pub kind: String,
+    /// Files written, relative to the output folder.
+    pub files: Vec<String>,
+    /// Count per material name (voxels or elements).
+    pub counts: Vec<(String, u64)>,
+    /// Units processed (voxels or elements) and what they are.
+    pub units: u64,
+    /// What `units` counts.
+    pub unit: String,
+    /// Parameters as given (for the manifest).
+    pub parameters: serde_json::Value,
+    /// Free-form lines for the user (quality figures, warnings).
+    pub notes: Vec<String>,
+    /// Wall time in seconds.
+    pub seconds: f64,
+}
+
+/// What a job's work function sees.
+pub struct JobContext {
+    staging: PathBuf,
+    cancel: Arc<AtomicBool>,
+    tx: SyncSender<Progress>,
+    start: Instant,
+    /// The design's hash, for the manifest.
+    pub design_hash: String,
+}
+
+impl JobContext {
+    /// The folder to write into (renamed to the destination on success).
+    pub fn staging(&self) -> &Path {
+        &self.staging
+    }
+
+    /// Err(Cancelled) once cancel was asked for.
+    pub fn check_cancel(&self) -> Result<(), ExportError> {
+        if self.cancel.load(Ordering::Relaxed) { Err(ExportError::Cancelled) } else { Ok(()) }
+    }
+
+    /// The cancel flag, for samplers.
+    pub fn cancel_flag(&self) -> &AtomicBool {
+        &self.cancel
+    }
+
+    /// Report progress (dropped if the receiver is behind: reports are
+    /// snapshots, the next one supersedes).
+    pub fn progress(&self, stage: &str, done: u64, total: u64, unit: &'static str, fraction: f64) {
+        let elapsed = self.start.elapsed();
+        let fraction = fraction.clamp(0.0, 1.0);
+        let eta = (fraction > 0.01).then(|| elapsed.mul_f64((1.0 - fraction) / fraction));
+        let p = Progress { stage: stage.to_owned(), fraction, done, total, unit, elapsed, eta };
+        match self.tx.try_send(p) {
+            Ok(()) | Err(TrySendError::Full(_)) | Err(TrySendError::Disconnected(_)) => {}
+        }
+    }
+}
+
+/// A running job.
+pub struct JobHandle {
+    /// Progress reports (bounded; drain it each frame).
+    pub progress: Receiver<Progress>,
+    cancel: Arc<AtomicBool>,
+    thread: Option<JoinHandle<Result<Summary, ExportError>>>,
+    dest: PathBuf,
+}
+
+impl JobHandle {
+    /// Ask the job to stop; `join` then returns `Cancelled`.
+    pub fn cancel(&self) {
+        self.cancel.store(true, Ordering::Relaxed);
+    }
+
+    /// True once the worker has finished (successfully or not).
+    pub fn is_finished(&self) -> bool {
+        self.thread.as_ref().is_none_or(|t| t.is_finished())
+    }
+
+    /// Where the output goes.
+    pub fn destination(&self) -> &Path {
+        &self.dest
+    }
+
+    /// Wait for the result.
+    pub fn join(mut self) -> Result<Summary, ExportError> {
+        match self.thread.take().map(|t| t.join()) {
+            Some(Ok(r)) => r,
+            Some(Err(panic)) => Err(ExportError::Panicked(panic_message(&panic))),
+            None => Err(ExportError::Other("job already joined".into())),
+        }
+    }
+}
+
+impl Drop for JobHandle {
+    /// Dropping a running job cancels it (its staging folder is removed by
+    /// the worker).
+    fn drop(&mut self) {
+        if self.thread.is_some() {
+            self.cancel();
+        }
+    }
+}
+
+fn panic_message(p: &Box<dyn std::any::Any + Send>) -> String {
+    p.downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| p.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "panic".into())
+}
+
+/// The manifest written into every output folder.
+#[derive(Serialize)]
+struct Manifest<'a> {
+    tool: &'static str,
+    version: &'static str,
+    design_hash: &'a str,
+    #[serde(flatten)]
+    summary: &'a Summary,
+}
+
+/// A stable 64-bit FNV-1a hash of the design text (and anything else that
+/// defines the output), as 16 hex digits.
+pub fn design_hash(parts: &[&[u8]]) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for part in parts {
+        for b in *part {
+            h ^= u64::from(*b);
+            h = h.wrapping_mul(0x0100_0000_01b3);
+        }
+        h ^= 0xff;
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    format!("{h:016x}")
+}
+
+/// Start `work` on a new thread, writing into a staging folder beside `dest`.
+pub fn spawn<F>(dest: PathBuf, design_hash: String, work: F) -> JobHandle
+where
+    F: FnOnce(&JobContext) -> Result<Summary, ExportError> + Send + 'static,
+{
+    let (tx, rx) = sync_channel(64);
+    let cancel = Arc::new(AtomicBool::new(false));
+    let c2 = cancel.clone();
+    let d2 = dest.clone();
+    let thread = std::thread::Builder::new()
+        .name("volcad-export".into())
+        .spawn(move || run_job(d2, design_hash, c2, tx, work))
+        .expect("spawning a thread");
+    JobHandle { progress: rx, cancel, thread: Some(thread), dest }
+}
+
+/// Run `work` on this thread (the CLI uses this through `spawn` too; tests
+/// may call it directly).
+pub fn run_job<F>(dest: PathBuf, design_hash: String, cancel: Arc<AtomicBool>, tx: SyncSender<Progress>, work: F) -> Result<Summary, ExportError>
+where
+    F: FnOnce(&JobContext) -> Result<Summary, ExportError>,
+{
+    if dest.exists() && !(dest.is_dir() && dest.join("manifest.json").exists()) {
+        // Never replace something that is not one of our exports.
+        if !(dest.is_dir() && std::fs::read_dir(&dest).map(|mut d| d.next().is_none()).unwrap_or(false)) {
+            return Err(ExportError::DestinationExists(dest));
+        }
+    }
+    let parent = dest.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    std::fs::create_dir_all(parent).map_err(|e| ExportError::io(parent, e))?;
+    let name = dest.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_else(|| "export".into());
+    let staging = parent.join(format!(".{name}.partial-{}", std::process::id()));
+    if staging.exists() {
+        let _ = std::fs::remove_dir_all(&staging);
+    }
+    std::fs::create_dir_all(&staging).map_err(|e| ExportError::io(&staging, e))?;
+    let ctx = JobContext { staging: staging.clone(), cancel, tx, start: Instant::now(), design_hash };
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| work(&ctx)));
+    let result = match result {
+        Ok(r) => r,
+        Err(p) => Err(ExportError::Panicked(panic_message(&p))),
+    };
+    let finish = |mut summary: Summary| -> Result<Summary, ExportError> {
+        ctx.check_cancel()?;
+        summary.seconds = ctx.start.elapsed().as_secs_f64();
+        let manifest = Manifest { tool: "volcad", version: env!("CARGO_PKG_VERSION"), design_hash: &ctx.design_hash, summary: &summary };
+        let path = staging.join("manifest.json");
+        let text = serde_json::to_string_pretty(&manifest).map_err(|e| ExportError::Other(e.to_string()))?;
+        std::fs::write(&path, text).map_err(|e| ExportError::io(&path, e))?;
+        if dest.exists() {
+            std::fs::remove_dir_all(&dest).map_err(|e| ExportError::io(&dest, e))?;
+        }
+        std::fs::rename(&staging, &dest).map_err(|e| ExportError::io(&dest, e))?;
+        Ok(summary)
+    };
+    let out = result.and_then(finish);
+    if out.is_err() {
+        let _ = std::fs::remove_dir_all(&staging);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tmp(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("volcad-job-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        d
+    }
+
+    #[test]
+    fn success_renames_and_writes_manifest() {
+        let dest = tmp("ok").join("out");
+        let h = spawn(dest.clone(), "abc".into(), |ctx| {
+            std::fs::write(ctx.staging().join("a.txt"), "x").unwrap();
+            ctx.progress("writing", 1, 1, "files", 1.0);
+            Ok(Summary { kind: "test".into(), files: vec!["a.txt".into()], ..Summary::default() })
+        });
+        let s = h.join().unwrap();
+        assert_eq!(s.files, vec!["a.txt"]);
+        assert!(dest.join("a.txt").exists());
+        let m = std::fs::read_to_string(dest.join("manifest.json")).unwrap();
+        assert!(m.contains("\"design_hash\": \"abc\""), "{m}");
+        let parent = dest.parent().unwrap();
+        assert_eq!(std::fs::read_dir(parent).unwrap().count(), 1, "no staging folder left");
+    }
+
+    #[test]
+    fn cancel_leaves_nothing() {
+        let dest = tmp("cancel").join("out");
+        let h = spawn(dest.clone(), "abc".into(), |ctx| {
+            std::fs::write(ctx.staging().join("a.txt"), "x").unwrap();
+            loop {
+                ctx.check_cancel()?;
+                std::thread::sleep(Duration::from_millis(1));
+            }
+        });
+        h.cancel();
+        assert!(matches!(h.join(), Err(ExportError::Cancelled)));
+        assert!(!dest.exists());
+        assert_eq!(std::fs::read_dir(dest.parent().unwrap()).unwrap().count(), 0);
+    }
+
+    #[test]
+    fn panic_is_an_error_and_leaves_nothing() {
+        let dest = tmp("panic").join("out");
+        let h = spawn(dest.clone(), "abc".into(), |_| panic!("boom"));
+        let e = h.join().unwrap_err().to_string();
+        assert!(e.contains("boom"), "{e}");
+        assert!(!dest.exists());
+    }
+
+    #[test]
+    fn refuses_to_replace_foreign_folders() {
+        let dest = tmp("foreign").join("out");
+        std::fs::create_dir_all(&dest).unwrap();
+        std::fs::write(dest.join("precious.txt"), "x").unwrap();
+        let h = spawn(dest.clone(), "abc".into(), |_| Ok(Summary::default()));
+        assert!(matches!(h.join(), Err(ExportError::DestinationExists(_))));
+        assert!(dest.join("precious.txt").exists());
+    }
+}
