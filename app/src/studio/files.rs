@@ -1,0 +1,393 @@
+//! Files: the open document, file dialogs on worker threads, and the
+//! recovery file that autosaves unsaved text.
+//!
+//! Dialogs: `rfd`'s blocking dialogs run on a short-lived thread each and
+//! answer through a channel that the UI drains every frame (under Xvfb with
+//! no portal they answer "cancelled"). Tests never open dialogs: they type
+//! paths into fields or call the app's methods.
+//!
+//! Recovery: every few seconds while the text differs from the saved file,
+//! `recovery.rhai` (the text) and `recovery.json` (which file it belongs to)
+//! are written in the data folder, on a worker thread, atomically
+//! (write + rename). Saving or discarding removes them; on start-up the
+//! studio offers to restore them.
+
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::{Receiver, Sender, channel};
+use std::time::{Duration, Instant, SystemTime};
+
+use serde::{Deserialize, Serialize};
+
+/// The document in the editor.
+#[derive(Clone, Debug, Default)]
+pub struct Document {
+    /// Where it is saved (`None`: untitled).
+    pub path: Option<PathBuf>,
+    /// The text as last saved or opened (dirty = editor text differs).
+    pub saved_text: String,
+    /// Folder relative file names resolve in (the file's folder, or the
+    /// examples folder for an example).
+    pub base_dir: Option<PathBuf>,
+    /// What the title bar and errors call it when untitled.
+    pub untitled_name: String,
+}
+
+impl Document {
+    /// An untitled document.
+    pub fn untitled(name: &str, text: &str, base_dir: Option<PathBuf>) -> Self {
+        Self {
+            path: None,
+            saved_text: text.to_owned(),
+            base_dir,
+            untitled_name: name.to_owned(),
+        }
+    }
+
+    /// A document read from `path`.
+    pub fn from_file(path: &Path, text: &str) -> Self {
+        Self {
+            path: Some(path.to_owned()),
+            saved_text: text.to_owned(),
+            base_dir: volcad_core::script::ScriptOptions::for_file(path).base_dir,
+            untitled_name: String::new(),
+        }
+    }
+
+    /// The name errors and the title use.
+    pub fn name(&self) -> String {
+        match &self.path {
+            Some(p) => p.file_name().map_or_else(
+                || p.display().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            ),
+            None => self.untitled_name.clone(),
+        }
+    }
+
+    /// True when `text` differs from what is saved.
+    pub fn is_dirty(&self, text: &str) -> bool {
+        text != self.saved_text
+    }
+
+    /// Write `text` to `path` and make it this document's file.
+    pub fn save_as(&mut self, path: &Path, text: &str) -> Result<(), String> {
+        write_atomically(path, text.as_bytes())
+            .map_err(|e| format!("could not save {}: {e}", path.display()))?;
+        *self = Document::from_file(path, text);
+        Ok(())
+    }
+}
+
+/// Write via a temporary file and a rename, so a crash never leaves half a file.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
+    std::fs::write(&tmp, bytes)?;
+    std::fs::rename(&tmp, path).inspect_err(|_| {
+        let _ = std::fs::remove_file(&tmp);
+    })
+}
+
+/// Read a script file.
+pub fn read_script(path: &Path) -> Result<String, String> {
+    std::fs::read_to_string(path).map_err(|e| format!("could not open {}: {e}", path.display()))
+}
+
+/// What a dialog was opened for.
+#[derive(Clone, Debug, PartialEq)]
+pub enum DialogPurpose {
+    /// File → Open.
+    Open,
+    /// File → Save As (then maybe continue with a pending action).
+    SaveAs,
+    /// An export panel's output folder (panel index).
+    ExportFolder(usize),
+}
+
+/// A dialog's answer.
+#[derive(Debug)]
+pub struct DialogAnswer {
+    /// What it was for.
+    pub purpose: DialogPurpose,
+    /// The chosen path (`None`: cancelled or no dialog available).
+    pub path: Option<PathBuf>,
+}
+
+/// Native file dialogs on worker threads.
+pub struct Dialogs {
+    tx: Sender<DialogAnswer>,
+    rx: Receiver<DialogAnswer>,
+    open: usize,
+}
+
+impl Default for Dialogs {
+    fn default() -> Self {
+        let (tx, rx) = channel();
+        Self { tx, rx, open: 0 }
+    }
+}
+
+impl Dialogs {
+    /// True while a dialog is showing.
+    pub fn is_open(&self) -> bool {
+        self.open > 0
+    }
+
+    /// Show a dialog for `purpose` (starting in `dir`) on a worker thread.
+    pub fn show(
+        &mut self,
+        ctx: &egui::Context,
+        purpose: DialogPurpose,
+        dir: Option<PathBuf>,
+        file_name: Option<String>,
+    ) {
+        let tx = self.tx.clone();
+        let ctx = ctx.clone();
+        self.open += 1;
+        let p = purpose.clone();
+        let spawned = std::thread::Builder::new()
+            .name("volcad-dialog".into())
+            .spawn(move || {
+                let mut d = rfd::FileDialog::new();
+                if let Some(dir) = dir {
+                    d = d.set_directory(dir);
+                }
+                let path = match &p {
+                    DialogPurpose::Open => {
+                        d.add_filter("Rhai design script", &["rhai"]).pick_file()
+                    }
+                    DialogPurpose::SaveAs => {
+                        let d = d.add_filter("Rhai design script", &["rhai"]);
+                        let d = match file_name {
+                            Some(n) => d.set_file_name(n),
+                            None => d,
+                        };
+                        d.save_file().map(|p| {
+                            if p.extension().is_none() {
+                                p.with_extension("rhai")
+                            } else {
+                                p
+                            }
+                        })
+                    }
+                    DialogPurpose::ExportFolder(_) => d.pick_folder(),
+                };
+                let _ = tx.send(DialogAnswer { purpose: p, path });
+                ctx.request_repaint();
+            });
+        if spawned.is_err() {
+            self.open -= 1;
+            let _ = self.tx.send(DialogAnswer {
+                purpose,
+                path: None,
+            });
+        }
+    }
+
+    /// The next answer, if any (call each frame).
+    pub fn poll(&mut self) -> Option<DialogAnswer> {
+        let a = self.rx.try_recv().ok()?;
+        self.open = self.open.saturating_sub(1);
+        Some(a)
+    }
+}
+
+/// What `recovery.json` records.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RecoveryMeta {
+    /// The file the text belongs to (`None`: untitled).
+    pub path: Option<PathBuf>,
+    /// Seconds since the Unix epoch when it was written.
+    pub saved_at: u64,
+}
+
+/// Text found in the recovery file at start-up.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Recovered {
+    /// The unsaved text.
+    pub text: String,
+    /// Which file it belongs to, and when it was written.
+    pub meta: RecoveryMeta,
+}
+
+/// The autosave of unsaved text.
+pub struct Recovery {
+    dir: Option<PathBuf>,
+    interval: Duration,
+    last_write: Option<Instant>,
+    last_text: Option<String>,
+}
+
+impl Recovery {
+    /// Autosave into `dir` every `interval` (`None`: disabled).
+    pub fn new(dir: Option<PathBuf>, interval: Duration) -> Self {
+        Self {
+            dir,
+            interval,
+            last_write: None,
+            last_text: None,
+        }
+    }
+
+    /// The recovery file's path.
+    pub fn text_path(&self) -> Option<PathBuf> {
+        self.dir.as_ref().map(|d| d.join("recovery.rhai"))
+    }
+
+    fn meta_path(&self) -> Option<PathBuf> {
+        self.dir.as_ref().map(|d| d.join("recovery.json"))
+    }
+
+    /// What an earlier session left behind.
+    pub fn load(&self) -> Option<Recovered> {
+        let text = std::fs::read_to_string(self.text_path()?).ok()?;
+        let meta = self
+            .meta_path()
+            .and_then(|p| std::fs::read_to_string(p).ok())
+            .and_then(|s| serde_json::from_str(&s).ok())
+            .unwrap_or_default();
+        Some(Recovered { text, meta })
+    }
+
+    /// Called each frame: write the text when dirty, changed, and the
+    /// interval has passed. Returns true when a write was started.
+    pub fn tick(
+        &mut self,
+        ctx: &egui::Context,
+        text: &str,
+        dirty: bool,
+        path: Option<&Path>,
+    ) -> bool {
+        let (Some(tp), Some(mp)) = (self.text_path(), self.meta_path()) else {
+            return false;
+        };
+        if !dirty || self.last_text.as_deref() == Some(text) {
+            return false;
+        }
+        if let Some(t) = self.last_write {
+            let left = self.interval.saturating_sub(t.elapsed());
+            if !left.is_zero() {
+                ctx.request_repaint_after(left);
+                return false;
+            }
+        }
+        self.last_write = Some(Instant::now());
+        self.last_text = Some(text.to_owned());
+        let saved_at = SystemTime::now()
+            .duration_since(SystemTime::UNIX_EPOCH)
+            .map_or(0, |d| d.as_secs());
+        let meta = RecoveryMeta {
+            path: path.map(Path::to_owned),
+            saved_at,
+        };
+        let text = text.to_owned();
+        let dir = self.dir.clone();
+        let _ = std::thread::Builder::new()
+            .name("volcad-autosave".into())
+            .spawn(move || {
+                let result = dir
+                    .as_deref()
+                    .map_or(Ok(()), std::fs::create_dir_all)
+                    .and_then(|_| write_atomically(&tp, text.as_bytes()))
+                    .and_then(|_| {
+                        write_atomically(
+                            &mp,
+                            serde_json::to_string(&meta).unwrap_or_default().as_bytes(),
+                        )
+                    });
+                if let Err(e) = result {
+                    eprintln!("volcad-studio: autosave to {} failed: {e}", tp.display());
+                }
+            });
+        true
+    }
+
+    /// Remove the recovery files (after save, or when the user discards).
+    pub fn clear(&mut self) {
+        self.last_text = None;
+        for p in [self.text_path(), self.meta_path()].into_iter().flatten() {
+            let _ = std::fs::remove_file(p);
+        }
+    }
+}
+
+/// The default data folder: `$XDG_DATA_HOME/volcad` (or `~/.local/share/volcad`).
+pub fn default_data_dir() -> Option<PathBuf> {
+    std::env::var_os("XDG_DATA_HOME")
+        .filter(|v| !v.is_empty())
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".local/share")))
+        .map(|d| d.join("volcad"))
+}
+
+/// Open a folder in the desktop's file manager (`xdg-open`), without waiting.
+pub fn open_folder(path: &Path) -> Result<(), String> {
+    let program = if cfg!(target_os = "macos") {
+        "open"
+    } else if cfg!(windows) {
+        "explorer"
+    } else {
+        "xdg-open"
+    };
+    let mut child = std::process::Command::new(program)
+        .arg(path)
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .map_err(|e| format!("could not run {program}: {e}"))?;
+    // Reap it off the UI thread so it leaves no zombie.
+    std::thread::spawn(move || child.wait());
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn recovery_round_trip() {
+        let dir = std::env::temp_dir().join(format!("volcad-recovery-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let ctx = egui::Context::default();
+        let mut r = Recovery::new(Some(dir.clone()), Duration::ZERO);
+        assert!(r.load().is_none());
+        assert!(!r.tick(&ctx, "x", false, None), "clean text is not saved");
+        assert!(r.tick(&ctx, "unsaved", true, Some(Path::new("/a/b.rhai"))));
+        assert!(
+            !r.tick(&ctx, "unsaved", true, None),
+            "same text is not saved twice"
+        );
+        let t = Instant::now();
+        let got = loop {
+            if let Some(g) = r.load().filter(|g| g.meta.path.is_some()) {
+                break g;
+            }
+            assert!(t.elapsed() < Duration::from_secs(5));
+            std::thread::sleep(Duration::from_millis(10));
+        };
+        assert_eq!(got.text, "unsaved");
+        assert_eq!(got.meta.path.as_deref(), Some(Path::new("/a/b.rhai")));
+        r.clear();
+        assert!(r.load().is_none());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn save_as_makes_a_clean_document() {
+        let dir = std::env::temp_dir().join(format!("volcad-doc-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut d = Document::untitled("untitled.rhai", "", None);
+        assert!(d.is_dirty("abc"));
+        let p = dir.join("part.rhai");
+        d.save_as(&p, "abc").unwrap();
+        assert!(!d.is_dirty("abc"));
+        assert_eq!(d.name(), "part.rhai");
+        assert_eq!(read_script(&p).unwrap(), "abc");
+        assert_eq!(d.base_dir.as_deref(), Some(dir.as_path()));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

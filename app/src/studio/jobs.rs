@@ -1,0 +1,270 @@
+//! Running exports: each is a `volcad_compilers::job` (its own thread,
+//! progress channel, cancel, staging folder renamed on success). The list is
+//! drained every frame with `try_recv`; a finished job is joined only once
+//! `is_finished()` says it will not wait.
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use volcad_compilers::job::{JobHandle, Progress, Summary};
+
+use super::files;
+
+/// Where a job is.
+#[derive(Debug)]
+pub enum JobState {
+    /// Working; the last progress report.
+    Running(Option<Progress>),
+    /// Done: what it wrote.
+    Done(Summary),
+    /// Cancelled by the user: nothing was written.
+    Cancelled,
+    /// Failed: why.
+    Failed(String),
+}
+
+/// One export job in the list.
+pub struct Job {
+    /// "PNG stack", "Meshes", "FEA".
+    pub title: String,
+    /// The output folder.
+    pub dest: PathBuf,
+    /// Its state.
+    pub state: JobState,
+    handle: Option<JobHandle>,
+}
+
+impl Job {
+    /// True while the worker runs.
+    pub fn is_running(&self) -> bool {
+        matches!(self.state, JobState::Running(_))
+    }
+}
+
+/// All jobs of this session.
+#[derive(Default)]
+pub struct Jobs {
+    list: Vec<Job>,
+}
+
+impl Jobs {
+    /// Track a started job.
+    pub fn push(&mut self, title: &str, handle: JobHandle) {
+        let dest = handle.destination().to_owned();
+        self.list.push(Job {
+            title: title.to_owned(),
+            dest,
+            state: JobState::Running(None),
+            handle: Some(handle),
+        });
+    }
+
+    /// The jobs, oldest first.
+    pub fn list(&self) -> &[Job] {
+        &self.list
+    }
+
+    /// True when any job still runs (closing the window asks first).
+    pub fn any_running(&self) -> bool {
+        self.list.iter().any(Job::is_running)
+    }
+
+    /// Cancel every running job.
+    pub fn cancel_all(&self) {
+        for j in &self.list {
+            if let Some(h) = &j.handle {
+                h.cancel();
+            }
+        }
+    }
+
+    /// Drain progress and collect finished jobs (call every frame). Returns
+    /// log lines for jobs that finished.
+    pub fn poll(&mut self, ctx: &egui::Context) -> Vec<String> {
+        let mut finished = Vec::new();
+        for j in &mut self.list {
+            let Some(h) = &j.handle else { continue };
+            let mut last = None;
+            while let Ok(p) = h.progress.try_recv() {
+                last = Some(p);
+            }
+            if let (Some(p), JobState::Running(cur)) = (last, &mut j.state) {
+                *cur = Some(p);
+            }
+            if h.is_finished()
+                && let Some(h) = j.handle.take()
+            {
+                j.state = match h.join() {
+                    Ok(s) => JobState::Done(s),
+                    Err(volcad_compilers::ExportError::Cancelled) => JobState::Cancelled,
+                    Err(e) => JobState::Failed(e.to_string()),
+                };
+                finished.push(match &j.state {
+                    JobState::Done(s) => format!(
+                        "{} done: {} files in {:.1} s, {}",
+                        j.title,
+                        s.files.len(),
+                        s.seconds,
+                        j.dest.display()
+                    ),
+                    JobState::Cancelled => format!(
+                        "{} cancelled; nothing written to {}",
+                        j.title,
+                        j.dest.display()
+                    ),
+                    JobState::Failed(e) => format!("{} failed: {e}", j.title),
+                    JobState::Running(_) => String::new(),
+                });
+            }
+        }
+        if self.any_running() {
+            // Job progress has no wake-up of its own: look again shortly.
+            ctx.request_repaint_after(Duration::from_millis(100));
+        }
+        finished
+    }
+
+    /// Show the list: progress bars with time left and Cancel, summaries with
+    /// "Open folder". Returns log lines (from "Open folder" failures).
+    pub fn ui(&mut self, ui: &mut egui::Ui) -> Vec<String> {
+        let mut notes = Vec::new();
+        let mut remove = None;
+        for (i, j) in self.list.iter().enumerate().rev() {
+            ui.push_id(("job", i), |ui| {
+                ui.group(|ui| {
+                    ui.horizontal(|ui| {
+                        ui.label(egui::RichText::new(&j.title).strong());
+                        ui.weak(j.dest.display().to_string());
+                    });
+                    match &j.state {
+                        JobState::Running(p) => {
+                            let (fraction, text) = progress_text(p.as_ref());
+                            ui.add(egui::ProgressBar::new(fraction as f32).text(text));
+                            if ui.button("Cancel").clicked()
+                                && let Some(h) = &j.handle
+                            {
+                                h.cancel();
+                            }
+                        }
+                        JobState::Done(s) => {
+                            ui.label(summary_text(s));
+                            for n in &s.notes {
+                                ui.weak(n);
+                            }
+                            ui.horizontal(|ui| {
+                                if ui.button("Open folder").clicked()
+                                    && let Err(e) = files::open_folder(&j.dest)
+                                {
+                                    notes.push(e);
+                                }
+                                if ui.small_button("Dismiss").clicked() {
+                                    remove = Some(i);
+                                }
+                            });
+                        }
+                        JobState::Cancelled => {
+                            ui.weak("Cancelled; nothing was written.");
+                            if ui.small_button("Dismiss").clicked() {
+                                remove = Some(i);
+                            }
+                        }
+                        JobState::Failed(e) => {
+                            ui.colored_label(ui.visuals().error_fg_color, e);
+                            if ui.small_button("Dismiss").clicked() {
+                                remove = Some(i);
+                            }
+                        }
+                    }
+                });
+            });
+        }
+        if let Some(i) = remove {
+            self.list.remove(i);
+        }
+        notes
+    }
+}
+
+/// Progress bar fraction and text: "sampling 42% · 1,234 of 5,000 layers · 12 s left".
+pub fn progress_text(p: Option<&Progress>) -> (f64, String) {
+    let Some(p) = p else {
+        return (0.0, "starting…".into());
+    };
+    let mut s = format!("{} {:.0}%", p.stage, p.fraction * 100.0);
+    if p.total > 0 {
+        s += &format!(" · {} of {} {}", p.done, p.total, p.unit);
+    }
+    if let Some(eta) = p.eta {
+        s += &format!(" · {} left", duration_text(eta));
+    }
+    (p.fraction, s)
+}
+
+/// "1 h 02 min", "3 min 05 s", "12 s".
+pub fn duration_text(d: Duration) -> String {
+    let s = d.as_secs();
+    if s >= 3600 {
+        format!("{} h {:02} min", s / 3600, (s / 60) % 60)
+    } else if s >= 60 {
+        format!("{} min {:02} s", s / 60, s % 60)
+    } else {
+        format!("{s} s")
+    }
+}
+
+fn summary_text(s: &Summary) -> String {
+    let mut t = format!(
+        "Done in {}: {} files",
+        duration_text(Duration::from_secs_f64(s.seconds)),
+        s.files.len()
+    );
+    if s.units > 0 {
+        t += &format!(", {} {}", s.units, s.unit);
+    }
+    if !s.counts.is_empty() {
+        let counts: Vec<String> = s.counts.iter().map(|(n, c)| format!("{n} {c}")).collect();
+        t += &format!("\n{}", counts.join(", "));
+    }
+    t
+}
+
+/// A destination that does not exist yet: `base/name`, or `base/name-2`, ...
+pub fn fresh_destination(base: &Path, name: &str) -> PathBuf {
+    let first = base.join(name);
+    if !first.exists() {
+        return first;
+    }
+    (2..)
+        .map(|i| base.join(format!("{name}-{i}")))
+        .find(|p| !p.exists())
+        .unwrap_or(first)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn durations_read_well() {
+        assert_eq!(duration_text(Duration::from_secs(12)), "12 s");
+        assert_eq!(duration_text(Duration::from_secs(185)), "3 min 05 s");
+        assert_eq!(duration_text(Duration::from_secs(3720)), "1 h 02 min");
+    }
+
+    #[test]
+    fn progress_text_has_stage_units_and_eta() {
+        let p = Progress {
+            stage: "sampling".into(),
+            fraction: 0.5,
+            done: 5,
+            total: 10,
+            unit: "layers",
+            elapsed: Duration::from_secs(3),
+            eta: Some(Duration::from_secs(3)),
+        };
+        assert_eq!(
+            progress_text(Some(&p)).1,
+            "sampling 50% · 5 of 10 layers · 3 s left"
+        );
+    }
+}

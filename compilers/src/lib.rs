@@ -1,0 +1,24 @@
+//! # volcad-compilers
+//!
+//! Export jobs: a prepared [`volcad_core::Model`] plus parameters in, files
+//! out. Every job runs through [`job`] (background thread, progress channel,
+//! cancel, staging folder renamed on success, `manifest.json`) and samples the
+//! model through the core's one grid sampler (`volcad_core::sampler`).
+//!
+//! * [`png_stack`]: inkjet slice stacks, one PNG per layer.
+//! * [`mesh`]: segmented meshes (STL, OBJ, one 3MF with per-part settings).
+//! * [`fea`]: Abaqus/CalculiX `.inp` meshes (C3D8R bricks, adaptive C3D4 tets).
+#![warn(missing_docs)]
+
+pub mod fea;
+pub mod job;
+
+pub mod dither;
+pub mod mesh;
+pub mod png_io;
+pub mod png_stack;
+mod presets;
+mod probe;
+pub mod resources;
+
+pub use job::{ExportError, JobHandle, Progress, Summary};

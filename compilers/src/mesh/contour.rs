@@ -1,0 +1,443 @@
+//! Multi-label contouring: closed, outward-oriented meshes for every label
+//! of a labelled voxel grid, sharing their interfaces exactly.
+//!
+//! # Method
+//!
+//! Samples sit at voxel centres; each carries a label (0 = void, 1..=L the
+//! segments), a signed distance and interface values. Each cube between 8
+//! neighbouring samples is split into six tetrahedra around its main
+//! diagonal (the Kuhn / Freudenthal split: tet `π` has corners `0`,
+//! `e_π1`, `e_π1 + e_π2`, `(1,1,1)`); the split of every cube face is the
+//! same from both sides, so there are no ambiguous faces and no cracks
+//! (this is marching *tetrahedra* inside each marching cube).
+//!
+//! Within one tet, a point is placed on every edge whose ends differ in
+//! label: at `p = a + t (b − a)` with
+//! * void | inside: `t = d_a / (d_a − d_b)` (the true surface, from the
+//!   distances);
+//! * segment `s` | `r` by ranges of a value `f` cut into `n` ranges:
+//!   where `f` meets `c = (s + r + 1) / (2n)` (the shared range boundary when
+//!   `|s − r| = 1`), `t = (c − f_a) / (f_b − f_a)`;
+//! * dominant material `A` | `B`: where `f_A − f_B` changes sign;
+//!
+//! always computed from the edge's lower end, clamped to `[10⁻³, 1 − 10⁻³]`.
+//! With two labels in the tet, the interface is the usual marching-tetrahedra
+//! triangle or quad. With three or four, a point is added at the centroid of
+//! the edge points of each three-label face and of the tet, and the
+//! interface is the cone from the tet point over the curves on the faces
+//! (straight between edge points on two-label faces, through the face point
+//! on three-label faces). Each label's part of a tet is then a topological
+//! ball and the parts tile the tet, so every label's mesh is a closed
+//! 2-manifold and two labels share their interface triangles exactly (same
+//! vertices, opposite orientation). Orientation is combinatorial (from the
+//! tet's vertex order), never from a geometric test.
+//!
+//! Vertices are shared through keys on the grid elements they lie on
+//! (edge, face or tet, by lowest corner index and direction), so each
+//! label's mesh has every vertex once. Only the keys of two sample planes are
+//! kept: memory is proportional to a plane plus the output.
+
+use std::collections::HashMap;
+
+use glam::DVec3;
+use rayon::prelude::*;
+use volcad_core::sampler::Grid;
+
+use super::indexed::IndexedMesh;
+
+/// How an edge between two inside samples of different labels is cut.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Interface {
+    /// At the middle (labels only; no values).
+    Midpoint,
+    /// One value per sample in `[0, 1]`, labels `s + 1` for range
+    /// `[s/n, (s+1)/n)`: cut where the value meets the range boundary.
+    Ranges {
+        /// Number of ranges.
+        n: usize,
+    },
+    /// `k` fractions per sample, label `s + 1` = slot `s` dominant: cut
+    /// where the two dominant fractions are equal.
+    Dominant {
+        /// Fractions per sample.
+        k: usize,
+    },
+}
+
+impl Interface {
+    /// Values stored per sample.
+    pub fn stride(&self) -> usize {
+        match *self {
+            Interface::Midpoint => 0,
+            Interface::Ranges { .. } => 1,
+            Interface::Dominant { k } => k,
+        }
+    }
+}
+
+/// One z plane of samples (`nx·ny` each, x fastest).
+#[derive(Clone, Debug, Default)]
+pub struct Plane {
+    /// 0 = void, 1.. = label.
+    pub label: Vec<u16>,
+    /// Signed distance (mm).
+    pub dist: Vec<f32>,
+    /// Interface values, [`Interface::stride`] per sample.
+    pub value: Vec<f32>,
+}
+
+/// Edge-point parameter clamp: keeps every triangle off the sample points.
+const T_MIN: f64 = 1e-3;
+/// Axis orders of the six Kuhn tets.
+const PERMS: [[u8; 3]; 6] = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
+/// Faces of a positively oriented tet (v0..v3), counter-clockwise seen from
+/// outside.
+const FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
+/// Key type offsets: edges 1..=7 (direction mask), faces 8..=71, tets 72..=77.
+const FACE_KEY: u64 = 8;
+const TET_KEY: u64 = 72;
+const KEY_TYPES: u64 = 128;
+
+/// A point of the contour inside one cube, by the cube corners (bit masks
+/// x = 1, y = 2, z = 4) it is built from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Pt {
+    /// On the edge between two corners (lower mask first).
+    Edge(u8, u8),
+    /// Centroid of a three-label face (corners by inclusion).
+    Face(u8, u8, u8),
+    /// Centroid of the tet's edge points.
+    Tet,
+}
+
+/// A vertex: its key (shared across cubes) and position.
+#[derive(Clone, Copy, Debug)]
+struct VRef {
+    key: u64,
+    pos: [f32; 3],
+}
+
+/// A triangle for one label, before vertex sharing.
+#[derive(Clone, Copy, Debug)]
+struct Tri {
+    label: u16,
+    v: [VRef; 3],
+}
+
+/// Order corner masks by inclusion (Kuhn corners are nested sets).
+fn by_inclusion(a: u8, b: u8) -> (u8, u8) {
+    if a.count_ones() < b.count_ones() { (a, b) } else { (b, a) }
+}
+
+fn edge(a: u8, b: u8) -> Pt {
+    let (a, b) = by_inclusion(a, b);
+    Pt::Edge(a, b)
+}
+
+/// The 8 samples of one cube.
+struct Cube<'a> {
+    base: [usize; 3],
+    label: [u16; 8],
+    dist: [f32; 8],
+    value: [&'a [f32]; 8],
+}
+
+/// Builds label meshes plane by plane.
+pub struct Contourer {
+    grid: Grid,
+    iface: Interface,
+    meshes: Vec<IndexedMesh>,
+    /// Per label: key → vertex index, for keys based in the lower and the
+    /// upper plane of the current cube layer.
+    maps: Vec<[HashMap<u64, u32>; 2]>,
+    prev: Option<(usize, Plane)>,
+}
+
+impl Contourer {
+    /// A contourer for `labels` labels (1..=labels) on `grid`.
+    pub fn new(grid: Grid, labels: usize, iface: Interface) -> Self {
+        Self {
+            grid,
+            iface,
+            meshes: vec![IndexedMesh::default(); labels],
+            maps: (0..labels).map(|_| [HashMap::new(), HashMap::new()]).collect(),
+            prev: None,
+        }
+    }
+
+    /// Add plane `z` (planes come in order from 0); contours the cube layer
+    /// between it and the previous plane.
+    ///
+    /// # Panics
+    /// If a plane is skipped or has the wrong size.
+    pub fn push_plane(&mut self, z: usize, plane: Plane) {
+        let layer = self.grid.dims[0] * self.grid.dims[1];
+        assert!(plane.label.len() == layer && plane.dist.len() == layer, "plane size");
+        assert_eq!(plane.value.len(), layer * self.iface.stride(), "plane values");
+        let Some((pz, lo)) = self.prev.take() else {
+            assert_eq!(z, 0, "planes must start at 0");
+            self.prev = Some((z, plane));
+            return;
+        };
+        assert_eq!(pz + 1, z, "planes must come in order");
+        let ny = self.grid.dims[1];
+        let rows: Vec<Vec<Tri>> = (0..ny.saturating_sub(1)).into_par_iter().map(|j| self.row(pz, j, &lo, &plane)).collect();
+        let plane_len = layer as u64;
+        for tri in rows.iter().flatten() {
+            let l = tri.label as usize - 1;
+            let (mesh, maps) = (&mut self.meshes[l], &mut self.maps[l]);
+            let idx = tri.v.map(|v| {
+                let slot = ((v.key / KEY_TYPES) / plane_len - pz as u64) as usize;
+                *maps[slot].entry(v.key).or_insert_with(|| {
+                    mesh.vertices.push(v.pos);
+                    (mesh.vertices.len() - 1) as u32
+                })
+            });
+            mesh.triangles.push(idx);
+        }
+        for m in &mut self.maps {
+            m.swap(0, 1);
+            m[1].clear();
+        }
+        self.prev = Some((z, plane));
+    }
+
+    /// The meshes, label 1 first.
+    pub fn finish(self) -> Vec<IndexedMesh> {
+        self.meshes
+    }
+
+    /// Triangles of the cubes in row `j` between planes `z` and `z + 1`.
+    fn row(&self, z: usize, j: usize, lo: &Plane, hi: &Plane) -> Vec<Tri> {
+        let nx = self.grid.dims[0];
+        let s = self.iface.stride();
+        let mut out = Vec::new();
+        for i in 0..nx.saturating_sub(1) {
+            let mut label = [0u16; 8];
+            let mut idx = [0usize; 8];
+            for (c, (l, ix)) in label.iter_mut().zip(&mut idx).enumerate() {
+                *ix = (j + (c >> 1 & 1)) * nx + i + (c & 1);
+                *l = if c & 4 == 0 { lo.label[*ix] } else { hi.label[*ix] };
+            }
+            if label.iter().all(|l| *l == label[0]) {
+                continue;
+            }
+            let plane = |c: usize| if c & 4 == 0 { lo } else { hi };
+            let cube = Cube {
+                base: [i, j, z],
+                label,
+                dist: std::array::from_fn(|c| plane(c).dist[idx[c]]),
+                value: std::array::from_fn(|c| &plane(c).value[idx[c] * s..(idx[c] + 1) * s]),
+            };
+            for perm in 0..6 {
+                self.tet(&cube, perm, &mut out);
+            }
+        }
+        out
+    }
+
+    /// Grid index (i, j, k) of corner `m` of the cube.
+    fn corner(cube: &Cube, m: u8) -> [usize; 3] {
+        let [i, j, k] = cube.base;
+        [i + (m & 1) as usize, j + (m >> 1 & 1) as usize, k + (m >> 2 & 1) as usize]
+    }
+
+    fn global(&self, c: [usize; 3]) -> u64 {
+        let [nx, ny, _] = self.grid.dims;
+        ((c[2] * ny + c[1]) * nx + c[0]) as u64
+    }
+
+    fn center(&self, c: [usize; 3]) -> DVec3 {
+        self.grid.center(c[0], c[1], c[2])
+    }
+
+    /// Edge parameter from corner `a` (the lower) to `b`.
+    fn crossing(&self, cube: &Cube, a: u8, b: u8) -> f64 {
+        let (a, b) = (a as usize, b as usize);
+        let (la, lb) = (cube.label[a], cube.label[b]);
+        let t = if la == 0 || lb == 0 {
+            let (da, db) = (f64::from(cube.dist[a]), f64::from(cube.dist[b]));
+            da / (da - db)
+        } else {
+            let (fa, fb) = (cube.value[a], cube.value[b]);
+            match self.iface {
+                Interface::Midpoint => 0.5,
+                Interface::Ranges { n } => {
+                    let c = f64::from(la + lb - 1) / (2 * n) as f64;
+                    (c - f64::from(fa[0])) / f64::from(fb[0] - fa[0])
+                }
+                Interface::Dominant { .. } => {
+                    let (sa, sb) = (la as usize - 1, lb as usize - 1);
+                    let ga = f64::from(fa[sa]) - f64::from(fa[sb]);
+                    let gb = f64::from(fb[sa]) - f64::from(fb[sb]);
+                    ga / (ga - gb)
+                }
+            }
+        };
+        if t.is_finite() { t.clamp(T_MIN, 1.0 - T_MIN) } else { 0.5 }
+    }
+
+    fn edge_pos(&self, cube: &Cube, a: u8, b: u8) -> DVec3 {
+        let (pa, pb) = (self.center(Self::corner(cube, a)), self.center(Self::corner(cube, b)));
+        pa + (pb - pa) * self.crossing(cube, a, b)
+    }
+
+    /// Key and position of a point of tet `perm` (corners `v`).
+    fn resolve(&self, cube: &Cube, perm: usize, v: &[u8; 4], p: Pt) -> VRef {
+        let (key, pos) = match p {
+            Pt::Edge(a, b) => {
+                let key = self.global(Self::corner(cube, a)) * KEY_TYPES + u64::from(b & !a);
+                (key, self.edge_pos(cube, a, b))
+            }
+            Pt::Face(a, b, c) => {
+                let key = self.global(Self::corner(cube, a)) * KEY_TYPES + FACE_KEY + u64::from(b ^ a) * 8 + u64::from(c ^ a);
+                let sum = self.edge_pos(cube, a, b) + self.edge_pos(cube, b, c) + self.edge_pos(cube, a, c);
+                (key, sum / 3.0)
+            }
+            Pt::Tet => {
+                let key = self.global(cube.base) * KEY_TYPES + TET_KEY + perm as u64;
+                let (mut sum, mut n) = (DVec3::ZERO, 0.0);
+                for (x, y) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
+                    let (a, b) = by_inclusion(v[x], v[y]);
+                    if cube.label[a as usize] != cube.label[b as usize] {
+                        sum += self.edge_pos(cube, a, b);
+                        n += 1.0;
+                    }
+                }
+                (key, sum / n)
+            }
+        };
+        VRef { key, pos: pos.as_vec3().to_array() }
+    }
+
+    /// Contour tet `perm` of `cube` into `out`.
+    fn tet(&self, cube: &Cube, perm: usize, out: &mut Vec<Tri>) {
+        let [a1, a2, _] = PERMS[perm];
+        let m1 = 1u8 << a1;
+        let m2 = m1 | 1 << a2;
+        // Even axis orders give positively oriented tets; swap for odd ones.
+        let v: [u8; 4] = if matches!(perm, 0 | 3 | 4) { [0, m1, m2, 7] } else { [0, m2, m1, 7] };
+        let lab = v.map(|m| cube.label[m as usize]);
+        if lab.iter().all(|l| *l == lab[0]) {
+            return;
+        }
+        let mut distinct = [lab[0]; 4];
+        let mut nd = 1;
+        for l in &lab[1..] {
+            if !distinct[..nd].contains(l) {
+                distinct[nd] = *l;
+                nd += 1;
+            }
+        }
+        // Oriented curve segments on the faces, per label: (label, from, to)
+        // with the label's region on the left seen from outside the tet.
+        let mut segs: Vec<(u16, Pt, Pt)> = Vec::with_capacity(24);
+        for f in FACES {
+            let [u, w, x] = f.map(|i| v[i]);
+            let [lu, lw, lx] = f.map(|i| lab[i]);
+            // Odd one out `o` with its predecessor `p` and successor `s`.
+            let odd = if lu == lw && lw == lx {
+                continue;
+            } else if lu == lw {
+                Some((x, w, u, lx, lu))
+            } else if lw == lx {
+                Some((u, x, w, lu, lw))
+            } else if lx == lu {
+                Some((w, u, x, lw, lx))
+            } else {
+                None
+            };
+            match odd {
+                Some((o, p, s, lo, lrest)) => {
+                    segs.push((lo, edge(p, o), edge(o, s)));
+                    segs.push((lrest, edge(o, s), edge(p, o)));
+                }
+                None => {
+                    let (a, b) = by_inclusion(u, w);
+                    let (b, c) = by_inclusion(b, x);
+                    let (a, b) = by_inclusion(a, b);
+                    let face = Pt::Face(a, b, c);
+                    for (o, p, s, lo) in [(u, x, w, lu), (w, u, x, lw), (x, w, u, lx)] {
+                        segs.push((lo, edge(p, o), face));
+                        segs.push((lo, face, edge(o, s)));
+                    }
+                }
+            }
+        }
+        let res = |p: Pt| self.resolve(cube, perm, &v, p);
+        if nd == 2 {
+            // One interface: chain the first non-void label's segments into
+            // a loop and fan it; the other label gets the reverse.
+            let (x, y) = if distinct[0] == 0 || (distinct[1] != 0 && distinct[1] < distinct[0]) {
+                (distinct[1], distinct[0])
+            } else {
+                (distinct[0], distinct[1])
+            };
+            let mine: Vec<(Pt, Pt)> = segs.iter().filter(|s| s.0 == x).map(|s| (s.1, s.2)).collect();
+            if let Some(ring) = chain(&mine) {
+                let ring: Vec<VRef> = ring.into_iter().map(res).collect();
+                for i in 1..ring.len() - 1 {
+                    let t = [ring[0], ring[i], ring[i + 1]];
+                    out.push(Tri { label: x, v: t });
+                    if y != 0 {
+                        out.push(Tri { label: y, v: [t[0], t[2], t[1]] });
+                    }
+                }
+                return;
+            }
+            debug_assert!(false, "two-label tet without a single loop: {lab:?}");
+        }
+        let apex = res(Pt::Tet);
+        for (l, a, b) in segs {
+            if l != 0 {
+                out.push(Tri { label: l, v: [res(a), res(b), apex] });
+            }
+        }
+    }
+}
+
+/// Join segments `(from, to)` into one closed loop of points; `None` if they
+/// do not form exactly one loop.
+fn chain(segs: &[(Pt, Pt)]) -> Option<Vec<Pt>> {
+    let (first, mut end) = *segs.first()?;
+    let mut ring = vec![first];
+    while end != first {
+        if ring.len() > segs.len() {
+            return None;
+        }
+        ring.push(end);
+        end = segs.iter().find(|s| s.0 == end)?.1;
+    }
+    (ring.len() == segs.len() && ring.len() >= 3).then_some(ring)
+}
+
+/// Mesh the region `{v ≤ 0}` of a field sampled at the centres of `grid`
+/// (`values` x fastest, then y, then z): marching cubes, each cube split
+/// into six tetrahedra (see the module docs). Samples on the grid's outer
+/// layer count as outside, so the mesh is always closed.
+///
+/// # Panics
+/// If `values` does not have one value per voxel.
+pub fn marching_cubes(grid: &Grid, values: &[f32]) -> IndexedMesh {
+    let [nx, ny, nz] = grid.dims;
+    assert_eq!(values.len(), nx * ny * nz, "one value per voxel");
+    let mut c = Contourer::new(*grid, 1, Interface::Midpoint);
+    for z in 0..nz {
+        let dist = values[z * nx * ny..(z + 1) * nx * ny].to_vec();
+        let label = border_void(&dist, [nx, ny, nz], z, |d| u16::from(d <= 0.0));
+        c.push_plane(z, Plane { label, dist, value: Vec::new() });
+    }
+    c.finish().pop().unwrap_or_default()
+}
+
+/// Labels of plane `z` from `f`, with the grid's outer layer void.
+pub fn border_void(dist: &[f32], [nx, ny, nz]: [usize; 3], z: usize, f: impl Fn(f32) -> u16) -> Vec<u16> {
+    let edge_plane = z == 0 || z + 1 == nz;
+    dist.iter()
+        .enumerate()
+        .map(|(v, d)| {
+            let (x, y) = (v % nx, v / nx);
+            if edge_plane || x == 0 || y == 0 || x + 1 == nx || y + 1 == ny { 0 } else { f(*d) }
+        })
+        .collect()
+}

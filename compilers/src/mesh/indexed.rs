@@ -1,0 +1,149 @@
+//! Indexed triangle meshes and the checks every exported mesh must pass.
+//!
+//! Volume by the divergence theorem: for a closed, outward-oriented mesh,
+//! `V = Σ_t a·(b × c) / 6` over triangles `(a, b, c)` (signed tetrahedra
+//! from the origin; computed in f64). Watertight here means the strict
+//! 2-manifold condition slicers want: every undirected edge is used by
+//! exactly two triangles, once in each direction (which also makes the
+//! orientation consistent), and no triangle repeats an index.
+
+/// Triangles over shared vertices (mm), counter-clockwise seen from outside.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct IndexedMesh {
+    /// Vertex positions.
+    pub vertices: Vec<[f32; 3]>,
+    /// Vertex indices per triangle.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// Edge statistics of a mesh (all zero for a watertight one).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct EdgeReport {
+    /// Directed edges without the reverse edge (holes, flipped triangles).
+    pub open: usize,
+    /// Directed edges used more than once (non-manifold or flipped).
+    pub repeated: usize,
+    /// Triangles that use one vertex twice.
+    pub degenerate: usize,
+}
+
+impl EdgeReport {
+    /// True when nothing is wrong.
+    pub fn is_clean(&self) -> bool {
+        *self == EdgeReport::default()
+    }
+}
+
+fn f64x3(p: [f32; 3]) -> [f64; 3] {
+    p.map(f64::from)
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+impl IndexedMesh {
+    /// True when there are no triangles.
+    pub fn is_empty(&self) -> bool {
+        self.triangles.is_empty()
+    }
+
+    /// Positions of triangle `t` in f64.
+    pub fn corners(&self, t: usize) -> [[f64; 3]; 3] {
+        self.triangles[t].map(|i| f64x3(self.vertices[i as usize]))
+    }
+
+    /// Enclosed volume (mm³): positive for an outward-oriented closed mesh.
+    /// Relative to the mesh's first vertex, so far-off meshes keep precision.
+    pub fn volume(&self) -> f64 {
+        let Some(o) = self.vertices.first().map(|p| f64x3(*p)) else {
+            return 0.0;
+        };
+        let mut six_v = 0.0;
+        for t in 0..self.triangles.len() {
+            let [a, b, c] = self.corners(t).map(|p| sub(p, o));
+            let n = cross(b, c);
+            six_v += a[0] * n[0] + a[1] * n[1] + a[2] * n[2];
+        }
+        six_v / 6.0
+    }
+
+    /// Surface area (mm²).
+    pub fn area(&self) -> f64 {
+        (0..self.triangles.len())
+            .map(|t| {
+                let [a, b, c] = self.corners(t);
+                let n = cross(sub(b, a), sub(c, a));
+                0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
+            })
+            .sum()
+    }
+
+    /// Unit normal of triangle `t` (zero for a degenerate one).
+    pub fn normal(&self, t: usize) -> [f32; 3] {
+        let [a, b, c] = self.corners(t);
+        let n = cross(sub(b, a), sub(c, a));
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        if len > 0.0 { n.map(|v| (v / len) as f32) } else { [0.0; 3] }
+    }
+
+    /// Count open, repeated and degenerate edges.
+    pub fn edge_report(&self) -> EdgeReport {
+        let mut r = EdgeReport::default();
+        let mut edges: Vec<(u32, u32)> = Vec::with_capacity(self.triangles.len() * 3);
+        for t in &self.triangles {
+            if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
+                r.degenerate += 1;
+            }
+            edges.extend([(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]);
+        }
+        edges.sort_unstable();
+        r.repeated = edges.windows(2).filter(|w| w[0] == w[1]).count();
+        r.open = edges.iter().filter(|(a, b)| edges.binary_search(&(*b, *a)).is_err()).count();
+        r
+    }
+
+    /// Every edge shared by exactly two triangles, in opposite directions.
+    pub fn is_watertight(&self) -> bool {
+        !self.is_empty() && self.edge_report().is_clean()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The unit cube, outward oriented (12 triangles from 3MF.md).
+    pub(crate) fn cube() -> IndexedMesh {
+        let v = [[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.], [0., 0., 1.], [1., 0., 1.], [1., 1., 1.], [0., 1., 1.]];
+        let t = [[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4], [3, 7, 6], [3, 6, 2], [0, 4, 7], [0, 7, 3], [1, 2, 6], [1, 6, 5]];
+        IndexedMesh { vertices: v.to_vec(), triangles: t.to_vec() }
+    }
+
+    #[test]
+    fn cube_is_watertight_with_unit_volume() {
+        let m = cube();
+        assert!(m.is_watertight());
+        assert!((m.volume() - 1.0).abs() < 1e-12);
+        assert!((m.area() - 6.0).abs() < 1e-12);
+        assert_eq!(m.normal(0), [0.0, 0.0, -1.0]);
+    }
+
+    #[test]
+    fn flipped_or_missing_triangles_are_caught() {
+        let mut m = cube();
+        m.triangles[3] = [m.triangles[3][0], m.triangles[3][2], m.triangles[3][1]];
+        let r = m.edge_report();
+        assert!(!m.is_watertight() && r.repeated > 0 && r.open > 0, "{r:?}");
+        let mut m = cube();
+        m.triangles.pop();
+        assert_eq!(m.edge_report().open, 3);
+        let mut m = cube();
+        m.triangles.push(m.triangles[0]);
+        assert!(!m.is_watertight());
+    }
+}

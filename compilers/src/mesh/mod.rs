@@ -1,0 +1,404 @@
+//! Segmented meshes for slicers: the part split by fraction ranges of one
+//! material (or by dominant material), each segment a closed triangle mesh.
+//!
+//! Pipeline, a slab of layers at a time: `Sampler::sample_layers` (grid
+//! padded by one voxel so its outer layer is outside) → [`segment`] labels
+//! per voxel → [`contour`] (marching tetrahedra inside each cube, multi-label,
+//! shared vertices) → per segment an [`IndexedMesh`] → STL ([`stl`]), OBJ
+//! ([`obj`]) per segment and one `segments.3mf` ([`threemf`]) with every
+//! segment as a named part carrying its `fill_density`.
+//!
+//! Guarantees: each segment's mesh is watertight (every edge in exactly two
+//! triangles, opposite directions) and outward oriented; neighbouring
+//! segments share their interface triangles exactly (same positions,
+//! opposite orientation), so the segments cover the part once. The outer
+//! surface is placed from the true distances.
+//!
+//! Infill: `fill_density = clamp(expr(f), 0, 100)%`, `expr` a math string of
+//! `f` (default [`DEFAULT_INFILL`]), where `f` is the middle of the
+//! segment's range `(s + ½)/n` when splitting by a material, and the mean
+//! dominant fraction over the segment's voxels when splitting by dominant
+//! material.
+
+pub mod contour;
+pub mod indexed;
+pub mod obj;
+pub mod segment;
+pub mod stl;
+pub mod threemf;
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::sync::atomic::AtomicBool;
+
+use glam::DVec3;
+use rayon::prelude::*;
+use serde_json::json;
+use volcad_core::expr::Expr;
+use volcad_core::sampler::{Grid, Sampler, Slab};
+use volcad_core::{MaterialId, Model};
+
+pub use contour::marching_cubes;
+pub use indexed::{EdgeReport, IndexedMesh};
+
+use crate::job::{ExportError, JobContext, Summary};
+use crate::png_io::folder_name;
+use crate::png_stack::grid_for;
+use crate::probe::probe;
+use crate::resources::{check_disk, check_memory, human_bytes, run_with_threads};
+use contour::Contourer;
+use segment::{Classifier, Tally};
+
+/// Infill percent from `f` when no expression is given.
+pub const DEFAULT_INFILL: &str = "10 + 80*f";
+/// Most segments by fraction ranges.
+pub const MAX_SEGMENTS: usize = 1000;
+/// Working memory aimed at for one slab of samples.
+const SLAB_BUDGET: usize = 256 << 20;
+/// Triangles per voxel face of surface (measured on spheres and lattices).
+const TRIANGLES_PER_FACE: f64 = 9.0;
+
+/// How the part is split.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SegmentBy {
+    /// `segments` equal ranges of this material's fraction.
+    Material(MaterialId),
+    /// One segment per material of the design, where it has the largest
+    /// fraction (`segments` is ignored).
+    Dominant,
+}
+
+/// Which files to write.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MeshFormats {
+    /// Binary STL per segment.
+    pub stl: bool,
+    /// OBJ per segment.
+    pub obj: bool,
+    /// One `segments.3mf` with every segment as a part.
+    pub threemf: bool,
+}
+
+impl Default for MeshFormats {
+    /// All three.
+    fn default() -> Self {
+        Self { stl: true, obj: true, threemf: true }
+    }
+}
+
+/// Parameters of a segmented mesh export.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshParams {
+    /// Voxel size (mm) per axis of the sampling grid.
+    pub voxel: DVec3,
+    /// Number of fraction ranges (with [`SegmentBy::Material`]).
+    pub segments: usize,
+    /// How to split.
+    pub by: SegmentBy,
+    /// Files to write.
+    pub formats: MeshFormats,
+    /// Infill percent as a math string of `f` (`None`: [`DEFAULT_INFILL`]).
+    pub infill_expr: Option<String>,
+    /// Worker threads (`None`: all cores).
+    pub threads: Option<usize>,
+}
+
+impl Default for MeshParams {
+    /// 0.1 mm voxels, by dominant material, every format.
+    fn default() -> Self {
+        Self { voxel: DVec3::splat(0.1), segments: 4, by: SegmentBy::Dominant, formats: MeshFormats::default(), infill_expr: None, threads: None }
+    }
+}
+
+/// What a mesh export will take, known before it starts.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshEstimate {
+    /// The (padded) sampling grid.
+    pub grid: Grid,
+    /// Voxels sampled.
+    pub voxels: u64,
+    /// Segments.
+    pub segments: usize,
+    /// Layers sampled per slab.
+    pub slab_layers: usize,
+    /// Rough triangle count over all segments.
+    pub triangles: u64,
+    /// Working memory, meshes included (bytes, rough).
+    pub memory_bytes: u64,
+    /// Rough size of the output (bytes).
+    pub disk_bytes: u64,
+}
+
+/// One segment's result.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SegmentMesh {
+    /// File and part name.
+    pub name: String,
+    /// Its closed mesh (may be empty when no voxel fell in the segment).
+    pub mesh: IndexedMesh,
+    /// Voxels in the segment.
+    pub voxels: u64,
+    /// The `f` its infill is computed from (see the module docs).
+    pub f: f64,
+    /// Infill percent.
+    pub infill_percent: f64,
+}
+
+struct Plan {
+    grid: Grid,
+    classifier: Classifier,
+    infill: Expr,
+    slab_layers: usize,
+    estimate: MeshEstimate,
+}
+
+fn plan(model: &Model, p: &MeshParams) -> Result<Plan, ExportError> {
+    let k = model.materials().len();
+    let classifier = match p.by {
+        SegmentBy::Dominant => Classifier::Dominant { k },
+        SegmentBy::Material(id) => {
+            if id == 0 || model.table().get(id).is_none() {
+                return Err(ExportError::param(
+                    "--material",
+                    format!("material id {id} is not in the material table ({}); it has ids 1..={}", model.table().origin(), model.table().len() - 1),
+                ));
+            }
+            if !(1..=MAX_SEGMENTS).contains(&p.segments) {
+                return Err(ExportError::param("--segments", format!("{} segments; use 1..={MAX_SEGMENTS}", p.segments)));
+            }
+            Classifier::Ranges { slot: model.materials().iter().position(|m| *m == id), n: p.segments }
+        }
+    };
+    if !(p.formats.stl || p.formats.obj || p.formats.threemf) {
+        return Err(ExportError::param("--format", "no output format chosen; pick stl, obj and/or 3mf"));
+    }
+    let src = p.infill_expr.as_deref().unwrap_or(DEFAULT_INFILL);
+    let infill = Expr::compile(src, &["f"]).map_err(|e| ExportError::param("--infill", e.to_string()))?;
+    crate::png_stack::palette(model)?;
+    let grid = grid_for(model, p.voxel, p.voxel.max_element())?;
+    let [nx, ny, nz] = grid.dims;
+    let layer = nx * ny;
+    let stride = classifier.interface().stride();
+    let per_layer = layer * (4 + 4 * k);
+    let slab_layers = (SLAB_BUDGET / per_layer.max(1)).clamp(1, 16).min(nz);
+    let pr = probe(model, p.voxel);
+    let face = (p.voxel.x * p.voxel.y * p.voxel.z).powf(2.0 / 3.0);
+    let segments = classifier.segments();
+    // Interfaces add surface; assume about half the outer area per extra segment.
+    let area = pr.surface_mm2 * (1.0 + 0.5 * (segments as f64 - 1.0).min(4.0));
+    let triangles = (area / face * TRIANGLES_PER_FACE) as u64;
+    // Meshes: 12 B per triangle, ~½ vertex per triangle at 12 B + map entry.
+    let mesh_bytes = triangles * 12 + triangles / 2 * 40;
+    let planes = (2 * layer * (2 + 4 + 4 * stride)) as u64;
+    let memory_bytes = (slab_layers * per_layer) as u64 + planes + mesh_bytes;
+    check_memory(memory_bytes, &format!("meshing {nx} × {ny} × {nz} voxels (about {triangles} triangles)"))?;
+    let per_tri = f64::from(u8::from(p.formats.stl)) * 50.0 + f64::from(u8::from(p.formats.obj)) * 40.0 + f64::from(u8::from(p.formats.threemf)) * 20.0;
+    let estimate = MeshEstimate {
+        grid,
+        voxels: grid.count(),
+        segments,
+        slab_layers,
+        triangles,
+        memory_bytes,
+        disk_bytes: (triangles as f64 * per_tri) as u64 + 4096 * segments as u64,
+    };
+    Ok(Plan { grid, classifier, infill, slab_layers, estimate })
+}
+
+/// Grid, memory, rough triangle count and output size; errors for bad
+/// parameters (voxel, segments, material, infill expression, formats), an
+/// unbounded design, or meshes that would not fit in memory.
+pub fn estimate_mesh(model: &Model, p: &MeshParams) -> Result<MeshEstimate, ExportError> {
+    plan(model, p).map(|pl| pl.estimate)
+}
+
+fn segment_names(model: &Model, p: &MeshParams, c: &Classifier) -> Vec<String> {
+    let n = c.segments();
+    let digits = n.saturating_sub(1).to_string().len().max(2);
+    let mat = |id: MaterialId| folder_name(model.table().name(id), id);
+    (0..n)
+        .map(|s| match p.by {
+            SegmentBy::Material(id) => {
+                let (lo, hi) = (s as f64 / n as f64, (s + 1) as f64 / n as f64);
+                format!("seg{s:0digits$}_{}_{lo:.3}-{hi:.3}", mat(id))
+            }
+            SegmentBy::Dominant => format!("seg{s:0digits$}_{}", mat(model.materials()[s])),
+        })
+        .collect()
+}
+
+/// Compute every segment's mesh in memory (`progress(layers_done, layers)`
+/// after each slab). The export writes these; tests and previews use them
+/// directly.
+pub fn segment_meshes(model: &Model, p: &MeshParams, cancel: &AtomicBool, progress: impl Fn(usize, usize) + Sync) -> Result<Vec<SegmentMesh>, ExportError> {
+    let pl = plan(model, p)?;
+    run_with_threads(p.threads, || build(model, p, &pl, cancel, &progress))
+}
+
+fn build(model: &Model, p: &MeshParams, pl: &Plan, cancel: &AtomicBool, progress: &(impl Fn(usize, usize) + Sync)) -> Result<Vec<SegmentMesh>, ExportError> {
+    let dims = pl.grid.dims;
+    let nz = dims[2];
+    let sampler = Sampler::new(model, pl.grid, true);
+    let mut contourer = Contourer::new(pl.grid, pl.classifier.segments(), pl.classifier.interface());
+    let mut tally = Tally::new(pl.classifier.segments());
+    let mut slab = Slab::default();
+    let mut z0 = 0;
+    while z0 < nz {
+        let z1 = (z0 + pl.slab_layers).min(nz);
+        sampler.sample_layers(z0, z1, &mut slab, cancel).map_err(|_| ExportError::Cancelled)?;
+        for z in z0..z1 {
+            let (plane, t) = pl.classifier.plane(&slab, z - z0, dims, z);
+            tally.add(&t);
+            contourer.push_plane(z, plane);
+        }
+        progress(z1, nz);
+        z0 = z1;
+    }
+    let names = segment_names(model, p, &pl.classifier);
+    let n = pl.classifier.segments();
+    contourer
+        .finish()
+        .into_iter()
+        .enumerate()
+        .map(|(s, mesh)| {
+            let voxels = tally.voxels[s];
+            let f = match pl.classifier {
+                Classifier::Ranges { .. } => (s as f64 + 0.5) / n as f64,
+                Classifier::Dominant { .. } => if voxels > 0 { tally.sum_f[s] / voxels as f64 } else { 1.0 },
+            };
+            let v = pl.infill.eval(&[f]);
+            if !v.is_finite() {
+                return Err(ExportError::param("--infill", format!("\"{}\" gives {v} at f = {f}", pl.infill.source())));
+            }
+            Ok(SegmentMesh { name: names[s].clone(), mesh, voxels, f, infill_percent: v.clamp(0.0, 100.0) })
+        })
+        .collect()
+}
+
+/// `fill_density` text: the percent rounded to 0.01, with `%`.
+fn percent_text(v: f64) -> String {
+    format!("{}%", (v * 100.0).round() / 100.0)
+}
+
+/// Write the segments' files into `ctx.staging()`.
+pub fn export_meshes(model: &Model, p: &MeshParams, ctx: &JobContext) -> Result<Summary, ExportError> {
+    let pl = plan(model, p)?;
+    check_disk(pl.estimate.disk_bytes, ctx.staging())?;
+    run_with_threads(p.threads, || {
+        let nz = pl.grid.dims[2];
+        let segs = build(model, p, &pl, ctx.cancel_flag(), &|done, total| {
+            ctx.progress("meshing", done as u64, total as u64, "layers", 0.9 * done as f64 / total.max(1) as f64);
+        })?;
+        debug_assert!(nz > 0);
+        ctx.check_cancel()?;
+        ctx.progress("writing", 0, 1, "files", 0.9);
+        let files = write_files(&segs, p, ctx)?;
+        Ok(summary(model, p, &pl, &segs, files))
+    })
+}
+
+fn create(path: &std::path::Path) -> Result<BufWriter<File>, ExportError> {
+    File::create(path).map(|f| BufWriter::with_capacity(1 << 20, f)).map_err(|e| ExportError::io(path, e))
+}
+
+/// One output file.
+#[derive(Clone, Copy)]
+enum FileJob<'a> {
+    Stl(&'a SegmentMesh),
+    Obj(&'a SegmentMesh),
+    ThreeMf,
+}
+
+/// Write every file, all in parallel (each file's bytes depend only on its
+/// meshes); the list comes back in a fixed order.
+fn write_files(segs: &[SegmentMesh], p: &MeshParams, ctx: &JobContext) -> Result<Vec<String>, ExportError> {
+    let present: Vec<&SegmentMesh> = segs.iter().filter(|s| !s.mesh.is_empty()).collect();
+    if present.is_empty() {
+        return Err(ExportError::Other("no segment has any voxel at this voxel size; the part is thinner than a voxel or empty".into()));
+    }
+    let mut jobs: Vec<FileJob> = Vec::new();
+    if p.formats.threemf {
+        jobs.push(FileJob::ThreeMf);
+    }
+    for s in &present {
+        if p.formats.stl {
+            jobs.push(FileJob::Stl(s));
+        }
+        if p.formats.obj {
+            jobs.push(FileJob::Obj(s));
+        }
+    }
+    jobs.par_iter()
+        .map(|job| {
+            ctx.check_cancel()?;
+            let name = match job {
+                FileJob::Stl(s) => format!("{}.stl", s.name),
+                FileJob::Obj(s) => format!("{}.obj", s.name),
+                FileJob::ThreeMf => "segments.3mf".to_owned(),
+            };
+            let path = ctx.staging().join(&name);
+            let mut w = create(&path)?;
+            let r = match job {
+                FileJob::Stl(s) => stl::write_stl(&s.mesh, &s.name, &mut w),
+                FileJob::Obj(s) => obj::write_obj(&s.mesh, &s.name, &mut w),
+                FileJob::ThreeMf => {
+                    let parts: Vec<threemf::Part> = present
+                        .iter()
+                        .map(|s| threemf::Part { name: &s.name, mesh: &s.mesh, settings: vec![("fill_density", percent_text(s.infill_percent))] })
+                        .collect();
+                    threemf::write_3mf(&parts, "part", &mut w)
+                }
+            };
+            r.and_then(|_| w.flush()).map_err(|e| ExportError::io(&path, e))?;
+            Ok(name)
+        })
+        .collect()
+}
+
+fn summary(model: &Model, p: &MeshParams, pl: &Plan, segs: &[SegmentMesh], files: Vec<String>) -> Summary {
+    let [nx, ny, nz] = pl.grid.dims;
+    let mut notes = vec![format!("grid {nx} × {ny} × {nz} (padded by one voxel), working memory about {}", human_bytes(pl.estimate.memory_bytes))];
+    if let SegmentBy::Material(id) = p.by {
+        if !model.materials().contains(&id) {
+            notes.push(format!("material {} is not in the design: its fraction is 0 everywhere", model.table().name(id)));
+        }
+    }
+    let mut total_volume = 0.0;
+    for s in segs {
+        if s.mesh.is_empty() {
+            notes.push(format!("{}: empty (no voxel in this range), no file", s.name));
+            continue;
+        }
+        let v = s.mesh.volume();
+        total_volume += v;
+        let tight = if s.mesh.is_watertight() { "watertight" } else { "NOT WATERTIGHT (please report)" };
+        notes.push(format!(
+            "{}: {} triangles, {} vertices, {v:.3} mm³, {tight}, fill_density {}",
+            s.name,
+            s.mesh.triangles.len(),
+            s.mesh.vertices.len(),
+            percent_text(s.infill_percent)
+        ));
+    }
+    notes.push(format!("total volume {total_volume:.3} mm³"));
+    let by = match p.by {
+        SegmentBy::Material(id) => json!({ "material": model.table().name(id), "id": id, "segments": p.segments }),
+        SegmentBy::Dominant => json!("dominant"),
+    };
+    Summary {
+        kind: "mesh".into(),
+        files,
+        counts: segs.iter().map(|s| (s.name.clone(), s.voxels)).collect(),
+        units: pl.estimate.voxels,
+        unit: "voxels".into(),
+        parameters: json!({
+            "voxel_mm": p.voxel.to_array(),
+            "by": by,
+            "formats": { "stl": p.formats.stl, "obj": p.formats.obj, "3mf": p.formats.threemf },
+            "infill": p.infill_expr.as_deref().unwrap_or(DEFAULT_INFILL),
+            "grid": { "dims": [nx, ny, nz], "origin_mm": pl.grid.origin.to_array() },
+        }),
+        notes,
+        seconds: 0.0,
+    }
+}

@@ -1,0 +1,185 @@
+//! Which segment each voxel belongs to, from its sampled fractions.
+//!
+//! A voxel is void when it is outside (`d > 0`), its fractions sum to
+//! (almost) nothing, or it lies on the grid's outer layer (the grid is
+//! padded so that layer is outside anyway; forcing it closes every mesh).
+//! Fractions are normalised by their total `T = Σ f_i`. Then:
+//!
+//! * by the fraction `f = f_m / T` of one material `m`: segment
+//!   `s = min(⌊f·n⌋, n − 1)`, i.e. ranges `[s/n, (s+1)/n)` with the top range
+//!   closed. A material the design does not use has `f = 0` everywhere.
+//! * by dominant material: the slot with the largest fraction (ties to the
+//!   lowest), one segment per material of the design.
+//!
+//! Labels are `segment + 1` (0 = void), as [`super::contour`] takes them.
+
+use rayon::prelude::*;
+use volcad_core::sampler::Slab;
+
+use super::contour::{Interface, Plane};
+
+/// Fraction totals at or below this are void.
+const MIN_TOTAL: f32 = 1e-6;
+
+/// How voxels are put into segments.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Classifier {
+    /// `n` ranges of the normalised fraction of slot `slot` (`None`: a
+    /// material the design does not use, so `f = 0`).
+    Ranges {
+        /// The material's slot in the design, if it has one.
+        slot: Option<usize>,
+        /// Number of ranges.
+        n: usize,
+    },
+    /// The dominant material among `k`.
+    Dominant {
+        /// Materials of the design.
+        k: usize,
+    },
+}
+
+/// Per-segment tallies.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Tally {
+    /// Voxels per segment.
+    pub voxels: Vec<u64>,
+    /// Sum per segment of the classifying fraction (the material's `f`, or
+    /// the dominant fraction), for means.
+    pub sum_f: Vec<f64>,
+}
+
+impl Tally {
+    /// Zero tallies for `n` segments.
+    pub fn new(n: usize) -> Self {
+        Self { voxels: vec![0; n], sum_f: vec![0.0; n] }
+    }
+
+    /// Add `other` (in a fixed order, so sums are deterministic).
+    pub fn add(&mut self, other: &Tally) {
+        for (a, b) in self.voxels.iter_mut().zip(&other.voxels) {
+            *a += b;
+        }
+        for (a, b) in self.sum_f.iter_mut().zip(&other.sum_f) {
+            *a += b;
+        }
+    }
+}
+
+impl Classifier {
+    /// Number of segments.
+    pub fn segments(&self) -> usize {
+        match *self {
+            Classifier::Ranges { n, .. } => n,
+            Classifier::Dominant { k } => k,
+        }
+    }
+
+    /// How [`super::contour`] cuts edges between segments.
+    pub fn interface(&self) -> Interface {
+        match *self {
+            Classifier::Ranges { n, .. } => Interface::Ranges { n },
+            Classifier::Dominant { k } => Interface::Dominant { k },
+        }
+    }
+
+    /// Label (0 = void) and interface values of one inside voxel with
+    /// fractions `f`; `value` gets [`Interface::stride`] numbers. Returns
+    /// the label and the classifying fraction.
+    #[inline]
+    fn classify(&self, f: &[f32], value: &mut [f32]) -> (u16, f32) {
+        let total: f32 = f.iter().sum();
+        if !(total > MIN_TOTAL) {
+            value.fill(0.0);
+            return (0, 0.0);
+        }
+        let inv = 1.0 / total;
+        match *self {
+            Classifier::Ranges { slot, n } => {
+                let x = slot.map_or(0.0, |s| (f[s] * inv).clamp(0.0, 1.0));
+                value[0] = x;
+                let s = ((x * n as f32) as usize).min(n - 1);
+                (s as u16 + 1, x)
+            }
+            Classifier::Dominant { .. } => {
+                let mut best = 0;
+                for (i, (v, fi)) in value.iter_mut().zip(f).enumerate() {
+                    *v = fi * inv;
+                    if *fi > f[best] {
+                        best = i;
+                    }
+                }
+                (best as u16 + 1, value[best])
+            }
+        }
+    }
+
+    /// The plane of labels for layer `l` of `slab` (grid `[nx, ny, nz]`,
+    /// global layer `z`), with its tallies.
+    pub fn plane(&self, slab: &Slab, l: usize, [nx, ny, nz]: [usize; 3], z: usize) -> (Plane, Tally) {
+        let layer = nx * ny;
+        let k = slab.k;
+        let stride = self.interface().stride();
+        let dist = slab.dist[l * layer..(l + 1) * layer].to_vec();
+        let fracs = &slab.fracs[l * layer * k..(l + 1) * layer * k];
+        let mut label = vec![0u16; layer];
+        let mut value = vec![0f32; layer * stride];
+        let segments = self.segments();
+        let edge_plane = z == 0 || z + 1 == nz;
+        let tallies: Vec<Tally> = label
+            .par_chunks_mut(nx)
+            .zip(value.par_chunks_mut(nx * stride))
+            .enumerate()
+            .map(|(y, (labels, values))| {
+                let mut t = Tally::new(segments);
+                if edge_plane || y == 0 || y + 1 == ny {
+                    return t;
+                }
+                for x in 1..nx - 1 {
+                    let v = y * nx + x;
+                    if dist[v] > 0.0 {
+                        continue;
+                    }
+                    let (lab, f) = self.classify(&fracs[v * k..(v + 1) * k], &mut values[x * stride..(x + 1) * stride]);
+                    labels[x] = lab;
+                    if lab > 0 {
+                        t.voxels[lab as usize - 1] += 1;
+                        t.sum_f[lab as usize - 1] += f64::from(f);
+                    }
+                }
+                t
+            })
+            .collect();
+        let mut tally = Tally::new(segments);
+        for t in &tallies {
+            tally.add(t);
+        }
+        (Plane { label, dist, value }, tally)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges_close_the_top_and_normalise() {
+        let c = Classifier::Ranges { slot: Some(0), n: 4 };
+        let mut v = [0.0];
+        assert_eq!(c.classify(&[1.0, 0.0], &mut v).0, 4);
+        assert_eq!(c.classify(&[0.25, 0.75], &mut v).0, 2);
+        assert_eq!(c.classify(&[0.1, 0.3], &mut v), (2, 0.25));
+        assert_eq!(c.classify(&[0.0, 0.0], &mut v).0, 0);
+        let unused = Classifier::Ranges { slot: None, n: 3 };
+        assert_eq!(unused.classify(&[0.5, 0.5], &mut v).0, 1);
+    }
+
+    #[test]
+    fn dominant_picks_the_largest_lowest_on_ties() {
+        let c = Classifier::Dominant { k: 3 };
+        let mut v = [0.0; 3];
+        assert_eq!(c.classify(&[0.2, 0.5, 0.3], &mut v).0, 2);
+        assert_eq!(c.classify(&[0.4, 0.2, 0.4], &mut v).0, 1);
+        assert_eq!(v, [0.4, 0.2, 0.4]);
+    }
+}

@@ -1,0 +1,127 @@
+//! Memory and disk checks made before an export starts, so that a job that
+//! cannot fit is refused with the numbers instead of failing half-way.
+//!
+//! Both probes are best effort: `None` means "unknown" and the check is then
+//! skipped (a full disk is still caught when a write fails, and the job
+//! runner removes the partial output).
+
+use std::path::Path;
+
+use crate::job::ExportError;
+
+/// Bytes of memory available to new allocations (`MemAvailable` from
+/// `/proc/meminfo`), or `None` where that is not known.
+pub fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// Free bytes on the file system holding `dir` (POSIX `df -Pk`: the fourth
+/// column of the second line is the space available in KiB), or `None`.
+pub fn available_disk(dir: &Path) -> Option<u64> {
+    let out = std::process::Command::new("df").arg("-Pk").arg(dir).output().ok()?;
+    if !out.status.success() {
+        return None;
+    }
+    let text = String::from_utf8(out.stdout).ok()?;
+    let kib: u64 = text.lines().nth(1)?.split_whitespace().nth(3)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// Run `f` on a pool of `threads` workers (`None`: the current pool, all
+/// cores by default). Output never depends on the count; only speed does.
+pub fn run_with_threads<T: Send>(threads: Option<usize>, f: impl FnOnce() -> Result<T, ExportError> + Send) -> Result<T, ExportError> {
+    match threads {
+        None => f(),
+        Some(0) => Err(ExportError::param("--threads", "must be at least 1")),
+        Some(n) => {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|e| ExportError::Other(format!("starting {n} worker threads: {e}")))?;
+            pool.install(f)
+        }
+    }
+}
+
+/// `n` bytes for people: "1.5 GiB", "12 MiB", "300 B".
+pub fn human_bytes(n: u64) -> String {
+    const UNITS: [&str; 5] = ["B", "KiB", "MiB", "GiB", "TiB"];
+    let mut v = n as f64;
+    let mut u = 0;
+    while v >= 1024.0 && u + 1 < UNITS.len() {
+        v /= 1024.0;
+        u += 1;
+    }
+    if u == 0 { format!("{n} B") } else if v < 10.0 { format!("{v:.1} {}", UNITS[u]) } else { format!("{v:.0} {}", UNITS[u]) }
+}
+
+/// Refuse when `needed` bytes of working memory exceed what is available
+/// (with 20% head room for the rest of the program). `what` says what the
+/// memory is for; the error names `--voxel`, the parameter that fixes it.
+pub fn check_memory(needed: u64, what: &str) -> Result<(), ExportError> {
+    if let Some(avail) = available_memory() {
+        let usable = avail / 5 * 4;
+        if needed > usable {
+            return Err(ExportError::param(
+                "--voxel",
+                format!(
+                    "{what} needs {} of memory but only {} is available ({} free); use a larger voxel size",
+                    human_bytes(needed),
+                    human_bytes(usable),
+                    human_bytes(avail)
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Refuse when about `needed` bytes of output will not fit on the disk that
+/// holds `dir`. The error names `--out`.
+pub fn check_disk(needed: u64, dir: &Path) -> Result<(), ExportError> {
+    if let Some(free) = available_disk(dir) {
+        if needed > free {
+            return Err(ExportError::param(
+                "--out",
+                format!(
+                    "the output needs about {} but only {} is free on the disk of {}; free space, choose another folder or use a larger voxel size",
+                    human_bytes(needed),
+                    human_bytes(free),
+                    dir.display()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn human_bytes_rounds() {
+        assert_eq!(human_bytes(300), "300 B");
+        assert_eq!(human_bytes(1536), "1.5 KiB");
+        assert_eq!(human_bytes(50 << 20), "50 MiB");
+    }
+
+    #[test]
+    fn probes_answer_on_linux() {
+        if cfg!(target_os = "linux") {
+            assert!(available_memory().is_some_and(|m| m > 0));
+            assert!(available_disk(&std::env::temp_dir()).is_some_and(|d| d > 0));
+        }
+    }
+
+    #[test]
+    fn huge_needs_are_refused_with_numbers() {
+        let e = check_memory(u64::MAX / 2, "one layer").unwrap_err().to_string();
+        assert!(e.starts_with("--voxel: one layer needs"), "{e}");
+        let e = check_disk(u64::MAX / 2, &std::env::temp_dir()).unwrap_err().to_string();
+        assert!(e.starts_with("--out: the output needs about"), "{e}");
+    }
+}

@@ -1,0 +1,85 @@
+//! Helpers shared by the export tests: models from script text, jobs run
+//! through the real job runner, output folders read back.
+#![allow(dead_code)]
+
+use std::collections::BTreeMap;
+use std::io::Cursor;
+use std::path::Path;
+use std::sync::Arc;
+
+use volcad_compilers::job::{self, JobContext};
+use volcad_compilers::{ExportError, Summary};
+use volcad_core::Model;
+use volcad_core::script::{ScriptOptions, run_script};
+
+/// The prepared model of a Rhai design.
+pub fn model(src: &str) -> Arc<Model> {
+    let d = run_script(src, "t.rhai", &ScriptOptions::default()).expect("script runs");
+    Arc::new(Model::prepare(&d.root, d.materials.clone()).expect("model prepares"))
+}
+
+/// Run `work` as a job writing to `dest`, and wait.
+pub fn run<F>(dest: &Path, work: F) -> Result<Summary, ExportError>
+where
+    F: FnOnce(&JobContext) -> Result<Summary, ExportError> + Send + 'static,
+{
+    job::spawn(dest.to_path_buf(), "test".into(), work).join()
+}
+
+/// Every file under `dir` but the manifest (which holds timings), by
+/// relative path.
+pub fn read_tree(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).expect("readable folder") {
+            let p = e.expect("entry").path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                let rel = p.strip_prefix(dir).unwrap().to_string_lossy().replace('\\', "/");
+                if rel != "manifest.json" {
+                    out.insert(rel, std::fs::read(&p).expect("readable file"));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// A decoded PNG: width, height, colour type, bit depth, pixel bytes.
+pub struct Png {
+    pub width: usize,
+    pub height: usize,
+    pub color: png::ColorType,
+    pub depth: png::BitDepth,
+    pub data: Vec<u8>,
+}
+
+pub fn decode(bytes: &[u8]) -> Png {
+    let mut r = png::Decoder::new(Cursor::new(bytes)).read_info().expect("png header");
+    let mut buf = vec![0; r.output_buffer_size().expect("size")];
+    let info = r.next_frame(&mut buf).expect("png data");
+    buf.truncate(info.buffer_size());
+    Png { width: info.width as usize, height: info.height as usize, color: info.color_type, depth: info.bit_depth, data: buf }
+}
+
+/// Pixels per RGBA colour over every `slice_*.png` at the top of a tree.
+pub fn colour_counts(files: &BTreeMap<String, Vec<u8>>) -> BTreeMap<[u8; 4], u64> {
+    let mut counts = BTreeMap::new();
+    for (name, bytes) in files {
+        if name.starts_with("slice_") {
+            let png = decode(bytes);
+            assert_eq!((png.color, png.depth), (png::ColorType::Rgba, png::BitDepth::Eight), "{name}");
+            for px in png.data.chunks_exact(4) {
+                *counts.entry([px[0], px[1], px[2], px[3]]).or_insert(0) += 1;
+            }
+        }
+    }
+    counts
+}
+
+/// A fresh temporary folder (removed on drop).
+pub fn tmp() -> tempfile::TempDir {
+    tempfile::tempdir().expect("temp dir")
+}

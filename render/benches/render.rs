@@ -1,0 +1,122 @@
+//! Bake and frame timings (plain timers, `harness = false`):
+//!
+//! `cargo bench -p volcad-render` prints, per test design, the bake time at
+//! 64/128/256 voxels, the time to a first coarse image (bake 64 + upload +
+//! one frame), and the frame time at 1280×800 in Solid and Volume modes;
+//! then the thin-feature coverage of the BCC sphere with and without the
+//! bias. Images go to `target/bench-images/`. Set `VOLCAD_BENCH_QUICK=1` to
+//! skip the 256 level.
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use std::time::Instant;
+
+use common::*;
+use glam::Vec3;
+use volcad_render::{Camera, Offscreen, StandardView, ViewMode, ViewSettings, bake_blocking};
+
+const FRAME: [u32; 2] = [1280, 800];
+const FRAMES: usize = 3;
+
+/// The same sphere as `SPHERE`, as the intersection of 200 nodes: the
+/// geometry (so the textures) are identical, the node count is not.
+fn many_node_sphere() -> String {
+    let boxes: Vec<String> = (0..199).map(|i| format!("RectPrism(Vec3(0,0,0), Vec3({s},{s},{s}), m.id(\"blue\"))", s = 40 + i)).collect();
+    format!(
+        "let m = default_materials(); Intersection(false, [Sphere(Vec3(0,0,0), 10, m.id(\"blue\")), {}])",
+        boxes.join(", ")
+    )
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    v[v.len() / 2]
+}
+
+fn main() {
+    let quick = std::env::var_os("VOLCAD_BENCH_QUICK").is_some();
+    let levels: &[u32] = if quick { &[64, 128] } else { &[64, 128, 256] };
+    let out = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/bench-images");
+    std::fs::create_dir_all(&out).unwrap();
+    let mut off = Offscreen::new(FRAME).expect("a GPU adapter (lavapipe) is required");
+    println!("adapter: {}; {} rayon threads", off.adapter(), rayon::current_num_threads());
+
+    let designs: Vec<(&str, String)> = vec![
+        ("graded_bar", GRADED_BAR.to_owned()),
+        ("bcc_sphere", BCC_SPHERE.to_owned()),
+        ("calibration_sheet", calibration_sheet()),
+        ("sphere_1_node", SPHERE.to_owned()),
+        ("sphere_200_nodes", many_node_sphere()),
+    ];
+    println!(
+        "{:<18} {:>6} {:>9} {:>10} {:>12} {:>12}",
+        "design", "level", "bake s", "voxels", "solid ms", "volume ms"
+    );
+    for (name, src) in &designs {
+        let model = model(src);
+        // Coarse first image: bake 64 + upload + one frame.
+        let t = Instant::now();
+        let b = bake_blocking(&model, 64).unwrap();
+        off.upload(&b);
+        let cam = Camera::fit(&model.bbox(), StandardView::Iso);
+        let solid = ViewSettings { camera: cam, ..Default::default() };
+        off.render(&solid).unwrap();
+        let first = t.elapsed().as_secs_f64();
+        println!("{name:<18} first coarse image (bake 64 + upload + 1280x800 frame + readback): {first:.3} s");
+        for &level in levels {
+            let b = bake_blocking(&model, level).unwrap();
+            off.upload(&b);
+            let volume = ViewSettings { mode: ViewMode::Volume, ..solid.clone() };
+            off.draw_timed(&solid).unwrap(); // warm-up
+            let s_ms = median((0..FRAMES).map(|_| off.draw_timed(&solid).unwrap() * 1e3).collect());
+            let v_ms = median((0..FRAMES).map(|_| off.draw_timed(&volume).unwrap() * 1e3).collect());
+            println!(
+                "{name:<18} {level:>6} {:>9.3} {:>10} {s_ms:>12.1} {v_ms:>12.1}",
+                b.bake_seconds,
+                b.voxel_count()
+            );
+            if level == 128 {
+                off.render(&solid).unwrap().save(out.join(format!("{name}_solid.png"))).unwrap();
+                off.render(&volume).unwrap().save(out.join(format!("{name}_volume.png"))).unwrap();
+            }
+        }
+    }
+
+    // Thin features: coverage of the BCC sphere's disk (front, orthographic)
+    // by level and bias. The finest level without bias is the reference.
+    let model = model(BCC_SPHERE);
+    let mut cam = Camera::fit(&model.bbox(), StandardView::Front);
+    cam.orthographic = true;
+    let s = ViewSettings::plain(cam);
+    let bg = bg_bytes(s.background);
+    let (cx, cy) = project(&cam, Vec3::ZERO, FRAME);
+    let (ex, _) = project(&cam, Vec3::X * 10.0, FRAME);
+    let r = (ex as f32 - cx as f32).abs() * 0.95;
+    println!("BCC sphere (0.35 mm struts, 20 mm sphere): coverage of the disk, front view");
+    for &level in levels {
+        let b = bake_blocking(&model, level).unwrap();
+        off.upload(&b);
+        for bias in [0.0, 0.2, volcad_render::THIN_BIAS_VOXELS] {
+            off.renderer_mut().set_thin_bias_voxels(bias);
+            let img = off.render(&s).unwrap();
+            let (mut inside, mut hit) = (0u32, 0u32);
+            for y in 0..FRAME[1] {
+                for x in 0..FRAME[0] {
+                    if ((x as f32 - cx as f32).powi(2) + (y as f32 - cy as f32).powi(2)).sqrt() < r {
+                        inside += 1;
+                        hit += is_fg(&img, x, y, bg) as u32;
+                    }
+                }
+            }
+            println!(
+                "  level {level:>3} (voxel {:.3} mm) bias {bias:.2} voxel: {:.1} %",
+                b.voxel_size_mm,
+                100.0 * hit as f32 / inside as f32
+            );
+            img.save(out.join(format!("bcc_front_{level}_bias{:02}.png", (bias * 100.0) as u32))).unwrap();
+        }
+        off.renderer_mut().set_thin_bias_voxels(volcad_render::THIN_BIAS_VOXELS);
+    }
+    println!("images in {}", out.display());
+}
