@@ -19,13 +19,13 @@ use volcad_render::{Camera, Offscreen, StandardView, ViewMode, ViewSettings, bak
 const FRAME: [u32; 2] = [1280, 800];
 const FRAMES: usize = 3;
 
-/// The same sphere as `SPHERE`, as the intersection of 200 nodes: the
-/// geometry (so the textures) are identical, the node count is not.
+/// The same sphere as `SPHERE` as a union of 200 identical spheres: the
+/// geometry (so the baked textures) are identical, the node count is not.
 fn many_node_sphere() -> String {
-    let boxes: Vec<String> = (0..199).map(|i| format!("RectPrism(Vec3(0,0,0), Vec3({s},{s},{s}), m.id(\"blue\"))", s = 40 + i)).collect();
+    let spheres = vec!["Sphere(Vec3(0,0,0), 10, m.id(\"blue\"))"; 200];
     format!(
-        "let m = default_materials(); Intersection(false, [Sphere(Vec3(0,0,0), 10, m.id(\"blue\")), {}])",
-        boxes.join(", ")
+        "let m = default_materials(); Union(false, [{}])",
+        spheres.join(", ")
     )
 }
 
@@ -40,7 +40,11 @@ fn main() {
     let out = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/bench-images");
     std::fs::create_dir_all(&out).unwrap();
     let mut off = Offscreen::new(FRAME).expect("a GPU adapter (lavapipe) is required");
-    println!("adapter: {}; {} rayon threads", off.adapter(), rayon::current_num_threads());
+    println!(
+        "adapter: {}; {} rayon threads",
+        off.adapter(),
+        rayon::current_num_threads()
+    );
 
     let designs: Vec<(&str, String)> = vec![
         ("graded_bar", GRADED_BAR.to_owned()),
@@ -50,9 +54,10 @@ fn main() {
         ("sphere_200_nodes", many_node_sphere()),
     ];
     println!(
-        "{:<18} {:>6} {:>9} {:>10} {:>12} {:>12}",
-        "design", "level", "bake s", "voxels", "solid ms", "volume ms"
+        "{:<18} {:>6} {:>9} {:>10} {:>10} {:>10} {:>10} {:>10}",
+        "design", "level", "bake s", "voxels", "solid ms", "half ms", "volume ms", "iso ms"
     );
+    let mut reference: Vec<Vec<u16>> = Vec::new();
     for (name, src) in &designs {
         let model = model(src);
         // Coarse first image: bake 64 + upload + one frame.
@@ -60,25 +65,87 @@ fn main() {
         let b = bake_blocking(&model, 64).unwrap();
         off.upload(&b);
         let cam = Camera::fit(&model.bbox(), StandardView::Iso);
-        let solid = ViewSettings { camera: cam, ..Default::default() };
+        let solid = ViewSettings {
+            camera: cam,
+            ..Default::default()
+        };
         off.render(&solid).unwrap();
         let first = t.elapsed().as_secs_f64();
-        println!("{name:<18} first coarse image (bake 64 + upload + 1280x800 frame + readback): {first:.3} s");
+        let t = Instant::now();
+        let b = bake_blocking(&model, 64).unwrap();
+        off.upload(&b);
+        off.render(&ViewSettings {
+            render_scale: 0.5,
+            ..solid.clone()
+        })
+        .unwrap();
+        let first_half = t.elapsed().as_secs_f64();
+        println!(
+            "{name:<18} first coarse image (bake 64 + upload + 1280x800 frame + readback): {first:.3} s, at render_scale 0.5: {first_half:.3} s"
+        );
         for &level in levels {
             let b = bake_blocking(&model, level).unwrap();
             off.upload(&b);
-            let volume = ViewSettings { mode: ViewMode::Volume, ..solid.clone() };
+            let volume = ViewSettings {
+                mode: ViewMode::Volume,
+                ..solid.clone()
+            };
             off.draw_timed(&solid).unwrap(); // warm-up
-            let s_ms = median((0..FRAMES).map(|_| off.draw_timed(&solid).unwrap() * 1e3).collect());
-            let v_ms = median((0..FRAMES).map(|_| off.draw_timed(&volume).unwrap() * 1e3).collect());
+            let s_ms = median(
+                (0..FRAMES)
+                    .map(|_| off.draw_timed(&solid).unwrap() * 1e3)
+                    .collect(),
+            );
+            let v_ms = median(
+                (0..FRAMES)
+                    .map(|_| off.draw_timed(&volume).unwrap() * 1e3)
+                    .collect(),
+            );
+            let half = ViewSettings {
+                render_scale: 0.5,
+                ..solid.clone()
+            };
+            let h_ms = median(
+                (0..FRAMES)
+                    .map(|_| off.draw_timed(&half).unwrap() * 1e3)
+                    .collect(),
+            );
+            let iso = ViewSettings {
+                mode: ViewMode::Iso {
+                    material_index: 0,
+                    level: 0.5,
+                },
+                ..solid.clone()
+            };
+            let i_ms = median(
+                (0..FRAMES)
+                    .map(|_| off.draw_timed(&iso).unwrap() * 1e3)
+                    .collect(),
+            );
             println!(
-                "{name:<18} {level:>6} {:>9.3} {:>10} {s_ms:>12.1} {v_ms:>12.1}",
+                "{name:<18} {level:>6} {:>9.3} {:>10} {s_ms:>10.1} {h_ms:>10.1} {v_ms:>10.1} {i_ms:>10.1}",
                 b.bake_seconds,
                 b.voxel_count()
             );
+            if *name == "sphere_1_node" {
+                reference.push(b.distance.clone());
+            } else if *name == "sphere_200_nodes" {
+                let same = reference.get(levels.iter().position(|l| *l == level).unwrap())
+                    == Some(&b.distance);
+                println!(
+                    "{:<18} {level:>6} distance texture identical to sphere_1_node: {same}",
+                    ""
+                );
+            }
             if level == 128 {
-                off.render(&solid).unwrap().save(out.join(format!("{name}_solid.png"))).unwrap();
-                off.render(&volume).unwrap().save(out.join(format!("{name}_volume.png"))).unwrap();
+                off.render(&solid)
+                    .unwrap()
+                    .save(out.join(format!("{name}_solid.png")))
+                    .unwrap();
+                off.render(&volume)
+                    .unwrap()
+                    .save(out.join(format!("{name}_volume.png")))
+                    .unwrap();
             }
         }
     }
@@ -97,13 +164,14 @@ fn main() {
     for &level in levels {
         let b = bake_blocking(&model, level).unwrap();
         off.upload(&b);
-        for bias in [0.0, 0.2, volcad_render::THIN_BIAS_VOXELS] {
+        for bias in [0.0, volcad_render::THIN_BIAS_VOXELS, 0.35] {
             off.renderer_mut().set_thin_bias_voxels(bias);
             let img = off.render(&s).unwrap();
             let (mut inside, mut hit) = (0u32, 0u32);
             for y in 0..FRAME[1] {
                 for x in 0..FRAME[0] {
-                    if ((x as f32 - cx as f32).powi(2) + (y as f32 - cy as f32).powi(2)).sqrt() < r {
+                    if ((x as f32 - cx as f32).powi(2) + (y as f32 - cy as f32).powi(2)).sqrt() < r
+                    {
                         inside += 1;
                         hit += is_fg(&img, x, y, bg) as u32;
                     }
@@ -114,9 +182,14 @@ fn main() {
                 b.voxel_size_mm,
                 100.0 * hit as f32 / inside as f32
             );
-            img.save(out.join(format!("bcc_front_{level}_bias{:02}.png", (bias * 100.0) as u32))).unwrap();
+            img.save(out.join(format!(
+                "bcc_front_{level}_bias{:02}.png",
+                (bias * 100.0) as u32
+            )))
+            .unwrap();
         }
-        off.renderer_mut().set_thin_bias_voxels(volcad_render::THIN_BIAS_VOXELS);
+        off.renderer_mut()
+            .set_thin_bias_voxels(volcad_render::THIN_BIAS_VOXELS);
     }
     println!("images in {}", out.display());
 }

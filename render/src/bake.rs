@@ -115,7 +115,11 @@ impl VolumeBake {
 
     /// World-space box of the grid (mm).
     pub fn grid_box(&self) -> (Vec3, Vec3) {
-        let d = Vec3::new(self.dims[0] as f32, self.dims[1] as f32, self.dims[2] as f32);
+        let d = Vec3::new(
+            self.dims[0] as f32,
+            self.dims[1] as f32,
+            self.dims[2] as f32,
+        );
         (self.origin, self.origin + d * self.voxel)
     }
 
@@ -140,7 +144,17 @@ impl VolumeBake {
 }
 
 fn palette(model: &Model) -> Vec<[u8; 4]> {
-    model.materials().iter().map(|id| model.table().get(*id).map(|m| m.rgba()).unwrap_or([255, 0, 255, 255])).collect()
+    model
+        .materials()
+        .iter()
+        .map(|id| {
+            model
+                .table()
+                .get(*id)
+                .map(|m| m.rgba())
+                .unwrap_or([255, 0, 255, 255])
+        })
+        .collect()
 }
 
 /// Bake `model` with `resolution` voxels along the longest side of its
@@ -161,7 +175,11 @@ pub fn bake(model: &Model, resolution: u32, cancel: &AtomicBool) -> Result<Volum
     }
     let resolution = resolution.max(2);
     let voxel = (bbox.size().max_element() / resolution as f64).max(1e-9);
-    let grid = Grid::covering(&bbox.expand(PAD_VOXELS * voxel), DVec3::splat(voxel), MAX_BAKE_VOXELS)?;
+    let grid = Grid::covering(
+        &bbox.expand(PAD_VOXELS * voxel),
+        DVec3::splat(voxel),
+        MAX_BAKE_VOXELS,
+    )?;
     let [nx, ny, nz] = grid.dims;
     let layer = nx * ny;
     let n = layer * nz;
@@ -202,7 +220,14 @@ pub fn bake(model: &Model, resolution: u32, cancel: &AtomicBool) -> Result<Volum
             });
         z0 = z1;
     }
-    dilate(&mut color, &mut fractions, &distance, grid.dims, voxel as f32, cancel)?;
+    dilate(
+        &mut color,
+        &mut fractions,
+        &distance,
+        grid.dims,
+        voxel as f32,
+        cancel,
+    )?;
 
     Ok(VolumeBake {
         dims: [nx as u32, ny as u32, nz as u32],
@@ -258,7 +283,11 @@ fn dilate(
 ) -> Result<(), BakeError> {
     let [nx, ny, nz] = dims;
     let near = 3.0 * voxel;
-    let mut filled: Vec<bool> = color.par_iter().zip(fractions.par_iter()).map(|(c, f)| c[3] > 0 || f.iter().any(|v| *v > 0)).collect();
+    let mut filled: Vec<bool> = color
+        .par_iter()
+        .zip(fractions.par_iter())
+        .map(|(c, f)| c[3] > 0 || f.iter().any(|v| *v > 0))
+        .collect();
     for _pass in 0..2 {
         if cancel.load(Ordering::Relaxed) {
             return Err(BakeError::Cancelled);

@@ -45,7 +45,10 @@ const ORBIT_PER_PIXEL: f32 = 0.008;
 
 impl Default for Camera {
     fn default() -> Self {
-        Camera::fit(&Aabb::new(glam::DVec3::splat(-10.0), glam::DVec3::splat(10.0)), StandardView::Iso)
+        Camera::fit(
+            &Aabb::new(glam::DVec3::splat(-10.0), glam::DVec3::splat(10.0)),
+            StandardView::Iso,
+        )
     }
 }
 
@@ -56,7 +59,10 @@ impl Camera {
         let (target, radius) = if bbox.is_empty() || !bbox.is_finite() {
             (Vec3::ZERO, 10.0)
         } else {
-            (bbox.center().as_vec3(), (bbox.half_diagonal() as f32).max(1e-3))
+            (
+                bbox.center().as_vec3(),
+                (bbox.half_diagonal() as f32).max(1e-3),
+            )
         };
         let d = std::f32::consts::PI / 180.0;
         let (yaw, pitch) = match view {
@@ -67,7 +73,14 @@ impl Camera {
             StandardView::Bottom => (-90.0 * d, -90.0 * d),
         };
         let fov_y = 35.0 * d;
-        let mut cam = Camera { target, distance: 1.0, yaw, pitch, fov_y, orthographic: false };
+        let mut cam = Camera {
+            target,
+            distance: 1.0,
+            yaw,
+            pitch,
+            fov_y,
+            orthographic: false,
+        };
         cam.frame(radius);
         cam
     }
@@ -108,7 +121,8 @@ impl Camera {
     pub fn orbit(&mut self, dx: f32, dy: f32) {
         self.yaw -= dx * ORBIT_PER_PIXEL;
         self.yaw = self.yaw.rem_euclid(std::f32::consts::TAU);
-        self.pitch = (self.pitch + dy * ORBIT_PER_PIXEL).clamp(-std::f32::consts::FRAC_PI_2, std::f32::consts::FRAC_PI_2);
+        self.pitch = (self.pitch + dy * ORBIT_PER_PIXEL)
+            .clamp(-std::f32::consts::FRAC_PI_2, std::f32::consts::FRAC_PI_2);
     }
 
     /// Pan by a drag of `dx, dy` pixels in a viewport `viewport_h` pixels

@@ -47,20 +47,32 @@ impl Offscreen {
             compatible_surface: None,
             ..Default::default()
         }))
-        .map_err(|_| RenderError::NoAdapter { backends: format!("{backends:?}") })?;
+        .map_err(|_| RenderError::NoAdapter {
+            backends: format!("{backends:?}"),
+        })?;
         let info = adapter.get_info();
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("volcad offscreen"),
-            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
-            ..Default::default()
-        }))?;
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+                label: Some("volcad offscreen"),
+                required_limits:
+                    wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+                ..Default::default()
+            }))?;
         let max = device.limits().max_texture_dimension_2d;
         if size[0] == 0 || size[1] == 0 || size[0] > max || size[1] > max {
-            return Err(RenderError::BadSize { width: size[0], height: size[1], max });
+            return Err(RenderError::BadSize {
+                width: size[0],
+                height: size[1],
+                max,
+            });
         }
         let target = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("volcad offscreen target"),
-            size: wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
+            size: wgpu::Extent3d {
+                width: size[0],
+                height: size[1],
+                depth_or_array_layers: 1,
+            },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
@@ -68,7 +80,8 @@ impl Offscreen {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
-        let padded_row = (size[0] * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let padded_row = (size[0] * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let readback = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("volcad readback"),
             size: padded_row as u64 * size[1] as u64,
@@ -77,7 +90,16 @@ impl Offscreen {
         });
         let renderer = Renderer::new(&device, FORMAT);
         let adapter = format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type);
-        Ok(Offscreen { device, queue, renderer, target, readback, size, padded_row, adapter })
+        Ok(Offscreen {
+            device,
+            queue,
+            renderer,
+            target,
+            readback,
+            size,
+            padded_row,
+            adapter,
+        })
     }
 
     /// The adapter's name, backend and type (for reports).
@@ -107,7 +129,10 @@ impl Offscreen {
         let cmd = self.encode(settings, false);
         let idx = self.queue.submit([cmd]);
         self.device
-            .poll(wgpu::PollType::Wait { submission_index: Some(idx), timeout: None })
+            .poll(wgpu::PollType::Wait {
+                submission_index: Some(idx),
+                timeout: None,
+            })
             .map_err(|e| RenderError::Readback(e.to_string()))?;
         Ok(start.elapsed().as_secs_f64())
     }
@@ -122,7 +147,10 @@ impl Offscreen {
             let _ = tx.send(r);
         });
         self.device
-            .poll(wgpu::PollType::Wait { submission_index: Some(idx), timeout: None })
+            .poll(wgpu::PollType::Wait {
+                submission_index: Some(idx),
+                timeout: None,
+            })
             .map_err(|e| RenderError::Readback(e.to_string()))?;
         rx.recv()
             .map_err(|e| RenderError::Readback(e.to_string()))?
@@ -130,19 +158,29 @@ impl Offscreen {
         let [w, h] = self.size;
         let mut pixels = Vec::with_capacity((w * h * 4) as usize);
         {
-            let view = slice.get_mapped_range().map_err(|e| RenderError::Readback(e.to_string()))?;
+            let view = slice
+                .get_mapped_range()
+                .map_err(|e| RenderError::Readback(e.to_string()))?;
             for row in view.chunks(self.padded_row as usize).take(h as usize) {
                 pixels.extend_from_slice(&row[..(w * 4) as usize]);
             }
         }
         self.readback.unmap();
-        image::RgbaImage::from_raw(w, h, pixels).ok_or_else(|| RenderError::Readback("short image buffer".into()))
+        image::RgbaImage::from_raw(w, h, pixels)
+            .ok_or_else(|| RenderError::Readback("short image buffer".into()))
     }
 
     fn encode(&mut self, settings: &ViewSettings, copy: bool) -> wgpu::CommandBuffer {
-        let view = self.target.create_view(&wgpu::TextureViewDescriptor::default());
-        let mut enc = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("volcad offscreen") });
-        self.renderer.prepare_scaled(&self.device, &self.queue, &mut enc, settings, self.size);
+        let view = self
+            .target
+            .create_view(&wgpu::TextureViewDescriptor::default());
+        let mut enc = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("volcad offscreen"),
+            });
+        self.renderer
+            .prepare_scaled(&self.device, &self.queue, &mut enc, settings, self.size);
         {
             let [r, g, b, a] = settings.background.map(|c| c as f64);
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -151,7 +189,10 @@ impl Offscreen {
                     view: &view,
                     depth_slice: None,
                     resolve_target: None,
-                    ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a }), store: wgpu::StoreOp::Store },
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a }),
+                        store: wgpu::StoreOp::Store,
+                    },
                 })],
                 depth_stencil_attachment: None,
                 timestamp_writes: None,
@@ -171,9 +212,17 @@ impl Offscreen {
                 },
                 wgpu::TexelCopyBufferInfo {
                     buffer: &self.readback,
-                    layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(self.padded_row), rows_per_image: Some(h) },
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(self.padded_row),
+                        rows_per_image: Some(h),
+                    },
                 },
-                wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+                wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
             );
         }
         enc.finish()
@@ -188,7 +237,11 @@ pub fn render_offscreen(
     bake_resolution: u32,
 ) -> Result<image::RgbaImage, RenderError> {
     let mut off = Offscreen::new(size)?;
-    let b = bake(model, bake_resolution, &std::sync::atomic::AtomicBool::new(false))?;
+    let b = bake(
+        model,
+        bake_resolution,
+        &std::sync::atomic::AtomicBool::new(false),
+    )?;
     off.upload(&b);
     off.render(settings)
 }

@@ -21,7 +21,13 @@ pub struct ProbeHit {
 /// Sphere-trace `model` along the camera ray through `ndc` (−1..1, y up)
 /// with the exact (lower-bound) distance, clipped by `cut` if given.
 /// `None` when the ray misses.
-pub fn probe(model: &Model, camera: &Camera, cut: Option<&CutPlane>, ndc: Vec2, aspect: f32) -> Option<ProbeHit> {
+pub fn probe(
+    model: &Model,
+    camera: &Camera,
+    cut: Option<&CutPlane>,
+    ndc: Vec2,
+    aspect: f32,
+) -> Option<ProbeHit> {
     let bbox = model.bbox();
     if bbox.is_empty() || !bbox.is_finite() {
         return None;
@@ -36,7 +42,7 @@ pub fn probe(model: &Model, camera: &Camera, cut: Option<&CutPlane>, ndc: Vec2, 
     let t1 = (b.max - o) * inv;
     let tmin = t0.min(t1).max_element().max(0.0);
     let tmax = t0.max(t1).min_element();
-    if !(tmin <= tmax) {
+    if tmin.is_nan() || tmax.is_nan() || tmin > tmax {
         return None;
     }
     let eps = scale * 1e-5;
@@ -62,7 +68,11 @@ pub fn probe(model: &Model, camera: &Camera, cut: Option<&CutPlane>, ndc: Vec2, 
                 if sdf(p) <= 0.0 {
                     let (_, fr) = model.eval_point(p);
                     let fractions = fr.into_iter().filter(|(_, f)| *f > 0.0).collect();
-                    return Some(ProbeHit { point: p, distance: tt, fractions });
+                    return Some(ProbeHit {
+                        point: p,
+                        distance: tt,
+                        fractions,
+                    });
                 }
                 tt += eps;
             }

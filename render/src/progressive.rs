@@ -31,7 +31,11 @@ impl ProgressiveBaker {
     /// Start baking `model` at each of `levels` (voxels along the longest
     /// side; use [`DEFAULT_LEVELS`] unless the user picked a quality), calling
     /// `wake` after each level and when finished or failed.
-    pub fn start(model: Arc<Model>, levels: Vec<u32>, wake: impl Fn() + Send + Sync + 'static) -> Self {
+    pub fn start(
+        model: Arc<Model>,
+        levels: Vec<u32>,
+        wake: impl Fn() + Send + Sync + 'static,
+    ) -> Self {
         Self::spawn(model, levels, Arc::new(wake))
     }
 
@@ -40,33 +44,50 @@ impl ProgressiveBaker {
         let done = Arc::new(AtomicBool::new(false));
         let error = Arc::new(Mutex::new(None));
         let (tx, rx) = sync_channel(levels.len().max(1));
-        let (c, d, e, w, lv) = (cancel.clone(), done.clone(), error.clone(), wake.clone(), levels.clone());
-        let spawned = std::thread::Builder::new().name("volcad-bake".into()).spawn(move || {
-            for level in lv {
-                match bake(&model, level, &c) {
-                    Ok(b) => {
-                        if c.load(Ordering::Relaxed) || tx.send(Arc::new(b)).is_err() {
+        let (c, d, e, w, lv) = (
+            cancel.clone(),
+            done.clone(),
+            error.clone(),
+            wake.clone(),
+            levels.clone(),
+        );
+        let spawned = std::thread::Builder::new()
+            .name("volcad-bake".into())
+            .spawn(move || {
+                for level in lv {
+                    match bake(&model, level, &c) {
+                        Ok(b) => {
+                            if c.load(Ordering::Relaxed) || tx.send(Arc::new(b)).is_err() {
+                                break;
+                            }
+                            w();
+                        }
+                        Err(BakeError::Cancelled) => break,
+                        Err(err) => {
+                            *e.lock().unwrap_or_else(|p| p.into_inner()) = Some(err);
                             break;
                         }
-                        w();
-                    }
-                    Err(BakeError::Cancelled) => break,
-                    Err(err) => {
-                        *e.lock().unwrap_or_else(|p| p.into_inner()) = Some(err);
-                        break;
                     }
                 }
-            }
-            d.store(true, Ordering::Release);
-            w();
-        });
+                d.store(true, Ordering::Release);
+                w();
+            });
         if let Err(err) = spawned {
             // No thread: report it as done, with nothing baked.
             *error.lock().unwrap_or_else(|p| p.into_inner()) =
-                Some(BakeError::Grid(volcad_core::sampler::GridError::Unbounded(format!("could not start the bake thread: {err}"))));
+                Some(BakeError::Grid(volcad_core::sampler::GridError::Unbounded(
+                    format!("could not start the bake thread: {err}"),
+                )));
             done.store(true, Ordering::Release);
         }
-        ProgressiveBaker { cancel, done, error, rx, levels, wake }
+        ProgressiveBaker {
+            cancel,
+            done,
+            error,
+            rx,
+            levels,
+            wake,
+        }
     }
 
     /// Cancel the bake in flight and start baking `model` (same levels and

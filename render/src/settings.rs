@@ -89,11 +89,21 @@ impl Default for ViewSettings {
 impl ViewSettings {
     /// Settings with `camera` and no overlays (what tests and the CLI use).
     pub fn plain(camera: Camera) -> Self {
-        ViewSettings { camera, show_bbox: false, show_grid: false, show_axes: false, ..Default::default() }
+        ViewSettings {
+            camera,
+            show_bbox: false,
+            show_grid: false,
+            show_axes: false,
+            ..Default::default()
+        }
     }
 
     /// Opacity of model material `i` (1 when not listed).
     pub fn opacity(&self, i: usize) -> f32 {
-        self.material_opacity.get(i).copied().unwrap_or(1.0).clamp(0.0, 1.0)
+        self.material_opacity
+            .get(i)
+            .copied()
+            .unwrap_or(1.0)
+            .clamp(0.0, 1.0)
     }
 }

@@ -67,5 +67,9 @@ impl egui_wgpu::CallbackTrait for ViewportCallback {
 /// in the callback resources (call once, at startup).
 pub fn register(render_state: &egui_wgpu::RenderState) {
     let renderer = Renderer::new(&render_state.device, render_state.target_format);
-    render_state.renderer.write().callback_resources.insert(renderer);
+    render_state
+        .renderer
+        .write()
+        .callback_resources
+        .insert(renderer);
 }

@@ -31,13 +31,19 @@ fn bake_covers_the_box_with_padding_and_colours() {
     assert!(f[1] > 200 && f[0] < 30, "{f:?}");
     // Far outside voxels stay empty: bake a box with room around it.
     let far = bake(&common::model(SPHERE), 32, &AtomicBool::new(false)).unwrap();
-    assert_eq!(far.fractions[0], [0; 4], "corner of a sphere's grid is empty");
+    assert_eq!(
+        far.fractions[0], [0; 4],
+        "corner of a sphere's grid is empty"
+    );
 }
 
 #[test]
 fn bake_cancels() {
     let model = model(BCC_SPHERE);
-    assert_eq!(bake(&model, 64, &AtomicBool::new(true)).unwrap_err(), BakeError::Cancelled);
+    assert_eq!(
+        bake(&model, 64, &AtomicBool::new(true)).unwrap_err(),
+        BakeError::Cancelled
+    );
 }
 
 #[test]
@@ -59,7 +65,10 @@ fn progressive_baker_sends_each_level_then_finishes() {
     }
     let last = baker.try_recv().map(|b| b.resolution).or(first);
     assert_eq!(last, Some(24), "finest level last (first seen: {first:?})");
-    assert!(wakes.load(Ordering::SeqCst) >= 3, "wake after each level and at the end");
+    assert!(
+        wakes.load(Ordering::SeqCst) >= 3,
+        "wake after each level and at the end"
+    );
     assert!(baker.error().is_none());
 }
 
@@ -71,7 +80,10 @@ fn progressive_baker_restart_replaces_the_model() {
     baker.restart(small);
     let start = Instant::now();
     while !baker.is_done() {
-        assert!(start.elapsed() < Duration::from_secs(60), "restart did not finish");
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "restart did not finish"
+        );
         std::thread::sleep(Duration::from_millis(5));
     }
     let b = baker.try_recv().expect("a bake of the new model");
@@ -86,10 +98,18 @@ fn probe_hits_the_front_face_with_fractions() {
     assert!((hit.point.y + 5.0).abs() < 1e-3, "{:?}", hit.point);
     let total: f64 = hit.fractions.iter().map(|f| f.1).sum();
     assert!((total - 1.0).abs() < 1e-6);
-    assert!(hit.fractions.iter().all(|f| (f.1 - 0.5).abs() < 0.01), "{:?}", hit.fractions);
+    assert!(
+        hit.fractions.iter().all(|f| (f.1 - 0.5).abs() < 0.01),
+        "{:?}",
+        hit.fractions
+    );
     assert!(probe(&model, &cam, None, Vec2::new(0.99, 0.99), 1.5).is_none());
     // A cut at y = 0 keeping y >= 0 moves the hit to the cut face.
-    let cut = CutPlane { axis: 1, offset: 0.0, keep_below: false };
+    let cut = CutPlane {
+        axis: 1,
+        offset: 0.0,
+        keep_below: false,
+    };
     let hit = probe(&model, &cam, Some(&cut), Vec2::ZERO, 1.5).expect("hits the cut face");
     assert!(hit.point.y.abs() < 1e-3, "{:?}", hit.point);
 }
@@ -97,7 +117,13 @@ fn probe_hits_the_front_face_with_fractions() {
 #[test]
 fn camera_rays_agree_with_view_proj() {
     let bbox = model(GRADED_BAR).bbox();
-    for view in [StandardView::Iso, StandardView::Top, StandardView::Front, StandardView::Side, StandardView::Bottom] {
+    for view in [
+        StandardView::Iso,
+        StandardView::Top,
+        StandardView::Front,
+        StandardView::Side,
+        StandardView::Bottom,
+    ] {
         for ortho in [false, true] {
             let mut cam = Camera::fit(&bbox, view);
             cam.orthographic = ortho;
@@ -106,7 +132,10 @@ fn camera_rays_agree_with_view_proj() {
             let p = o + d * cam.distance * 0.9;
             let c = cam.view_proj(1.6) * p.extend(1.0);
             let got = Vec2::new(c.x / c.w, c.y / c.w);
-            assert!((got - ndc).length() < 1e-3, "{view:?} ortho={ortho}: {got:?}");
+            assert!(
+                (got - ndc).length() < 1e-3,
+                "{view:?} ortho={ortho}: {got:?}"
+            );
             assert!(c.z / c.w > 0.0 && c.z / c.w < 1.0);
         }
     }
@@ -130,5 +159,34 @@ fn zoom_keeps_the_point_under_the_cursor() {
     let h = cam.half_height_at_target();
     let after = cam.target + r * (ndc.x * h * 1.5) + u * (ndc.y * h);
     assert!((before - after).length() < 1e-4);
-    assert!((cam.distance - Camera::fit(&model(SPHERE).bbox(), StandardView::Iso).distance * 0.5).abs() < 1e-3);
+    assert!(
+        (cam.distance - Camera::fit(&model(SPHERE).bbox(), StandardView::Iso).distance * 0.5).abs()
+            < 1e-3
+    );
+}
+
+#[test]
+fn more_than_four_materials_keep_four_fraction_channels() {
+    let model = model(
+        r#"let m = default_materials();
+        Union(false, [Sphere(Vec3(0,0,0), 2, m.id("red")), Sphere(Vec3(5,0,0), 2, m.id("green")),
+                      Sphere(Vec3(10,0,0), 2, m.id("blue")), Sphere(Vec3(15,0,0), 2, m.id("yellow")),
+                      Sphere(Vec3(20,0,0), 2, m.id("cyan"))])"#,
+    );
+    let b = bake(&model, 48, &AtomicBool::new(false)).unwrap();
+    assert_eq!(b.materials.len(), 5);
+    assert_eq!(b.channels, vec![0, 1, 2, 3]);
+    assert_eq!(b.channel_of(4), None);
+    // The fifth material is in the colour volume.
+    let v = (
+        ((20.0 - b.origin.x) / b.voxel.x) as u32,
+        ((0.0 - b.origin.y) / b.voxel.y) as u32,
+        ((0.0 - b.origin.z) / b.voxel.z) as u32,
+    );
+    let c = b.color[b.index(v.0, v.1, v.2)];
+    assert!(
+        c[0] < 10 && c[1] > 245 && c[2] > 245,
+        "cyan sphere colour {c:?}"
+    );
+    assert_eq!(b.fractions[b.index(v.0, v.1, v.2)], [0; 4]);
 }

@@ -5,12 +5,23 @@ use std::path::Path;
 use wgpu::naga;
 
 fn validate(path: &Path) {
-    let src = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("read {}: {e}", path.display()));
-    let module = naga::front::wgsl::parse_str(&src)
-        .unwrap_or_else(|e| panic!("{}", e.emit_to_string_with_path(&src, path.to_string_lossy().as_ref())));
-    let mut validator = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::empty());
+    let src =
+        std::fs::read_to_string(path).unwrap_or_else(|e| panic!("read {}: {e}", path.display()));
+    let module = naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| {
+        panic!(
+            "{}",
+            e.emit_to_string_with_path(&src, path.to_string_lossy().as_ref())
+        )
+    });
+    let mut validator = naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::empty(),
+    );
     if let Err(e) = validator.validate(&module) {
-        panic!("{}", e.emit_to_string_with_path(&src, path.to_string_lossy().as_ref()));
+        panic!(
+            "{}",
+            e.emit_to_string_with_path(&src, path.to_string_lossy().as_ref())
+        );
     }
 }
 

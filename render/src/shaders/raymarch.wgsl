@@ -37,7 +37,8 @@ override VOLUME: bool = false;
 override REGION: bool = false;
 
 const MAX_STEPS: i32 = 384;
-const MAX_VOLUME_STEPS: i32 = 768;
+const MAX_VOLUME_STEPS: i32 = 320;
+const VOLUME_SAMPLES: f32 = 224.0;
 const BIG: f32 = 1.0e30;
 
 struct VsOut {
@@ -175,7 +176,7 @@ fn shade(base: vec3f, p: vec3f, n_in: vec3f, rd: vec3f) -> vec3f {
     let ao = occlusion(p, n);
     let h = normalize(l + v);
     let spec = pow(max(dot(n, h), 0.0), 48.0) * 0.18;
-    let light = ao * (0.20 + 0.10 * sky) + 0.55 * diff + 0.20 * fill;
+    let light = ao * (0.24 + 0.10 * sky) + 0.50 * diff + 0.24 * fill;
     return base * light + vec3f(spec);
 }
 
@@ -261,9 +262,11 @@ fn march_surface(r: Ray) -> Hit {
                 hit.inner = REGION && inside_prev;
                 break;
             }
+            // Inside the part but outside the region: fractions vary
+            // smoothly, so step a voxel and bisect the crossing afterwards.
             inside_prev = true;
             t_prev = t;
-            t += 0.5 * voxel;
+            t += voxel;
         } else {
             inside_prev = false;
             t_prev = t;
@@ -281,7 +284,7 @@ fn shade_hit(r: Ray, h: Hit) -> vec3f {
         // Region boundary inside the part: bisect it, normal from its gradient.
         var a = h.t_prev;
         var b = h.t;
-        for (var k = 0; k < 6; k++) {
+        for (var k = 0; k < 7; k++) {
             let m = 0.5 * (a + b);
             if (region(r.o + r.d * m) > 0.0) { b = m; } else { a = m; }
         }
@@ -308,7 +311,9 @@ fn march_volume(r: Ray) -> vec4f {
         return vec4f(0.0, 0.0, 0.0, 1.0);
     }
     let voxel = u.grid_min.w;
-    let dt = max(0.5 * voxel, (span.y - span.x) / f32(MAX_VOLUME_STEPS - 64));
+    // At most VOLUME_SAMPLES samples through the grid box (plus the empty
+    // space skips): the frame cost stays bounded at 256³.
+    let dt = max(voxel, (span.y - span.x) / VOLUME_SAMPLES);
     var t = span.x;
     var acc = vec3f(0.0);
     var trans = 1.0;
@@ -475,9 +480,15 @@ fn fs_main(in: VsOut) -> @location(0) vec4f {
     var t_hit = BIG;
     let has_volume = u.bbox_min.w > 0.5;
     if (has_volume) {
+        let contrast = select(vec3f(0.0), vec3f(1.0), dot(u.background.rgb, vec3f(0.333)) < 0.5);
         if (VOLUME) {
+            // The grid lies behind the translucent part: composite over it.
+            var behind = u.background.rgb;
+            if ((u.flags.y & 2u) != 0u) {
+                behind = mix(behind, contrast, grid_overlay(r, BIG) * 0.5);
+            }
             let v = march_volume(r);
-            color = v.rgb + v.a * u.background.rgb;
+            color = v.rgb + v.a * behind;
         } else {
             let h = march_surface(r);
             if (h.t < BIG) {
@@ -485,8 +496,7 @@ fn fs_main(in: VsOut) -> @location(0) vec4f {
                 color = shade_hit(r, h);
             }
         }
-        let contrast = select(vec3f(0.0), vec3f(1.0), dot(u.background.rgb, vec3f(0.333)) < 0.5);
-        if ((u.flags.y & 2u) != 0u) {
+        if (!VOLUME && (u.flags.y & 2u) != 0u) {
             color = mix(color, contrast, grid_overlay(r, t_hit) * 0.5);
         }
         if ((u.flags.y & 1u) != 0u) {

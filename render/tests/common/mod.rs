@@ -10,8 +10,12 @@ use volcad_render::Camera;
 
 /// Prepare a model from a Rhai script.
 pub fn model(src: &str) -> Model {
-    let d = volcad_core::script::run_script(src, "t.rhai", &volcad_core::script::ScriptOptions::default())
-        .unwrap_or_else(|e| panic!("script failed: {e}"));
+    let d = volcad_core::script::run_script(
+        src,
+        "t.rhai",
+        &volcad_core::script::ScriptOptions::default(),
+    )
+    .unwrap_or_else(|e| panic!("script failed: {e}"));
     Model::prepare(&d.root, d.materials.clone()).expect("prepare")
 }
 
@@ -66,7 +70,8 @@ pub fn out_dir() -> PathBuf {
 /// Save an image for inspection; returns its path.
 pub fn save(img: &image::RgbaImage, name: &str) -> PathBuf {
     let path = out_dir().join(name);
-    img.save(&path).unwrap_or_else(|e| panic!("save {}: {e}", path.display()));
+    img.save(&path)
+        .unwrap_or_else(|e| panic!("save {}: {e}", path.display()));
     eprintln!("wrote {}", path.display());
     path
 }
@@ -76,8 +81,12 @@ pub fn project(cam: &Camera, p: Vec3, size: [u32; 2]) -> (u32, u32) {
     let aspect = size[0] as f32 / size[1] as f32;
     let c = cam.view_proj(aspect) * p.extend(1.0);
     let ndc = c.xy() / c.w;
-    let x = ((ndc.x * 0.5 + 0.5) * size[0] as f32).floor().clamp(0.0, size[0] as f32 - 1.0);
-    let y = ((0.5 - ndc.y * 0.5) * size[1] as f32).floor().clamp(0.0, size[1] as f32 - 1.0);
+    let x = ((ndc.x * 0.5 + 0.5) * size[0] as f32)
+        .floor()
+        .clamp(0.0, size[0] as f32 - 1.0);
+    let y = ((0.5 - ndc.y * 0.5) * size[1] as f32)
+        .floor()
+        .clamp(0.0, size[1] as f32 - 1.0);
     (x as u32, y as u32)
 }
 
