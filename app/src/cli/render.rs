@@ -36,6 +36,10 @@ pub struct RenderArgs {
     /// Orthographic projection.
     #[arg(long)]
     pub ortho: bool,
+    /// Hide a material by name (repeatable), e.g. `--hide clear` to see the
+    /// bunny's struts through its clear body.
+    #[arg(long = "hide", value_name = "MATERIAL")]
+    pub hide: Vec<String>,
 }
 
 fn parse_view(v: &str) -> anyhow::Result<StandardView> {
@@ -50,9 +54,15 @@ fn parse_view(v: &str) -> anyhow::Result<StandardView> {
 }
 
 fn parse_size(s: &str) -> anyhow::Result<[u32; 2]> {
-    let (w, h) = s.split_once('x').with_context(|| format!("--size {s}: expected WIDTHxHEIGHT, e.g. 1024x768"))?;
-    let w: u32 = w.parse().with_context(|| format!("--size {s}: bad width"))?;
-    let h: u32 = h.parse().with_context(|| format!("--size {s}: bad height"))?;
+    let (w, h) = s
+        .split_once('x')
+        .with_context(|| format!("--size {s}: expected WIDTHxHEIGHT, e.g. 1024x768"))?;
+    let w: u32 = w
+        .parse()
+        .with_context(|| format!("--size {s}: bad width"))?;
+    let h: u32 = h
+        .parse()
+        .with_context(|| format!("--size {s}: bad height"))?;
     if !(16..=8192).contains(&w) || !(16..=8192).contains(&h) {
         bail!("--size {s}: width and height must be within 16..=8192");
     }
@@ -60,15 +70,24 @@ fn parse_size(s: &str) -> anyhow::Result<[u32; 2]> {
 }
 
 fn parse_cut(s: &str) -> anyhow::Result<CutPlane> {
-    let (axis, off) = s.split_once('=').with_context(|| format!("--cut {s}: expected AXIS=OFFSET, e.g. z=0"))?;
+    let (axis, off) = s
+        .split_once('=')
+        .with_context(|| format!("--cut {s}: expected AXIS=OFFSET, e.g. z=0"))?;
     let axis = match axis.trim() {
         "x" => 0,
         "y" => 1,
         "z" => 2,
         a => bail!("--cut {s}: axis {a:?} is not x, y or z"),
     };
-    let offset: f32 = off.trim().parse().with_context(|| format!("--cut {s}: {off:?} is not a number"))?;
-    Ok(CutPlane { axis, offset, keep_below: true })
+    let offset: f32 = off
+        .trim()
+        .parse()
+        .with_context(|| format!("--cut {s}: {off:?} is not a number"))?;
+    Ok(CutPlane {
+        axis,
+        offset,
+        keep_below: true,
+    })
 }
 
 /// Run `volcad render`.
@@ -88,11 +107,26 @@ pub fn render(a: &RenderArgs) -> anyhow::Result<()> {
     }
     let mut camera = Camera::fit(&bbox, view);
     camera.orthographic = a.ortho;
+    let mut material_opacity = vec![1.0; l.model.materials().len()];
+    for name in &a.hide {
+        let id = l
+            .model
+            .table()
+            .id(name)
+            .with_context(|| format!("--hide {name}"))?;
+        let slot = l
+            .model
+            .materials()
+            .iter()
+            .position(|m| *m == id)
+            .with_context(|| format!("--hide {name}: the design does not use this material"))?;
+        material_opacity[slot] = 0.0;
+    }
     let settings = ViewSettings {
         camera,
         mode,
         cut,
-        material_opacity: vec![1.0; l.model.materials().len()],
+        material_opacity,
         ..ViewSettings::default()
     };
     let img = volcad_render::render_offscreen(&l.model, &settings, size, a.resolution)?;

@@ -4,12 +4,14 @@
 //! gyroid `sin X cos Y + sin Y cos Z + sin Z cos X`, Schwarz P
 //! `cos X + cos Y + cos Z`, diamond
 //! `sin X sin Y sin Z + sin X cos Y cos Z + cos X sin Y cos Z + cos X cos Y sin Z`.
-//! The distance to the surface f = 0 is approximated to first order by
-//! `|f| / |∇f|` (exact in the limit near the surface, so the wall thickness
-//! is what the user asked for); the sheet is `|f|/|∇f| − t/2`. Where |∇f| is
-//! tiny (saddle points) the gradient is clamped to a fraction of its global
-//! maximum G so the value stays finite. For interval bounds we use that f is
-//! G-Lipschitz: |f(q)| ≥ |f(c)| − G·r over a ball of radius r.
+//! The distance to the surface f = 0 is `|f| / |∇f|` to first order, so the
+//! wall of thickness t is `{ |f| ≤ (t/2)·|∇f| }` (its thickness is what the
+//! user asked for). The field we return has exactly that zero set:
+//! `φ = (|f| − (t/2)·|∇f|) / G`, where G bounds |∇f| globally. Dividing by
+//! the global bound keeps φ from overestimating the distance (a first-order
+//! `|f|/|∇f|` overshoots near saddle points, which shows as speckles when
+//! sphere tracing). Intervals use that f is G-Lipschitz:
+//! `(|f(c)| − G·r)/G − t/2 ≤ φ ≤ (|f(c)| + G·r)/G` over a ball of radius r.
 
 use glam::DVec3;
 
@@ -70,22 +72,20 @@ impl Tpms {
         }
     }
 
-    /// Approximate signed distance to the sheet (see the module doc).
+    /// A distance bound to the sheet (see the module doc).
     #[inline]
     pub fn dist(&self, p: DVec3) -> f64 {
         let (f, grad) = self.field(p);
-        let g = grad.length().max(0.25 * self.g);
-        f.abs() / g - self.half_t
+        (f.abs() - self.half_t * grad.length()) / self.g
     }
 
     /// A conservative interval over `b`.
     pub fn interval(&self, b: &Aabb) -> Interval {
         let (f, _) = self.field(b.center());
         let r = b.half_diagonal();
-        // |f| ≥ |f(c)| − G r, and the value is ≥ |f| / (G) − t/2 because
-        // the clamped gradient never exceeds G.
         let lo = (f.abs() - self.g * r).max(0.0) / self.g - self.half_t;
-        Interval::new(lo, f64::INFINITY)
+        let hi = (f.abs() + self.g * r) / self.g;
+        Interval::new(lo, hi)
     }
 }
 
