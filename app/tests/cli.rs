@@ -51,7 +51,11 @@ fn ok(o: &Output) -> String {
 
 fn fails(o: &Output) -> String {
     assert!(!o.status.success(), "expected failure, got success");
-    assert!(matches!(o.status.code(), Some(1) | Some(2)), "exit {:?}", o.status);
+    assert!(
+        matches!(o.status.code(), Some(1) | Some(2)),
+        "exit {:?}",
+        o.status
+    );
     let err = String::from_utf8_lossy(&o.stderr).to_string();
     assert!(!err.contains("panicked"), "{err}");
     err
@@ -60,20 +64,41 @@ fn fails(o: &Output) -> String {
 #[test]
 fn info_reports_box_materials_and_params() {
     let out = ok(&volcad(&["info", &example("graded_bar.rhai")]));
-    assert!(out.contains("[-7.5000, -5.0000, -2.5000] .. [7.5000, 5.0000, 2.5000]"), "{out}");
+    assert!(
+        out.contains("[-7.5000, -5.0000, -2.5000] .. [7.5000, 5.0000, 2.5000]"),
+        "{out}"
+    );
     assert!(out.contains("red (1), blue (3)"), "{out}");
     assert!(out.contains("param:       length = 15"), "{out}");
-    let out = ok(&volcad(&["info", &example("graded_bar.rhai"), "--param", "length=30"]));
+    let out = ok(&volcad(&[
+        "info",
+        &example("graded_bar.rhai"),
+        "--param",
+        "length=30",
+    ]));
     assert!(out.contains("[-15.0000"), "{out}");
 }
 
 #[test]
 fn eval_prints_distance_and_fractions_by_name() {
-    let out = ok(&volcad(&["eval", &example("graded_bar.rhai"), "3.75", "0", "0"]));
+    let out = ok(&volcad(&[
+        "eval",
+        &example("graded_bar.rhai"),
+        "3.75",
+        "0",
+        "0",
+    ]));
     assert!(out.contains("distance: -2.5"), "{out}");
     assert!(out.contains("red: 0.75"), "{out}");
     assert!(out.contains("blue: 0.25"), "{out}");
-    let out = ok(&volcad(&["eval", &example("graded_bar.rhai"), "--", "-20", "0", "0"]));
+    let out = ok(&volcad(&[
+        "eval",
+        &example("graded_bar.rhai"),
+        "--",
+        "-20",
+        "0",
+        "0",
+    ]));
     assert!(out.contains("outside"), "{out}");
 }
 
@@ -106,7 +131,11 @@ fn bad_input_is_a_clear_error() {
 
     let d = tmp("bad");
     let bad = d.join("bad.rhai");
-    std::fs::write(&bad, "let m = default_materials();\nSphere(Vec3(0,0,0), 1, m.id(\"rde\"))\n").unwrap();
+    std::fs::write(
+        &bad,
+        "let m = default_materials();\nSphere(Vec3(0,0,0), 1, m.id(\"rde\"))\n",
+    )
+    .unwrap();
     let err = fails(&volcad(&["info", bad.to_str().unwrap()]));
     assert!(err.contains("bad.rhai:2:"), "{err}");
     assert!(err.contains("did you mean \"red\""), "{err}");
@@ -121,13 +150,34 @@ fn bad_input_is_a_clear_error() {
         "--out",
         d.join("o.csv").to_str().unwrap(),
     ]));
-    assert!(err.contains("pts.csv:3: `y` = \"oops\" is not a finite number"), "{err}");
+    assert!(
+        err.contains("pts.csv:3: `y` = \"oops\" is not a finite number"),
+        "{err}"
+    );
 
-    let err = fails(&volcad(&["export", "png", &example("hello_cube.rhai"), "--out", d.join("x").to_str().unwrap(), "--voxel", "-1"]));
+    let err = fails(&volcad(&[
+        "export",
+        "png",
+        &example("hello_cube.rhai"),
+        "--out",
+        d.join("x").to_str().unwrap(),
+        "--voxel",
+        "-1",
+    ]));
     assert!(err.contains("--voxel -1: voxel sizes must be > 0"), "{err}");
     assert!(!d.join("x").exists());
 
-    let err = fails(&volcad(&["export", "png", &example("gyroid.rhai"), "--out", d.join("y").to_str().unwrap(), "--voxel", "0.5", "--param", "cell"]));
+    let err = fails(&volcad(&[
+        "export",
+        "png",
+        &example("gyroid.rhai"),
+        "--out",
+        d.join("y").to_str().unwrap(),
+        "--voxel",
+        "0.5",
+        "--param",
+        "cell",
+    ]));
     assert!(err.contains("expected NAME=VALUE"), "{err}");
 }
 
@@ -136,7 +186,15 @@ fn unbounded_design_refuses_to_export() {
     let d = tmp("unbounded");
     let s = d.join("tile.rhai");
     std::fs::write(&s, "Tile(4, 4, 4, Sphere(Vec3(0,0,0), 1, 1))").unwrap();
-    let err = fails(&volcad(&["export", "png", s.to_str().unwrap(), "--out", d.join("o").to_str().unwrap(), "--voxel", "0.5"]));
+    let err = fails(&volcad(&[
+        "export",
+        "png",
+        s.to_str().unwrap(),
+        "--out",
+        d.join("o").to_str().unwrap(),
+        "--voxel",
+        "0.5",
+    ]));
     assert!(err.contains("unbounded"), "{err}");
     assert!(!d.join("o").exists());
 }
@@ -154,21 +212,63 @@ fn files_in(dir: &Path) -> Vec<String> {
 fn export_png_mesh_and_fea() {
     let d = tmp("export");
     let png = d.join("png");
-    let out = ok(&volcad(&["export", "png", &example("graded_bar.rhai"), "--out", png.to_str().unwrap(), "--voxel", "0.5", "--seed", "3"]));
+    let out = ok(&volcad(&[
+        "export",
+        "png",
+        &example("graded_bar.rhai"),
+        "--out",
+        png.to_str().unwrap(),
+        "--voxel",
+        "0.5",
+        "--seed",
+        "3",
+    ]));
     assert!(out.contains("red") && out.contains("blue"), "{out}");
     let files = files_in(&png);
     assert!(files.contains(&"manifest.json".to_string()));
-    assert_eq!(files.iter().filter(|f| f.ends_with(".png")).count(), 10, "5 mm / 0.5 mm layers: {files:?}");
+    assert_eq!(
+        files.iter().filter(|f| f.ends_with(".png")).count(),
+        10,
+        "5 mm / 0.5 mm layers: {files:?}"
+    );
 
     let mesh = d.join("mesh");
-    ok(&volcad(&["export", "mesh", &example("graded_bar.rhai"), "--out", mesh.to_str().unwrap(), "--voxel", "0.5", "--segments", "2", "--by", "red"]));
+    ok(&volcad(&[
+        "export",
+        "mesh",
+        &example("graded_bar.rhai"),
+        "--out",
+        mesh.to_str().unwrap(),
+        "--voxel",
+        "0.5",
+        "--segments",
+        "2",
+        "--by",
+        "red",
+    ]));
     let files = files_in(&mesh);
     assert!(files.iter().any(|f| f.ends_with(".3mf")), "{files:?}");
-    assert!(files.iter().filter(|f| f.ends_with(".stl")).count() >= 2, "{files:?}");
+    assert!(
+        files.iter().filter(|f| f.ends_with(".stl")).count() >= 2,
+        "{files:?}"
+    );
 
     let fea = d.join("fea");
-    ok(&volcad(&["export", "fea", &example("graded_bar.rhai"), "--out", fea.to_str().unwrap(), "--voxel", "1", "--step", "-0.1"]));
+    ok(&volcad(&[
+        "export",
+        "fea",
+        &example("graded_bar.rhai"),
+        "--out",
+        fea.to_str().unwrap(),
+        "--voxel",
+        "1",
+        "--step",
+        "-0.1",
+    ]));
     let inp = std::fs::read_to_string(fea.join("model.inp")).unwrap();
-    assert!(inp.contains("*ELEMENT") || inp.contains("*Element"), "{inp}");
+    assert!(
+        inp.contains("*ELEMENT") || inp.contains("*Element"),
+        "{inp}"
+    );
     assert!(inp.to_uppercase().contains("NSET=NBOTTOM"));
 }

@@ -47,7 +47,12 @@ fn studio_binary_renders_the_design_under_xvfb() {
         String::from_utf8_lossy(&out.stderr)
     );
     let img = image::open(&shot).expect("screenshot written").to_rgba8();
-    assert!(img.width() >= 640 && img.height() >= 400, "{}x{}", img.width(), img.height());
+    assert!(
+        img.width() >= 640 && img.height() >= 400,
+        "{}x{}",
+        img.width(),
+        img.height()
+    );
     // The graded bar is red at +x and blue at -x: the viewport must contain
     // strongly red and strongly blue pixels, and purple blends between.
     let (mut red, mut blue, mut purple) = (0, 0, 0);
@@ -63,5 +68,8 @@ fn studio_binary_renders_the_design_under_xvfb() {
             purple += 1;
         }
     }
-    assert!(red > 500 && blue > 500 && purple > 500, "red {red}, blue {blue}, purple {purple}: the design is not on screen");
+    assert!(
+        red > 500 && blue > 500 && purple > 500,
+        "red {red}, blue {blue}, purple {purple}: the design is not on screen"
+    );
 }

@@ -35,7 +35,9 @@ struct Case {
 }
 
 fn load(file: &str) -> Arc<Model> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets/examples").join(file);
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../assets/examples")
+        .join(file);
     let src = std::fs::read_to_string(&path).expect("example");
     let d = run_script(&src, file, &ScriptOptions::for_file(&path)).expect("script");
     Arc::new(Model::prepare(&d.root, d.materials.clone()).expect("prepare"))
@@ -60,7 +62,9 @@ fn stage_times(model: &Model, voxel: f64, dither: Dither) -> (u64, f64, f64) {
     let mut z = 0;
     while z < nz {
         let z1 = (z + layers).min(nz);
-        sampler.sample_layers(z, z1, &mut slab, &cancel).expect("sample");
+        sampler
+            .sample_layers(z, z1, &mut slab, &cancel)
+            .expect("sample");
         z = z1;
     }
     let sample = t.elapsed().as_secs_f64();
@@ -71,15 +75,27 @@ fn stage_times(model: &Model, voxel: f64, dither: Dither) -> (u64, f64, f64) {
     let mut z = 0;
     while z < nz {
         let z1 = (z + layers).min(nz);
-        sampler.sample_layers(z, z1, &mut slab, &cancel).expect("sample");
+        sampler
+            .sample_layers(z, z1, &mut slab, &cancel)
+            .expect("sample");
         for l in 0..z1 - z {
-            let (d, f) = (&slab.dist[l * layer..(l + 1) * layer], &slab.fracs[l * layer * k..(l + 1) * layer * k]);
+            let (d, f) = (
+                &slab.dist[l * layer..(l + 1) * layer],
+                &slab.fracs[l * layer * k..(l + 1) * layer * k],
+            );
             match dither {
                 Dither::Random => {
                     use rayon::prelude::*;
                     codes.par_chunks_mut(nx).enumerate().for_each(|(y, c)| {
                         let v = y * nx;
-                        choose_random(1, ((z + l) * layer + v) as u64, &d[v..v + nx], &f[v * k..(v + nx) * k], k, c);
+                        choose_random(
+                            1,
+                            ((z + l) * layer + v) as u64,
+                            &d[v..v + nx],
+                            &f[v * k..(v + nx) * k],
+                            k,
+                            c,
+                        );
                     });
                 }
                 Dither::Diffusion => diffuser.layer(z + l, d, f, &mut codes),
@@ -92,18 +108,28 @@ fn stage_times(model: &Model, voxel: f64, dither: Dither) -> (u64, f64, f64) {
 
 fn run_job<F>(dir: &Path, work: F) -> (f64, volcad_compilers::Summary)
 where
-    F: FnOnce(&job::JobContext) -> Result<volcad_compilers::Summary, volcad_compilers::ExportError> + Send + 'static,
+    F: FnOnce(&job::JobContext) -> Result<volcad_compilers::Summary, volcad_compilers::ExportError>
+        + Send
+        + 'static,
 {
     let dest = dir.join("out");
     let t = Instant::now();
-    let s = job::spawn(dest.clone(), "bench".into(), work).join().expect("export");
+    let s = job::spawn(dest.clone(), "bench".into(), work)
+        .join()
+        .expect("export");
     let secs = t.elapsed().as_secs_f64();
     std::fs::remove_dir_all(&dest).expect("clean up");
     (secs, s)
 }
 
 fn bytes_of(dir: &Path) -> u64 {
-    std::fs::read_dir(dir).map(|d| d.filter_map(|e| e.ok()).map(|e| e.metadata().map(|m| m.len()).unwrap_or(0)).sum()).unwrap_or(0)
+    std::fs::read_dir(dir)
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .map(|e| e.metadata().map(|m| m.len()).unwrap_or(0))
+                .sum()
+        })
+        .unwrap_or(0)
 }
 
 fn main() {
@@ -111,18 +137,54 @@ fn main() {
     let tmp = tempfile::tempdir().expect("temp dir");
     println!("threads: {}", rayon::current_num_threads());
     let cases = [
-        Case { name: "cube", model: load("hello_cube.rhai"), png_voxel: 0.02, mesh_voxel: 0.05, by: SegmentBy::Dominant, segments: 1 },
-        Case { name: "graded_bar", model: load("graded_bar.rhai"), png_voxel: 0.02, mesh_voxel: 0.05, by: SegmentBy::Material(1), segments: 4 },
-        Case { name: "bcc_sphere", model: inline(BCC_SPHERE), png_voxel: 0.04, mesh_voxel: 0.05, by: SegmentBy::Dominant, segments: 1 },
-        Case { name: "bunny_lattice", model: load("bunny_lattice.rhai"), png_voxel: 0.1, mesh_voxel: 0.2, by: SegmentBy::Dominant, segments: 1 },
+        Case {
+            name: "cube",
+            model: load("hello_cube.rhai"),
+            png_voxel: 0.02,
+            mesh_voxel: 0.05,
+            by: SegmentBy::Dominant,
+            segments: 1,
+        },
+        Case {
+            name: "graded_bar",
+            model: load("graded_bar.rhai"),
+            png_voxel: 0.02,
+            mesh_voxel: 0.05,
+            by: SegmentBy::Material(1),
+            segments: 4,
+        },
+        Case {
+            name: "bcc_sphere",
+            model: inline(BCC_SPHERE),
+            png_voxel: 0.04,
+            mesh_voxel: 0.05,
+            by: SegmentBy::Dominant,
+            segments: 1,
+        },
+        Case {
+            name: "bunny_lattice",
+            model: load("bunny_lattice.rhai"),
+            png_voxel: 0.1,
+            mesh_voxel: 0.2,
+            by: SegmentBy::Dominant,
+            segments: 1,
+        },
     ];
     for c in cases {
-        if filter.as_ref().is_some_and(|f| !c.name.contains(f.as_str())) {
+        if filter
+            .as_ref()
+            .is_some_and(|f| !c.name.contains(f.as_str()))
+        {
             continue;
         }
         for dither in [Dither::Random, Dither::Diffusion] {
             let (voxels, sample, choose) = stage_times(&c.model, c.png_voxel, dither);
-            let p = PngParams { voxel: DVec3::splat(c.png_voxel), seed: 1, dither, ..PngParams::default() };
+            let p = PngParams {
+                voxel: DVec3::splat(c.png_voxel),
+                seed: 1,
+                dither,
+                ..PngParams::default()
+            };
             let m = c.model.clone();
             let probe = tmp.path().join("size");
             let (secs, s) = run_job(tmp.path(), move |ctx| {
@@ -130,7 +192,10 @@ fn main() {
                 std::fs::write(&probe, bytes_of(ctx.staging()).to_string()).ok();
                 Ok(s)
             });
-            let size: u64 = std::fs::read_to_string(tmp.path().join("size")).ok().and_then(|s| s.parse().ok()).unwrap_or(0);
+            let size: u64 = std::fs::read_to_string(tmp.path().join("size"))
+                .ok()
+                .and_then(|s| s.parse().ok())
+                .unwrap_or(0);
             println!(
                 "png  {:<14} {:<9} {:>6} mm {:>12} voxels {:>8.3} s {:>8.1} M voxels/s  (sample {:.0} M/s, sample+choose {:.0} M/s; {} files, {:.1} MB)",
                 c.name,
@@ -145,13 +210,29 @@ fn main() {
                 size as f64 / 1e6
             );
         }
-        let p = MeshParams { voxel: DVec3::splat(c.mesh_voxel), segments: c.segments, by: c.by, ..MeshParams::default() };
+        let p = MeshParams {
+            voxel: DVec3::splat(c.mesh_voxel),
+            segments: c.segments,
+            by: c.by,
+            ..MeshParams::default()
+        };
         let t = Instant::now();
         segment_meshes(&c.model, &p, &AtomicBool::new(false), |_, _| {}).expect("meshes");
         let contour = t.elapsed().as_secs_f64();
         let m = c.model.clone();
         let (secs, s) = run_job(tmp.path(), move |ctx| export_meshes(&m, &p, ctx));
-        let tris: u64 = s.notes.iter().filter_map(|n| n.split(" triangles").next()?.rsplit(' ').next()?.parse::<u64>().ok()).sum();
+        let tris: u64 = s
+            .notes
+            .iter()
+            .filter_map(|n| {
+                n.split(" triangles")
+                    .next()?
+                    .rsplit(' ')
+                    .next()?
+                    .parse::<u64>()
+                    .ok()
+            })
+            .sum();
         println!(
             "mesh {:<14} {:<9} {:>6} mm {:>12} voxels {:>8.3} s {:>8.1} M voxels/s  (meshes alone {:.1} M/s; {} segments, {} triangles, STL+OBJ+3MF)",
             c.name,

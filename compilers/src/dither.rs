@@ -73,7 +73,14 @@ fn unit_f32(h: u64) -> f32 {
 /// Random choice for a run of consecutive voxels whose first voxel has global
 /// index `first_index`; `dist` and `out` have one entry per voxel, `fracs`
 /// `k` per voxel.
-pub fn choose_random(seed: u64, first_index: u64, dist: &[f32], fracs: &[f32], k: usize, out: &mut [u8]) {
+pub fn choose_random(
+    seed: u64,
+    first_index: u64,
+    dist: &[f32],
+    fracs: &[f32],
+    k: usize,
+    out: &mut [u8],
+) {
     for (v, o) in out.iter_mut().enumerate() {
         *o = 0;
         if dist[v] > 0.0 {
@@ -85,25 +92,24 @@ pub fn choose_random(seed: u64, first_index: u64, dist: &[f32], fracs: &[f32], k
             continue;
         }
         let total: f32 = f.iter().sum();
-        if !(total > MIN_TOTAL) {
+        if total.is_nan() || total <= MIN_TOTAL {
             continue;
         }
         let u = unit_f32(splitmix64(seed, first_index + v as u64)) * total;
+        // The first i with u < Σ_{j≤i} f_j is the number of running sums
+        // ≤ u (they never decrease); counted without branches, since the
+        // pick is unpredictable in a mix. A zero fraction is never picked.
         let mut acc = 0.0f32;
-        let mut pick = None;
-        let mut last_positive = 0;
-        for (i, fi) in f.iter().enumerate() {
-            if *fi > 0.0 {
-                last_positive = i;
-                acc += fi;
-                if u < acc {
-                    pick = Some(i);
-                    break;
-                }
-            }
+        let mut pick = 0usize;
+        for fi in f {
+            acc += fi;
+            pick += usize::from(acc <= u);
         }
-        // Rounding can leave u ≥ the running sum: the last material then.
-        *o = pick.unwrap_or(last_positive) as u8 + 1;
+        if pick >= k {
+            // Rounding left u at or above the total: the last material then.
+            pick = f.iter().rposition(|fi| *fi > 0.0).unwrap_or(0);
+        }
+        *o = pick as u8 + 1;
     }
 }
 
@@ -122,8 +128,18 @@ pub struct Diffuser {
 impl Diffuser {
     /// A diffuser for layers of `nx × ny` voxels with `k` fractions each.
     pub fn new(nx: usize, ny: usize, k: usize) -> Self {
-        let carry = if k > 1 { vec![0.0; nx * ny * k] } else { Vec::new() };
-        Self { nx, ny, k, carry, next_z: None }
+        let carry = if k > 1 {
+            vec![0.0; nx * ny * k]
+        } else {
+            Vec::new()
+        };
+        Self {
+            nx,
+            ny,
+            k,
+            carry,
+            next_z: None,
+        }
     }
 
     /// The first layer to diffuse so that layer `z` comes out as in a full
@@ -146,19 +162,26 @@ impl Diffuser {
     pub fn layer(&mut self, z: usize, dist: &[f32], fracs: &[f32], out: &mut [u8]) {
         let (nx, k) = (self.nx, self.k);
         assert_eq!(dist.len(), nx * self.ny, "layer size");
-        if z % BLOCK_LAYERS == 0 {
+        if z.is_multiple_of(BLOCK_LAYERS) {
             self.carry.fill(0.0);
         } else {
-            assert_eq!(self.next_z, Some(z), "error diffusion must run each block from its first layer");
+            assert_eq!(
+                self.next_z,
+                Some(z),
+                "error diffusion must run each block from its first layer"
+            );
         }
         self.next_z = Some(z + 1);
         if k == 1 {
             // One material: every inside voxel is it, and no error arises.
-            out.par_chunks_mut(nx).zip(dist.par_chunks(nx)).zip(fracs.par_chunks(nx)).for_each(|((o, d), f)| {
-                for ((o, d), f) in o.iter_mut().zip(d).zip(f) {
-                    *o = u8::from(*d <= 0.0 && *f > MIN_TOTAL);
-                }
-            });
+            out.par_chunks_mut(nx)
+                .zip(dist.par_chunks(nx))
+                .zip(fracs.par_chunks(nx))
+                .for_each(|((o, d), f)| {
+                    for ((o, d), f) in o.iter_mut().zip(d).zip(f) {
+                        *o = u8::from(*d <= 0.0 && *f > MIN_TOTAL);
+                    }
+                });
             return;
         }
         let strip = STRIP_ROWS * nx;
@@ -170,24 +193,44 @@ impl Diffuser {
             .zip(fracs.par_chunks(strip * k))
             .enumerate()
             .for_each(|(s, (((carry, out), dist), fracs))| {
-                diffuse_strip(s * STRIP_ROWS, nx, k, carry_on, dist, fracs, carry, out);
+                let y0 = s * STRIP_ROWS;
+                match k {
+                    2 => diffuse_strip::<2>(y0, nx, k, carry_on, dist, fracs, carry, out),
+                    3 => diffuse_strip::<3>(y0, nx, k, carry_on, dist, fracs, carry, out),
+                    4 => diffuse_strip::<4>(y0, nx, k, carry_on, dist, fracs, carry, out),
+                    _ => diffuse_strip::<0>(y0, nx, k, carry_on, dist, fracs, carry, out),
+                }
             });
     }
 }
 
 /// Serial Floyd–Steinberg over one strip whose first row is global row `y0`;
-/// `carry_on`: whether error may go to the next layer (not on a block's last).
+/// `carry_on`: whether error may go to the next layer (not on a block's
+/// last). `K` is the fraction count when known at compile time (loops
+/// unroll), 0 to use `k`.
 #[allow(clippy::too_many_arguments)]
-fn diffuse_strip(y0: usize, nx: usize, k: usize, carry_on: bool, dist: &[f32], fracs: &[f32], carry: &mut [f32], out: &mut [u8]) {
+fn diffuse_strip<const K: usize>(
+    y0: usize,
+    nx: usize,
+    k: usize,
+    carry_on: bool,
+    dist: &[f32],
+    fracs: &[f32],
+    carry: &mut [f32],
+    out: &mut [u8],
+) {
+    let k = if K == 0 { k } else { K };
     let rows = dist.len() / nx;
-    let inside: Vec<bool> = (0..rows * nx).map(|v| dist[v] <= 0.0 && fracs[v * k..(v + 1) * k].iter().sum::<f32>() > MIN_TOTAL).collect();
+    let inside: Vec<bool> = (0..rows * nx)
+        .map(|v| dist[v] <= 0.0 && fracs[v * k..(v + 1) * k].iter().sum::<f32>() > MIN_TOTAL)
+        .collect();
     // Row error buffers with one padding cell at each end (index x + 1).
     let mut cur = vec![0.0f32; (nx + 2) * k];
     let mut next = vec![0.0f32; (nx + 2) * k];
     let mut target = vec![0.0f32; k];
     let w_z = if carry_on { W_Z } else { 0.0 };
     for r in 0..rows {
-        let forward = (y0 + r) % 2 == 0;
+        let forward = (y0 + r).is_multiple_of(2);
         let next_row = (r + 1 < rows).then(|| &inside[(r + 1) * nx..(r + 2) * nx]);
         let row = &inside[r * nx..(r + 1) * nx];
         for step in 0..nx {
@@ -212,37 +255,60 @@ fn diffuse_strip(y0: usize, nx: usize, k: usize, carry_on: bool, dist: &[f32], f
                 }
             }
             let inv = 1.0 / f.iter().sum::<f32>();
-            let mut best = 0;
-            let mut best_val = f32::NEG_INFINITY;
             for i in 0..k {
-                let t = f[i] * inv + cur[xi * k + i] + c[i];
-                target[i] = t;
-                if t > best_val {
-                    best_val = t;
-                    best = i;
-                }
+                target[i] = f[i] * inv + incoming[i] + c[i];
+            }
+            // Branch-free argmax (the pick is unpredictable in a mix).
+            let mut best = 0;
+            for i in 1..k {
+                best = if target[i] > target[best] { i } else { best };
             }
             out[v] = best as u8 + 1;
-            target[best] -= 1.0;
+            for (i, t) in target.iter_mut().enumerate() {
+                *t -= f32::from(u8::from(i == best));
+            }
             // Neighbours that exist and are inside share the error in
             // proportion to their weights, so no error is lost inside the part.
-            let (ahead, behind) = if forward { (x + 1, x.wrapping_sub(1)) } else { (x.wrapping_sub(1), x + 1) };
-            let ok = |cells: Option<&[bool]>, x: usize| cells.and_then(|c| c.get(x)).copied().unwrap_or(false);
-            let w = [
-                if ok(Some(row), ahead) { W_AHEAD } else { 0.0 },
-                if ok(next_row, behind) { W_NEXT_BEHIND } else { 0.0 },
-                if ok(next_row, x) { W_NEXT_BELOW } else { 0.0 },
-                if ok(next_row, ahead) { W_NEXT_AHEAD } else { 0.0 },
-                w_z,
+            let (ahead, behind) = if forward {
+                (x + 1, x.wrapping_sub(1))
+            } else {
+                (x.wrapping_sub(1), x + 1)
+            };
+            let ok = |cells: Option<&[bool]>, x: usize| {
+                cells.and_then(|c| c.get(x)).copied().unwrap_or(false)
+            };
+            let has = [
+                ok(Some(row), ahead),
+                ok(next_row, behind),
+                ok(next_row, x),
+                ok(next_row, ahead),
             ];
-            let sum: f32 = w.iter().sum();
-            if sum == 0.0 {
-                c.fill(0.0);
-                continue;
-            }
-            let w = w.map(|wi| wi / sum);
+            let w = if has == [true; 4] && carry_on {
+                [W_AHEAD, W_NEXT_BEHIND, W_NEXT_BELOW, W_NEXT_AHEAD, W_Z]
+            } else {
+                let mut w = [0.0, 0.0, 0.0, 0.0, w_z];
+                for (wi, (h, full)) in w.iter_mut().zip(has.iter().zip([
+                    W_AHEAD,
+                    W_NEXT_BEHIND,
+                    W_NEXT_BELOW,
+                    W_NEXT_AHEAD,
+                ])) {
+                    if *h {
+                        *wi = full;
+                    }
+                }
+                let sum: f32 = w.iter().sum();
+                if sum == 0.0 {
+                    c.fill(0.0);
+                    continue;
+                }
+                w.map(|wi| wi / sum)
+            };
             // Padded indices: out-of-row neighbours have weight 0 and land in padding.
-            let (ai, bi) = (ahead.wrapping_add(1).min(nx + 1), behind.wrapping_add(1).min(nx + 1));
+            let (ai, bi) = (
+                ahead.wrapping_add(1).min(nx + 1),
+                behind.wrapping_add(1).min(nx + 1),
+            );
             for i in 0..k {
                 let e = target[i];
                 c[i] = w[4] * e;
@@ -294,7 +360,53 @@ mod tests {
                 d.layer(z, &dist, &fracs, &mut out);
                 all.extend_from_slice(&out);
             }
-            assert!((share_of_first(&all) - a as f64).abs() < 0.001, "diffusion {a}: {}", share_of_first(&all));
+            assert!(
+                (share_of_first(&all) - a as f64).abs() < 0.001,
+                "diffusion {a}: {}",
+                share_of_first(&all)
+            );
+        }
+    }
+
+    #[test]
+    fn random_pick_is_the_first_running_sum_above_u() {
+        // Reference: the definition, with branches.
+        let k = 4;
+        let n = 20_000;
+        let mut fracs = Vec::with_capacity(n * k);
+        for v in 0..n as u64 {
+            for i in 0..k as u64 {
+                let h = splitmix64(99, v * 8 + i);
+                // A quarter of the fractions are exactly zero.
+                fracs.push(if h.is_multiple_of(4) {
+                    0.0
+                } else {
+                    (h >> 40) as f32 / 16_777_216.0
+                });
+            }
+        }
+        let dist = vec![-1.0; n];
+        let mut out = vec![0u8; n];
+        choose_random(5, 1000, &dist, &fracs, k, &mut out);
+        for v in 0..n {
+            let f = &fracs[v * k..(v + 1) * k];
+            let total: f32 = f.iter().sum();
+            if total <= MIN_TOTAL {
+                assert_eq!(out[v], 0);
+                continue;
+            }
+            let u = unit_f32(splitmix64(5, 1000 + v as u64)) * total;
+            let mut acc = 0.0;
+            let mut want = f.iter().rposition(|x| *x > 0.0).unwrap();
+            for (i, fi) in f.iter().enumerate() {
+                acc += fi;
+                if u < acc {
+                    want = i;
+                    break;
+                }
+            }
+            assert_eq!(out[v] as usize, want + 1, "voxel {v}: {f:?}");
+            assert!(f[want] > 0.0);
         }
     }
 

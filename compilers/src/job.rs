@@ -73,12 +73,18 @@ pub enum ExportError {
 impl ExportError {
     /// An I/O error at `path`.
     pub fn io(path: &Path, source: std::io::Error) -> Self {
-        ExportError::Io { path: path.to_owned(), source }
+        ExportError::Io {
+            path: path.to_owned(),
+            source,
+        }
     }
 
     /// A bad parameter.
     pub fn param(param: &str, message: impl Into<String>) -> Self {
-        ExportError::BadParameter { param: param.to_owned(), message: message.into() }
+        ExportError::BadParameter {
+            param: param.to_owned(),
+            message: message.into(),
+        }
     }
 }
 
@@ -121,7 +127,11 @@ impl JobContext {
 
     /// Err(Cancelled) once cancel was asked for.
     pub fn check_cancel(&self) -> Result<(), ExportError> {
-        if self.cancel.load(Ordering::Relaxed) { Err(ExportError::Cancelled) } else { Ok(()) }
+        if self.cancel.load(Ordering::Relaxed) {
+            Err(ExportError::Cancelled)
+        } else {
+            Ok(())
+        }
     }
 
     /// The cancel flag, for samplers.
@@ -135,7 +145,15 @@ impl JobContext {
         let elapsed = self.start.elapsed();
         let fraction = fraction.clamp(0.0, 1.0);
         let eta = (fraction > 0.01).then(|| elapsed.mul_f64((1.0 - fraction) / fraction));
-        let p = Progress { stage: stage.to_owned(), fraction, done, total, unit, elapsed, eta };
+        let p = Progress {
+            stage: stage.to_owned(),
+            fraction,
+            done,
+            total,
+            unit,
+            elapsed,
+            eta,
+        };
         match self.tx.try_send(p) {
             Ok(()) | Err(TrySendError::Full(_)) | Err(TrySendError::Disconnected(_)) => {}
         }
@@ -232,30 +250,57 @@ where
         .name("volcad-export".into())
         .spawn(move || run_job(d2, design_hash, c2, tx, work))
         .expect("spawning a thread");
-    JobHandle { progress: rx, cancel, thread: Some(thread), dest }
+    JobHandle {
+        progress: rx,
+        cancel,
+        thread: Some(thread),
+        dest,
+    }
 }
 
 /// Run `work` on this thread (the CLI uses this through `spawn` too; tests
 /// may call it directly).
-pub fn run_job<F>(dest: PathBuf, design_hash: String, cancel: Arc<AtomicBool>, tx: SyncSender<Progress>, work: F) -> Result<Summary, ExportError>
+pub fn run_job<F>(
+    dest: PathBuf,
+    design_hash: String,
+    cancel: Arc<AtomicBool>,
+    tx: SyncSender<Progress>,
+    work: F,
+) -> Result<Summary, ExportError>
 where
     F: FnOnce(&JobContext) -> Result<Summary, ExportError>,
 {
     if dest.exists() && !(dest.is_dir() && dest.join("manifest.json").exists()) {
         // Never replace something that is not one of our exports.
-        if !(dest.is_dir() && std::fs::read_dir(&dest).map(|mut d| d.next().is_none()).unwrap_or(false)) {
+        if !(dest.is_dir()
+            && std::fs::read_dir(&dest)
+                .map(|mut d| d.next().is_none())
+                .unwrap_or(false))
+        {
             return Err(ExportError::DestinationExists(dest));
         }
     }
-    let parent = dest.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let parent = dest
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     std::fs::create_dir_all(parent).map_err(|e| ExportError::io(parent, e))?;
-    let name = dest.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_else(|| "export".into());
+    let name = dest
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_else(|| "export".into());
     let staging = parent.join(format!(".{name}.partial-{}", std::process::id()));
     if staging.exists() {
         let _ = std::fs::remove_dir_all(&staging);
     }
     std::fs::create_dir_all(&staging).map_err(|e| ExportError::io(&staging, e))?;
-    let ctx = JobContext { staging: staging.clone(), cancel, tx, start: Instant::now(), design_hash };
+    let ctx = JobContext {
+        staging: staging.clone(),
+        cancel,
+        tx,
+        start: Instant::now(),
+        design_hash,
+    };
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| work(&ctx)));
     let result = match result {
         Ok(r) => r,
@@ -264,9 +309,15 @@ where
     let finish = |mut summary: Summary| -> Result<Summary, ExportError> {
         ctx.check_cancel()?;
         summary.seconds = ctx.start.elapsed().as_secs_f64();
-        let manifest = Manifest { tool: "volcad", version: env!("CARGO_PKG_VERSION"), design_hash: &ctx.design_hash, summary: &summary };
+        let manifest = Manifest {
+            tool: "volcad",
+            version: env!("CARGO_PKG_VERSION"),
+            design_hash: &ctx.design_hash,
+            summary: &summary,
+        };
         let path = staging.join("manifest.json");
-        let text = serde_json::to_string_pretty(&manifest).map_err(|e| ExportError::Other(e.to_string()))?;
+        let text = serde_json::to_string_pretty(&manifest)
+            .map_err(|e| ExportError::Other(e.to_string()))?;
         std::fs::write(&path, text).map_err(|e| ExportError::io(&path, e))?;
         if dest.exists() {
             std::fs::remove_dir_all(&dest).map_err(|e| ExportError::io(&dest, e))?;
@@ -297,7 +348,11 @@ mod tests {
         let h = spawn(dest.clone(), "abc".into(), |ctx| {
             std::fs::write(ctx.staging().join("a.txt"), "x").unwrap();
             ctx.progress("writing", 1, 1, "files", 1.0);
-            Ok(Summary { kind: "test".into(), files: vec!["a.txt".into()], ..Summary::default() })
+            Ok(Summary {
+                kind: "test".into(),
+                files: vec!["a.txt".into()],
+                ..Summary::default()
+            })
         });
         let s = h.join().unwrap();
         assert_eq!(s.files, vec!["a.txt"]);
@@ -305,7 +360,11 @@ mod tests {
         let m = std::fs::read_to_string(dest.join("manifest.json")).unwrap();
         assert!(m.contains("\"design_hash\": \"abc\""), "{m}");
         let parent = dest.parent().unwrap();
-        assert_eq!(std::fs::read_dir(parent).unwrap().count(), 1, "no staging folder left");
+        assert_eq!(
+            std::fs::read_dir(parent).unwrap().count(),
+            1,
+            "no staging folder left"
+        );
     }
 
     #[test]
@@ -321,7 +380,10 @@ mod tests {
         h.cancel();
         assert!(matches!(h.join(), Err(ExportError::Cancelled)));
         assert!(!dest.exists());
-        assert_eq!(std::fs::read_dir(dest.parent().unwrap()).unwrap().count(), 0);
+        assert_eq!(
+            std::fs::read_dir(dest.parent().unwrap()).unwrap().count(),
+            0
+        );
     }
 
     #[test]

@@ -13,6 +13,7 @@
 pub mod fea;
 pub mod job;
 
+pub mod design;
 pub mod dither;
 pub mod mesh;
 pub mod png_io;

@@ -28,12 +28,28 @@ pub fn slice_name(z: usize, digits: usize) -> String {
 pub fn folder_name(name: &str, id: u8) -> String {
     let s: String = name
         .chars()
-        .map(|c| if c.is_ascii_alphanumeric() || "-_.+".contains(c) { c } else { '_' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "-_.+".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
         .collect();
-    if s.chars().all(|c| c == '.' || c == '_') { format!("material_{id}") } else { s }
+    if s.chars().all(|c| c == '.' || c == '_') {
+        format!("material_{id}")
+    } else {
+        s
+    }
 }
 
-fn encode(width: usize, height: usize, color: ColorType, depth: BitDepth, data: &[u8]) -> Result<Vec<u8>, png::EncodingError> {
+fn encode(
+    width: usize,
+    height: usize,
+    color: ColorType,
+    depth: BitDepth,
+    data: &[u8],
+) -> Result<Vec<u8>, png::EncodingError> {
     let mut out = Cursor::new(Vec::with_capacity(data.len() / 8 + 256));
     {
         let mut enc = Encoder::new(&mut out, width as u32, height as u32);
@@ -48,7 +64,11 @@ fn encode(width: usize, height: usize, color: ColorType, depth: BitDepth, data: 
 }
 
 /// An 8-bit RGBA image, `data` row-major from the top row, 4 bytes a pixel.
-pub fn encode_rgba(width: usize, height: usize, data: &[u8]) -> Result<Vec<u8>, png::EncodingError> {
+pub fn encode_rgba(
+    width: usize,
+    height: usize,
+    data: &[u8],
+) -> Result<Vec<u8>, png::EncodingError> {
     encode(width, height, ColorType::Rgba, BitDepth::Eight, data)
 }
 
@@ -59,7 +79,11 @@ pub fn bit_row_bytes(width: usize) -> usize {
 
 /// A 1-bit grayscale image (1 = white), rows of [`bit_row_bytes`] bytes,
 /// leftmost pixel in the most significant bit.
-pub fn encode_bits(width: usize, height: usize, data: &[u8]) -> Result<Vec<u8>, png::EncodingError> {
+pub fn encode_bits(
+    width: usize,
+    height: usize,
+    data: &[u8],
+) -> Result<Vec<u8>, png::EncodingError> {
     encode(width, height, ColorType::Grayscale, BitDepth::One, data)
 }
 
@@ -68,7 +92,9 @@ mod tests {
     use super::*;
 
     fn decode(bytes: &[u8]) -> (png::OutputInfo, Vec<u8>) {
-        let mut r = png::Decoder::new(Cursor::new(bytes)).read_info().expect("png header");
+        let mut r = png::Decoder::new(Cursor::new(bytes))
+            .read_info()
+            .expect("png header");
         let mut buf = vec![0; r.output_buffer_size().expect("size")];
         let info = r.next_frame(&mut buf).expect("png data");
         buf.truncate(info.buffer_size());
@@ -88,11 +114,17 @@ mod tests {
     fn rgba_and_bits_round_trip() {
         let rgba: Vec<u8> = (0..3 * 2 * 4).map(|i| i as u8).collect();
         let (info, back) = decode(&encode_rgba(3, 2, &rgba).unwrap());
-        assert_eq!((info.width, info.height, info.color_type, info.bit_depth), (3, 2, ColorType::Rgba, BitDepth::Eight));
+        assert_eq!(
+            (info.width, info.height, info.color_type, info.bit_depth),
+            (3, 2, ColorType::Rgba, BitDepth::Eight)
+        );
         assert_eq!(back, rgba);
         let bits = vec![0b1010_0000, 0b0100_0000];
         let (info, back) = decode(&encode_bits(3, 2, &bits).unwrap());
-        assert_eq!((info.color_type, info.bit_depth), (ColorType::Grayscale, BitDepth::One));
+        assert_eq!(
+            (info.color_type, info.bit_depth),
+            (ColorType::Grayscale, BitDepth::One)
+        );
         assert_eq!(back, bits);
     }
 }

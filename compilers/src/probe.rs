@@ -40,7 +40,10 @@ pub fn probe(model: &Model, voxel: DVec3) -> Probe {
     let [nx, ny, nz] = grid.dims;
     let sampler = Sampler::new(model, grid, true);
     let mut slab = Slab::default();
-    if sampler.sample_layers(0, nz, &mut slab, &AtomicBool::new(false)).is_err() {
+    if sampler
+        .sample_layers(0, nz, &mut slab, &AtomicBool::new(false))
+        .is_err()
+    {
         return Probe::default();
     }
     let k = slab.k;
@@ -70,8 +73,16 @@ pub fn probe(model: &Model, voxel: DVec3) -> Probe {
     let total = (nx * ny * nz) as f64;
     let h = grid.voxel;
     let faces = [h.y * h.z, h.x * h.z, h.x * h.y];
-    let cuberille: f64 = crossings.iter().zip(faces).map(|(c, a)| *c as f64 * a).sum();
-    Probe { inside: n_in as f64 / total, mixed: n_mixed as f64 / total, surface_mm2: cuberille * 2.0 / 3.0 }
+    let cuberille: f64 = crossings
+        .iter()
+        .zip(faces)
+        .map(|(c, a)| *c as f64 * a)
+        .sum();
+    Probe {
+        inside: n_in as f64 / total,
+        mixed: n_mixed as f64 / total,
+        surface_mm2: cuberille * 2.0 / 3.0,
+    }
 }
 
 #[cfg(test)]

@@ -21,18 +21,31 @@ pub fn available_memory() -> Option<u64> {
 /// Free bytes on the file system holding `dir` (POSIX `df -Pk`: the fourth
 /// column of the second line is the space available in KiB), or `None`.
 pub fn available_disk(dir: &Path) -> Option<u64> {
-    let out = std::process::Command::new("df").arg("-Pk").arg(dir).output().ok()?;
+    let out = std::process::Command::new("df")
+        .arg("-Pk")
+        .arg(dir)
+        .output()
+        .ok()?;
     if !out.status.success() {
         return None;
     }
     let text = String::from_utf8(out.stdout).ok()?;
-    let kib: u64 = text.lines().nth(1)?.split_whitespace().nth(3)?.parse().ok()?;
+    let kib: u64 = text
+        .lines()
+        .nth(1)?
+        .split_whitespace()
+        .nth(3)?
+        .parse()
+        .ok()?;
     Some(kib * 1024)
 }
 
 /// Run `f` on a pool of `threads` workers (`None`: the current pool, all
 /// cores by default). Output never depends on the count; only speed does.
-pub fn run_with_threads<T: Send>(threads: Option<usize>, f: impl FnOnce() -> Result<T, ExportError> + Send) -> Result<T, ExportError> {
+pub fn run_with_threads<T: Send>(
+    threads: Option<usize>,
+    f: impl FnOnce() -> Result<T, ExportError> + Send,
+) -> Result<T, ExportError> {
     match threads {
         None => f(),
         Some(0) => Err(ExportError::param("--threads", "must be at least 1")),
@@ -55,7 +68,13 @@ pub fn human_bytes(n: u64) -> String {
         v /= 1024.0;
         u += 1;
     }
-    if u == 0 { format!("{n} B") } else if v < 10.0 { format!("{v:.1} {}", UNITS[u]) } else { format!("{v:.0} {}", UNITS[u]) }
+    if u == 0 {
+        format!("{n} B")
+    } else if v < 10.0 {
+        format!("{v:.1} {}", UNITS[u])
+    } else {
+        format!("{v:.0} {}", UNITS[u])
+    }
 }
 
 /// Refuse when `needed` bytes of working memory exceed what is available
@@ -82,18 +101,18 @@ pub fn check_memory(needed: u64, what: &str) -> Result<(), ExportError> {
 /// Refuse when about `needed` bytes of output will not fit on the disk that
 /// holds `dir`. The error names `--out`.
 pub fn check_disk(needed: u64, dir: &Path) -> Result<(), ExportError> {
-    if let Some(free) = available_disk(dir) {
-        if needed > free {
-            return Err(ExportError::param(
-                "--out",
-                format!(
-                    "the output needs about {} but only {} is free on the disk of {}; free space, choose another folder or use a larger voxel size",
-                    human_bytes(needed),
-                    human_bytes(free),
-                    dir.display()
-                ),
-            ));
-        }
+    if let Some(free) = available_disk(dir)
+        && needed > free
+    {
+        return Err(ExportError::param(
+            "--out",
+            format!(
+                "the output needs about {} but only {} is free on the disk of {}; free space, choose another folder or use a larger voxel size",
+                human_bytes(needed),
+                human_bytes(free),
+                dir.display()
+            ),
+        ));
     }
     Ok(())
 }
@@ -119,9 +138,13 @@ mod tests {
 
     #[test]
     fn huge_needs_are_refused_with_numbers() {
-        let e = check_memory(u64::MAX / 2, "one layer").unwrap_err().to_string();
+        let e = check_memory(u64::MAX / 2, "one layer")
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("--voxel: one layer needs"), "{e}");
-        let e = check_disk(u64::MAX / 2, &std::env::temp_dir()).unwrap_err().to_string();
+        let e = check_disk(u64::MAX / 2, &std::env::temp_dir())
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("--out: the output needs about"), "{e}");
     }
 }

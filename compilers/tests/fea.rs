@@ -351,7 +351,9 @@ fn round_trip_through_calculix_into_a_simulation_field() {
         element: Element::C3D4,
         min_cell: 1.0,
         max_cell: 4.0,
-        step: Some(StepParams { top_displacement: TOP_UZ }),
+        step: Some(StepParams {
+            top_displacement: TOP_UZ,
+        }),
         ..FeaParams::default()
     };
     export(&m, &p, &dir);
@@ -362,14 +364,22 @@ fn round_trip_through_calculix_into_a_simulation_field() {
     let csv = dir.join("result.csv");
     write_result_csv(&frd, Some(&dir.join("model.inp")), &csv).unwrap();
     let header = std::fs::read_to_string(&csv).unwrap();
-    assert!(header.starts_with("node_id,x,y,z,dx,dy,dz"), "{}", &header[..60]);
+    assert!(
+        header.starts_with("node_id,x,y,z,dx,dy,dz"),
+        "{}",
+        &header[..60]
+    );
 
     // Import: the displacement magnitude drives a two-material grade.
     let script = r#"let m = default_materials();
         SimulationField("model.inp", "result.csv", ["clamp(0, len/0.1, 1)", "1 - clamp(0, len/0.1, 1)"],
                         [m.id("red"), m.id("blue")])"#;
-    let d = run_script(script, "roundtrip.rhai", &ScriptOptions::for_file(&dir.join("roundtrip.rhai")))
-        .unwrap_or_else(|e| panic!("{e}"));
+    let d = run_script(
+        script,
+        "roundtrip.rhai",
+        &ScriptOptions::for_file(&dir.join("roundtrip.rhai")),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
     let field = Model::prepare(&d.root, d.materials.clone()).unwrap();
     let red = |z: f64| {
         let (dist, f) = field.eval_point(glam::DVec3::new(5.0, 0.0, z));

@@ -12,7 +12,10 @@ use std::sync::atomic::AtomicBool;
 use common::{model, read_tree, run, tmp};
 use glam::DVec3;
 use volcad_compilers::ExportError;
-use volcad_compilers::mesh::{IndexedMesh, MeshFormats, MeshParams, SegmentBy, SegmentMesh, estimate_mesh, export_meshes, marching_cubes, segment_meshes};
+use volcad_compilers::mesh::{
+    IndexedMesh, MeshFormats, MeshParams, SegmentBy, SegmentMesh, estimate_mesh, export_meshes,
+    marching_cubes, segment_meshes,
+};
 use volcad_core::Model;
 use volcad_core::sampler::Grid;
 
@@ -21,7 +24,12 @@ FGrade(["x/20+0.5", "-x/20+0.5"], [m.id("red"), m.id("blue")], true, RectPrism(V
 const RED: u8 = 1;
 
 fn params(voxel: f64, segments: usize, by: SegmentBy) -> MeshParams {
-    MeshParams { voxel: DVec3::splat(voxel), segments, by, ..MeshParams::default() }
+    MeshParams {
+        voxel: DVec3::splat(voxel),
+        segments,
+        by,
+        ..MeshParams::default()
+    }
 }
 
 fn meshes(m: &Model, p: &MeshParams) -> Vec<SegmentMesh> {
@@ -39,16 +47,30 @@ fn sphere_and_box_are_watertight_with_analytic_volume() {
     assert_eq!(s.len(), 1);
     let v = 4.0 / 3.0 * std::f64::consts::PI * 1000.0;
     assert!(s[0].mesh.is_watertight(), "{:?}", s[0].mesh.edge_report());
-    assert!(rel(s[0].mesh.volume(), v) < 0.01, "sphere {} vs {v}", s[0].mesh.volume());
-    let bx = model(r#"let m = default_materials(); RectPrism(Vec3(1,2,3), Vec3(20,10,5), m.id("red"))"#);
+    assert!(
+        rel(s[0].mesh.volume(), v) < 0.01,
+        "sphere {} vs {v}",
+        s[0].mesh.volume()
+    );
+    let bx =
+        model(r#"let m = default_materials(); RectPrism(Vec3(1,2,3), Vec3(20,10,5), m.id("red"))"#);
     let s = meshes(&bx, &params(0.25, 1, SegmentBy::Dominant));
     assert!(s[0].mesh.is_watertight(), "{:?}", s[0].mesh.edge_report());
-    assert!(rel(s[0].mesh.volume(), 1000.0) < 0.01, "box {}", s[0].mesh.volume());
+    assert!(
+        rel(s[0].mesh.volume(), 1000.0) < 0.01,
+        "box {}",
+        s[0].mesh.volume()
+    );
 }
 
 #[test]
 fn marching_cubes_of_an_analytic_field() {
-    let grid = Grid::covering(&volcad_core::Aabb::new(DVec3::splat(-6.0), DVec3::splat(6.0)), DVec3::splat(0.25), 1 << 30).unwrap();
+    let grid = Grid::covering(
+        &volcad_core::Aabb::new(DVec3::splat(-6.0), DVec3::splat(6.0)),
+        DVec3::splat(0.25),
+        1 << 30,
+    )
+    .unwrap();
     let [nx, ny, nz] = grid.dims;
     let mut values = Vec::with_capacity(nx * ny * nz);
     for k in 0..nz {
@@ -62,7 +84,11 @@ fn marching_cubes_of_an_analytic_field() {
     assert!(m.is_watertight(), "{:?}", m.edge_report());
     let v = 4.0 / 3.0 * std::f64::consts::PI * 125.0;
     assert!(rel(m.volume(), v) < 0.01, "{} vs {v}", m.volume());
-    assert!(rel(m.area(), 4.0 * std::f64::consts::PI * 25.0) < 0.02, "area {}", m.area());
+    assert!(
+        rel(m.area(), 4.0 * std::f64::consts::PI * 25.0) < 0.02,
+        "area {}",
+        m.area()
+    );
 }
 
 /// Triangle key by positions, rotation-independent (starts at the smallest
@@ -71,7 +97,9 @@ fn tri_key(p: [[f32; 3]; 3]) -> [u32; 9] {
     let bits = p.map(|v| v.map(f32::to_bits));
     let i = (0..3).min_by_key(|i| bits[*i]).unwrap();
     let r = [bits[i], bits[(i + 1) % 3], bits[(i + 2) % 3]];
-    [r[0][0], r[0][1], r[0][2], r[1][0], r[1][1], r[1][2], r[2][0], r[2][1], r[2][2]]
+    [
+        r[0][0], r[0][1], r[0][2], r[1][0], r[1][1], r[1][2], r[2][0], r[2][1], r[2][2],
+    ]
 }
 
 fn positions(m: &IndexedMesh, t: usize) -> [[f32; 3]; 3] {
@@ -85,9 +113,18 @@ fn positions(m: &IndexedMesh, t: usize) -> [[f32; 3]; 3] {
 fn check_cover(segs: &[SegmentMesh]) -> f64 {
     let mut owner: HashMap<[u32; 9], usize> = HashMap::new();
     for (s, seg) in segs.iter().enumerate() {
-        assert!(seg.mesh.is_empty() || seg.mesh.is_watertight(), "{}: {:?}", seg.name, seg.mesh.edge_report());
+        assert!(
+            seg.mesh.is_empty() || seg.mesh.is_watertight(),
+            "{}: {:?}",
+            seg.name,
+            seg.mesh.edge_report()
+        );
         for t in 0..seg.mesh.triangles.len() {
-            assert!(owner.insert(tri_key(positions(&seg.mesh, t)), s).is_none(), "{}: triangle repeated", seg.name);
+            assert!(
+                owner.insert(tri_key(positions(&seg.mesh, t)), s).is_none(),
+                "{}: triangle repeated",
+                seg.name
+            );
         }
     }
     // The outer surface: triangles whose reverse no other segment has.
@@ -114,10 +151,21 @@ fn check_cover(segs: &[SegmentMesh]) -> f64 {
             }
         }
     }
-    assert!(segs.iter().filter(|s| !s.mesh.is_empty()).count() < 2 || interface > 0, "segments share no interface");
-    assert!(outer.is_watertight(), "outer surface: {:?}", outer.edge_report());
+    assert!(
+        segs.iter().filter(|s| !s.mesh.is_empty()).count() < 2 || interface > 0,
+        "segments share no interface"
+    );
+    assert!(
+        outer.is_watertight(),
+        "outer surface: {:?}",
+        outer.edge_report()
+    );
     let total: f64 = segs.iter().map(|s| s.mesh.volume()).sum();
-    assert!(rel(outer.volume(), total) < 1e-6, "outer {} vs segments {total}", outer.volume());
+    assert!(
+        rel(outer.volume(), total) < 1e-6,
+        "outer {} vs segments {total}",
+        outer.volume()
+    );
     total
 }
 
@@ -128,14 +176,26 @@ fn fraction_segments_cover_the_part_once_with_analytic_volumes() {
     let segs = meshes(&m, &params(0.25, 4, SegmentBy::Material(RED)));
     assert_eq!(segs.len(), 4);
     let total = check_cover(&segs);
-    assert!(rel(total, whole[0].mesh.volume()) < 0.002, "segments {total} vs whole {}", whole[0].mesh.volume());
+    assert!(
+        rel(total, whole[0].mesh.volume()) < 0.002,
+        "segments {total} vs whole {}",
+        whole[0].mesh.volume()
+    );
     assert!(rel(total, 1000.0) < 0.01, "{total}");
     // red = x/20 + 0.5: the range boundaries are the planes x = -5, 0, 5.
     for s in &segs {
-        assert!(rel(s.mesh.volume(), 250.0) < 0.01, "{}: {}", s.name, s.mesh.volume());
+        assert!(
+            rel(s.mesh.volume(), 250.0) < 0.01,
+            "{}: {}",
+            s.name,
+            s.mesh.volume()
+        );
     }
     assert_eq!(segs[0].name, "seg00_red_0.000-0.250");
-    assert_eq!(segs.iter().map(|s| s.infill_percent).collect::<Vec<_>>(), [20.0, 40.0, 60.0, 80.0]);
+    assert_eq!(
+        segs.iter().map(|s| s.infill_percent).collect::<Vec<_>>(),
+        [20.0, 40.0, 60.0, 80.0]
+    );
     // The other material splits the same bar mirrored.
     let blue = meshes(&m, &params(0.25, 4, SegmentBy::Material(3)));
     assert!(rel(blue[0].mesh.volume(), segs[3].mesh.volume()) < 1e-3);
@@ -158,7 +218,10 @@ FGrade(["x/20+0.4", "-x/20+0.4", "0.2 + y/10"], [m.id("red"), m.id("blue"), m.id
     assert_eq!(segs.len(), 3);
     assert!(segs.iter().all(|s| !s.mesh.is_empty()));
     let total = check_cover(&segs);
-    assert!(rel(total, 4.0 / 3.0 * std::f64::consts::PI * 512.0) < 0.01, "{total}");
+    assert!(
+        rel(total, 4.0 / 3.0 * std::f64::consts::PI * 512.0) < 0.01,
+        "{total}"
+    );
 }
 
 #[test]
@@ -168,11 +231,18 @@ fn lattice_sphere_is_watertight() {
 Intersection(false, [Tile(GraphLattice(LatticeType::BodyCenteredCubic, Vec3(5,5,5), 0.5, m.id("red"))), Sphere(Vec3(0,0,0), 6, m.id("blue"))])"#,
     );
     let segs = meshes(&m, &params(0.1, 1, SegmentBy::Dominant));
-    assert!(segs.iter().all(|s| s.mesh.is_empty() || s.mesh.is_watertight()));
+    assert!(
+        segs.iter()
+            .all(|s| s.mesh.is_empty() || s.mesh.is_watertight())
+    );
     assert!(segs.iter().any(|s| !s.mesh.is_empty()));
 }
 
-fn export(m: &Arc<Model>, p: &MeshParams, dest: &std::path::Path) -> Result<volcad_compilers::Summary, ExportError> {
+fn export(
+    m: &Arc<Model>,
+    p: &MeshParams,
+    dest: &std::path::Path,
+) -> Result<volcad_compilers::Summary, ExportError> {
     let (m, p) = (m.clone(), p.clone());
     run(dest, move |ctx| export_meshes(&m, &p, ctx))
 }
@@ -195,8 +265,14 @@ fn files_and_3mf_structure() {
         let stl = &tree[&format!("{}.stl", seg.name)];
         assert_eq!(stl.len(), 84 + 50 * seg.mesh.triangles.len());
         let obj = String::from_utf8(tree[&format!("{}.obj", seg.name)].clone()).unwrap();
-        assert_eq!(obj.lines().filter(|l| l.starts_with("v ")).count(), seg.mesh.vertices.len());
-        assert_eq!(obj.lines().filter(|l| l.starts_with("f ")).count(), seg.mesh.triangles.len());
+        assert_eq!(
+            obj.lines().filter(|l| l.starts_with("v ")).count(),
+            seg.mesh.vertices.len()
+        );
+        assert_eq!(
+            obj.lines().filter(|l| l.starts_with("f ")).count(),
+            seg.mesh.triangles.len()
+        );
     }
     let mut zip = zip::ZipArchive::new(Cursor::new(tree["segments.3mf"].clone())).unwrap();
     let mut read = |name: &str| {
@@ -215,21 +291,46 @@ fn files_and_3mf_structure() {
         .filter(|l| l.contains("<triangle "))
         .map(|l| [attr(l, "v1"), attr(l, "v2"), attr(l, "v3")].map(|v| v.parse().unwrap()))
         .collect();
-    assert_eq!(vertices, segs.iter().map(|s| s.mesh.vertices.len()).sum::<usize>());
-    assert_eq!(triangles.len(), segs.iter().map(|s| s.mesh.triangles.len()).sum::<usize>());
+    assert_eq!(
+        vertices,
+        segs.iter().map(|s| s.mesh.vertices.len()).sum::<usize>()
+    );
+    assert_eq!(
+        triangles.len(),
+        segs.iter().map(|s| s.mesh.triangles.len()).sum::<usize>()
+    );
     // One volume per segment: contiguous triangle ranges covering all, each
     // using only its own vertex block, named, with fill_density in percent.
     let volumes: Vec<&str> = config.split("<volume ").skip(1).collect();
     assert_eq!(volumes.len(), 4);
     let (mut next_tri, mut vbase) = (0, 0);
     for (v, seg) in volumes.iter().zip(&segs) {
-        let (first, last): (usize, usize) = (attr(v, "firstid").parse().unwrap(), attr(v, "lastid").parse().unwrap());
+        let (first, last): (usize, usize) = (
+            attr(v, "firstid").parse().unwrap(),
+            attr(v, "lastid").parse().unwrap(),
+        );
         assert_eq!(first, next_tri);
         assert_eq!(last + 1 - first, seg.mesh.triangles.len());
         let vend = vbase + seg.mesh.vertices.len();
-        assert!(triangles[first..=last].iter().flatten().all(|i| (vbase..vend).contains(i)), "{}", seg.name);
-        assert!(v.contains(&format!(r#"key="name" value="{}""#, seg.name)), "{v}");
-        assert!(v.contains(&format!(r#"key="fill_density" value="{}%""#, seg.infill_percent)), "{v}");
+        assert!(
+            triangles[first..=last]
+                .iter()
+                .flatten()
+                .all(|i| (vbase..vend).contains(i)),
+            "{}",
+            seg.name
+        );
+        assert!(
+            v.contains(&format!(r#"key="name" value="{}""#, seg.name)),
+            "{v}"
+        );
+        assert!(
+            v.contains(&format!(
+                r#"key="fill_density" value="{}%""#,
+                seg.infill_percent
+            )),
+            "{v}"
+        );
         next_tri = last + 1;
         vbase = vend;
     }
@@ -243,13 +344,20 @@ fn runs_and_thread_counts_give_identical_bytes() {
     let mut trees = Vec::new();
     for threads in [None, None, Some(1), Some(2)] {
         let dir = tmp();
-        let p = MeshParams { threads, infill_expr: Some("5 + 90*f^2".into()), ..params(0.5, 3, SegmentBy::Material(RED)) };
+        let p = MeshParams {
+            threads,
+            infill_expr: Some("5 + 90*f^2".into()),
+            ..params(0.5, 3, SegmentBy::Material(RED))
+        };
         export(&m, &p, &dir.path().join("out")).unwrap();
         trees.push(read_tree(&dir.path().join("out")));
     }
     assert_eq!(trees[0].len(), 7);
     for t in &trees[1..] {
-        assert!(t == &trees[0], "output differs between runs or thread counts");
+        assert!(
+            t == &trees[0],
+            "output differs between runs or thread counts"
+        );
     }
 }
 
@@ -259,8 +367,15 @@ fn cancel_leaves_no_output() {
     let dir = tmp();
     let dest = dir.path().join("out");
     let p = params(0.04, 1, SegmentBy::Dominant);
-    let h = volcad_compilers::job::spawn(dest.clone(), "t".into(), move |ctx| export_meshes(&m, &p, ctx));
-    assert!(h.progress.recv_timeout(std::time::Duration::from_secs(60)).is_ok(), "no progress");
+    let h = volcad_compilers::job::spawn(dest.clone(), "t".into(), move |ctx| {
+        export_meshes(&m, &p, ctx)
+    });
+    assert!(
+        h.progress
+            .recv_timeout(std::time::Duration::from_secs(60))
+            .is_ok(),
+        "no progress"
+    );
     h.cancel();
     assert!(matches!(h.join(), Err(ExportError::Cancelled)));
     assert!(!dest.exists());
@@ -275,15 +390,41 @@ fn bad_input_is_refused_naming_the_parameter() {
     assert!(err(params(0.5, 2, SegmentBy::Material(0))).starts_with("--material:"));
     assert!(err(params(0.5, 2, SegmentBy::Material(200))).starts_with("--material:"));
     assert!(err(params(0.5, 0, SegmentBy::Material(RED))).starts_with("--segments:"));
-    let e = err(MeshParams { infill_expr: Some("10 + 80*".into()), ..params(0.5, 2, SegmentBy::Material(RED)) });
+    let e = err(MeshParams {
+        infill_expr: Some("10 + 80*".into()),
+        ..params(0.5, 2, SegmentBy::Material(RED))
+    });
     assert!(e.starts_with("--infill:"), "{e}");
-    let e = err(MeshParams { formats: MeshFormats { stl: false, obj: false, threemf: false }, ..params(0.5, 2, SegmentBy::Dominant) });
+    let e = err(MeshParams {
+        formats: MeshFormats {
+            stl: false,
+            obj: false,
+            threemf: false,
+        },
+        ..params(0.5, 2, SegmentBy::Dominant)
+    });
     assert!(e.starts_with("--format:"), "{e}");
-    let tile = model(r#"let m = default_materials(); Tile(GraphLattice(LatticeType::BodyCenteredCubic, Vec3(5,5,5), 0.5, m.id("red")))"#);
-    assert!(estimate_mesh(&tile, &params(0.5, 2, SegmentBy::Dominant)).unwrap_err().to_string().starts_with("design:"));
+    let tile = model(
+        r#"let m = default_materials(); Tile(GraphLattice(LatticeType::BodyCenteredCubic, Vec3(5,5,5), 0.5, m.id("red")))"#,
+    );
+    assert!(
+        estimate_mesh(&tile, &params(0.5, 2, SegmentBy::Dominant))
+            .unwrap_err()
+            .to_string()
+            .starts_with("design:")
+    );
     // A material from the table that the design does not use: f = 0, one segment.
     let dir = tmp();
-    let s = export(&m, &params(0.5, 2, SegmentBy::Material(5)), &dir.path().join("out")).unwrap();
-    assert!(s.notes.iter().any(|n| n.contains("not in the design")), "{:?}", s.notes);
+    let s = export(
+        &m,
+        &params(0.5, 2, SegmentBy::Material(5)),
+        &dir.path().join("out"),
+    )
+    .unwrap();
+    assert!(
+        s.notes.iter().any(|n| n.contains("not in the design")),
+        "{:?}",
+        s.notes
+    );
     assert_eq!(s.counts[1].1, 0);
 }

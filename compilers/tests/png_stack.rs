@@ -26,10 +26,19 @@ const TWO_BOXES: &str = r#"let m = default_materials();
 Union(false, [RectPrism(Vec3(-6,0,0), Vec3(8,6,4), m.id("red")), RectPrism(Vec3(6,0,0), Vec3(8,6,4), m.id("blue"))])"#;
 
 fn params(voxel: f64, dither: Dither) -> PngParams {
-    PngParams { voxel: DVec3::splat(voxel), seed: 42, dither, ..PngParams::default() }
+    PngParams {
+        voxel: DVec3::splat(voxel),
+        seed: 42,
+        dither,
+        ..PngParams::default()
+    }
 }
 
-fn export(model: &Arc<Model>, p: &PngParams, dest: &std::path::Path) -> Result<volcad_compilers::Summary, ExportError> {
+fn export(
+    model: &Arc<Model>,
+    p: &PngParams,
+    dest: &std::path::Path,
+) -> Result<volcad_compilers::Summary, ExportError> {
     let (m, p) = (model.clone(), p.clone());
     run(dest, move |ctx| export_png_stack(&m, &p, ctx))
 }
@@ -47,9 +56,15 @@ fn graded_bar_counts_are_half_and_half() {
         let dir = tmp();
         let s = export(&m, &params(voxel, dither), &dir.path().join("out")).unwrap();
         let counts: Vec<u64> = s.counts.iter().map(|c| c.1).collect();
-        assert_eq!(s.counts.iter().map(|c| c.0.as_str()).collect::<Vec<_>>(), ["red", "blue"]);
+        assert_eq!(
+            s.counts.iter().map(|c| c.0.as_str()).collect::<Vec<_>>(),
+            ["red", "blue"]
+        );
         for c in &counts {
-            assert!(within(*c, expected, 0.01), "{dither:?}: {counts:?} vs {expected}");
+            assert!(
+                within(*c, expected, 0.01),
+                "{dither:?}: {counts:?} vs {expected}"
+            );
         }
         // The PNG pixels say the same as the summary.
         let px = colour_counts(&read_tree(&dir.path().join("out")));
@@ -57,7 +72,10 @@ fn graded_bar_counts_are_half_and_half() {
         assert_eq!(px.get(&BLUE).copied(), Some(counts[1]), "{dither:?}");
         assert_eq!(s.files.len(), 50);
         let manifest = std::fs::read_to_string(dir.path().join("out/manifest.json")).unwrap();
-        assert!(manifest.contains("\"red\"") && manifest.contains(&counts[0].to_string()), "{manifest}");
+        assert!(
+            manifest.contains("\"red\"") && manifest.contains(&counts[0].to_string()),
+            "{manifest}"
+        );
     }
 }
 
@@ -76,14 +94,20 @@ fn disjoint_boxes_counts_are_their_volumes() {
 #[test]
 fn graded_sphere_with_diffusion_keeps_fractions_at_the_surface() {
     // 80/20 everywhere inside a sphere: counts are 80% and 20% of the inside.
-    let m = model(r#"let m = default_materials(); FGrade(["0.8", "0.2"], [m.id("red"), m.id("blue")], true, Sphere(Vec3(0,0,0), 4, m.id("gray")))"#);
+    let m = model(
+        r#"let m = default_materials(); FGrade(["0.8", "0.2"], [m.id("red"), m.id("blue")], true, Sphere(Vec3(0,0,0), 4, m.id("gray")))"#,
+    );
     let voxel: f64 = 0.1;
     let sphere = 4.0 / 3.0 * std::f64::consts::PI * 64.0 / voxel.powi(3);
     for dither in [Dither::Random, Dither::Diffusion] {
         let dir = tmp();
         let s = export(&m, &params(voxel, dither), &dir.path().join("out")).unwrap();
         let (red, blue) = (s.counts[0].1, s.counts[1].1);
-        assert!(within(red + blue, sphere, 0.01), "{dither:?}: {} vs {sphere}", red + blue);
+        assert!(
+            within(red + blue, sphere, 0.01),
+            "{dither:?}: {} vs {sphere}",
+            red + blue
+        );
         let share = red as f64 / (red + blue) as f64;
         assert!((share - 0.8).abs() < 0.008, "{dither:?}: red share {share}");
     }
@@ -96,13 +120,20 @@ fn runs_and_thread_counts_give_identical_bytes() {
         let mut trees = Vec::new();
         for threads in [None, None, Some(1), Some(2)] {
             let dir = tmp();
-            let p = PngParams { threads, per_material_bitmaps: true, ..params(0.2, dither) };
+            let p = PngParams {
+                threads,
+                per_material_bitmaps: true,
+                ..params(0.2, dither)
+            };
             export(&m, &p, &dir.path().join("out")).unwrap();
             trees.push(read_tree(&dir.path().join("out")));
         }
         assert_eq!(trees[0].len(), 25 * 3, "RGBA + two 1-bit stacks");
         for t in &trees[1..] {
-            assert!(t == &trees[0], "{dither:?}: output differs between runs or thread counts");
+            assert!(
+                t == &trees[0],
+                "{dither:?}: output differs between runs or thread counts"
+            );
         }
     }
 }
@@ -111,7 +142,10 @@ fn runs_and_thread_counts_give_identical_bytes() {
 fn layer_ranges_merge_into_the_full_stack() {
     let m = model(GRADED_BAR);
     for dither in [Dither::Random, Dither::Diffusion] {
-        let p = PngParams { per_material_bitmaps: true, ..params(0.2, dither) };
+        let p = PngParams {
+            per_material_bitmaps: true,
+            ..params(0.2, dither)
+        };
         let full_dir = tmp();
         export(&m, &p, &full_dir.path().join("out")).unwrap();
         let full = read_tree(&full_dir.path().join("out"));
@@ -119,12 +153,18 @@ fn layer_ranges_merge_into_the_full_stack() {
         // 25 layers; cut inside diffusion blocks (16) on purpose.
         for r in [0..7, 7..19, 19..25] {
             let dir = tmp();
-            let part = PngParams { layers: Some(r.clone()), ..p.clone() };
+            let part = PngParams {
+                layers: Some(r.clone()),
+                ..p.clone()
+            };
             let s = export(&m, &part, &dir.path().join("out")).unwrap();
             assert_eq!(s.files.len(), r.len() * 3);
             merged.extend(read_tree(&dir.path().join("out")));
         }
-        assert!(merged == full, "{dither:?}: merged parts differ from the full run");
+        assert!(
+            merged == full,
+            "{dither:?}: merged parts differ from the full run"
+        );
     }
 }
 
@@ -148,22 +188,40 @@ Union(false, [RectPrism(Vec3(-2.5,0,0), Vec3(5,10,10), m.id("red")), RectPrism(V
     assert_eq!(px(top, 0, 0), RED);
     assert_eq!(px(top, 9, 0), BLUE, "max X, max Y is column 9, row 0");
     assert_eq!(px(top, 9, 9), VOID, "max X, min Y is void");
-    assert_eq!(px(bottom, 9, 0), VOID, "the blue cube is in the upper layers only");
+    assert_eq!(
+        px(bottom, 9, 0),
+        VOID,
+        "the blue cube is in the upper layers only"
+    );
 }
 
 #[test]
 fn one_bit_stacks_match_the_colour_stack() {
     let m = model(TWO_BOXES);
     let dir = tmp();
-    let p = PngParams { per_material_bitmaps: true, ..params(0.5, Dither::Random) };
+    let p = PngParams {
+        per_material_bitmaps: true,
+        ..params(0.5, Dither::Random)
+    };
     let s = export(&m, &p, &dir.path().join("out")).unwrap();
     let tree = read_tree(&dir.path().join("out"));
     for (name, count) in &s.counts {
         let mut ones = 0u64;
-        for (file, bytes) in tree.iter().filter(|(f, _)| f.starts_with(&format!("{name}/"))) {
+        for (file, bytes) in tree
+            .iter()
+            .filter(|(f, _)| f.starts_with(&format!("{name}/")))
+        {
             let png = decode(bytes);
-            assert_eq!((png.color, png.depth), (png::ColorType::Grayscale, png::BitDepth::One), "{file}");
-            ones += png.data.iter().map(|b| u64::from(b.count_ones())).sum::<u64>();
+            assert_eq!(
+                (png.color, png.depth),
+                (png::ColorType::Grayscale, png::BitDepth::One),
+                "{file}"
+            );
+            ones += png
+                .data
+                .iter()
+                .map(|b| u64::from(b.count_ones()))
+                .sum::<u64>();
         }
         assert_eq!(ones, *count, "{name}");
     }
@@ -176,14 +234,20 @@ fn cancel_leaves_no_output() {
     let dest = dir.path().join("out");
     let p = params(0.02, Dither::Diffusion);
     let mm = m.clone();
-    let h = volcad_compilers::job::spawn(dest.clone(), "t".into(), move |ctx| export_png_stack(&mm, &p, ctx));
+    let h = volcad_compilers::job::spawn(dest.clone(), "t".into(), move |ctx| {
+        export_png_stack(&mm, &p, ctx)
+    });
     // Wait for the first layers, then cancel.
     let first = h.progress.recv_timeout(std::time::Duration::from_secs(60));
     assert!(first.is_ok(), "no progress");
     h.cancel();
     assert!(matches!(h.join(), Err(ExportError::Cancelled)));
     assert!(!dest.exists());
-    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "no staging folder left");
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "no staging folder left"
+    );
 }
 
 #[test]
@@ -191,23 +255,47 @@ fn bad_input_is_refused_naming_the_parameter() {
     let m = model(GRADED_BAR);
     let err = |p: PngParams| estimate(&m, &p).unwrap_err().to_string();
     for v in [0.0, -0.1, f64::NAN] {
-        assert!(err(params(v, Dither::Random)).starts_with("--voxel:"), "{v}");
+        assert!(
+            err(params(v, Dither::Random)).starts_with("--voxel:"),
+            "{v}"
+        );
     }
     let e = err(params(1e-5, Dither::Random));
     assert!(e.starts_with("--voxel:") && e.contains("voxels"), "{e}");
-    let e = err(PngParams { layers: Some(10..100), ..params(0.5, Dither::Random) });
+    let e = err(PngParams {
+        layers: Some(10..100),
+        ..params(0.5, Dither::Random)
+    });
     assert!(e.starts_with("--layers:") && e.contains("10 layers"), "{e}");
-    let e = err(PngParams { layers: Some(3..3), ..params(0.5, Dither::Random) });
+    let e = err(PngParams {
+        layers: Some(3..3),
+        ..params(0.5, Dither::Random)
+    });
     assert!(e.starts_with("--layers:"), "{e}");
     // Under the voxel limit, but one layer's buffers cannot fit in memory.
-    let e = err(PngParams { voxel: DVec3::new(1e-4, 1e-4, 5.0), ..params(1.0, Dither::Random) });
-    assert!(e.starts_with("--voxel:") && e.contains("200000 × 100000") && e.contains("memory"), "{e}");
-    let tile = model(r#"let m = default_materials(); Tile(GraphLattice(LatticeType::BodyCenteredCubic, Vec3(5,5,5), 0.5, m.id("red")))"#);
-    let e = estimate(&tile, &params(0.5, Dither::Random)).unwrap_err().to_string();
+    let e = err(PngParams {
+        voxel: DVec3::new(1e-4, 1e-4, 5.0),
+        ..params(1.0, Dither::Random)
+    });
+    assert!(
+        e.starts_with("--voxel:") && e.contains("200000 × 100000") && e.contains("memory"),
+        "{e}"
+    );
+    let tile = model(
+        r#"let m = default_materials(); Tile(GraphLattice(LatticeType::BodyCenteredCubic, Vec3(5,5,5), 0.5, m.id("red")))"#,
+    );
+    let e = estimate(&tile, &params(0.5, Dither::Random))
+        .unwrap_err()
+        .to_string();
     assert!(e.starts_with("design:") && e.contains("unbounded"), "{e}");
     let dir = tmp();
-    let p = PngParams { threads: Some(0), ..params(0.5, Dither::Random) };
-    let e = export(&m, &p, &dir.path().join("out")).unwrap_err().to_string();
+    let p = PngParams {
+        threads: Some(0),
+        ..params(0.5, Dither::Random)
+    };
+    let e = export(&m, &p, &dir.path().join("out"))
+        .unwrap_err()
+        .to_string();
     assert!(e.starts_with("--threads:"), "{e}");
     assert!(!dir.path().join("out").exists());
 }
@@ -215,18 +303,30 @@ fn bad_input_is_refused_naming_the_parameter() {
 #[test]
 fn a_material_missing_from_the_table_is_an_error() {
     let d = volcad_core::script::run_script(GRADED_BAR, "t.rhai", &Default::default()).unwrap();
-    let small = volcad_core::MaterialTable::from_json(r#"{"materials":[{"name":"only","r":1,"g":2,"b":3,"a":255}]}"#, "small.json").unwrap();
+    let small = volcad_core::MaterialTable::from_json(
+        r#"{"materials":[{"name":"only","r":1,"g":2,"b":3,"a":255}]}"#,
+        "small.json",
+    )
+    .unwrap();
     let m = Arc::new(Model::prepare(&d.root, Arc::new(small)).unwrap());
     let dir = tmp();
-    let e = export(&m, &params(0.5, Dither::Random), &dir.path().join("out")).unwrap_err().to_string();
-    assert!(e.starts_with("materials:") && e.contains("small.json"), "{e}");
+    let e = export(&m, &params(0.5, Dither::Random), &dir.path().join("out"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("materials:") && e.contains("small.json"),
+        "{e}"
+    );
     assert!(!dir.path().join("out").exists());
 }
 
 #[test]
 fn j750_preset_estimate() {
     let m = model(GRADED_BAR);
-    let p = PngParams { voxel: preset("j750").unwrap().voxel, ..PngParams::default() };
+    let p = PngParams {
+        voxel: preset("j750").unwrap().voxel,
+        ..PngParams::default()
+    };
     let e = estimate(&m, &p).unwrap();
     // 20 mm / (25.4/600) = 472.4 → 473; 10 mm / (25.4/300) → 119; 5 / 0.027 → 186.
     assert_eq!(e.grid.dims, [473, 119, 186]);

@@ -310,7 +310,7 @@ impl<'a> Sampler<'a> {
                             }
                         } else {
                             let p = self.grid.center(x, y, z);
-                            self.model.eval_into(p, &mut f[..k]);
+                            self.model.fractions_inside(p, &mut f[..k]);
                             for (o, v) in out.iter_mut().zip(&f[..k]) {
                                 *o = *v as f32;
                             }

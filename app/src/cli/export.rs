@@ -89,7 +89,11 @@ pub struct ExportArgs {
 fn parse_voxel(s: &str) -> anyhow::Result<DVec3> {
     let parts: Vec<f64> = s
         .split(',')
-        .map(|p| p.trim().parse::<f64>().with_context(|| format!("--voxel {s}: {p:?} is not a number")))
+        .map(|p| {
+            p.trim()
+                .parse::<f64>()
+                .with_context(|| format!("--voxel {s}: {p:?} is not a number"))
+        })
         .collect::<anyhow::Result<_>>()?;
     let v = match parts.as_slice() {
         [a] => DVec3::splat(*a),
@@ -103,9 +107,17 @@ fn parse_voxel(s: &str) -> anyhow::Result<DVec3> {
 }
 
 fn parse_layers(s: &str) -> anyhow::Result<std::ops::Range<usize>> {
-    let (a, b) = s.split_once("..").with_context(|| format!("--layers {s}: expected A..B, e.g. 100..200"))?;
-    let a: usize = a.trim().parse().with_context(|| format!("--layers {s}: bad start"))?;
-    let b: usize = b.trim().parse().with_context(|| format!("--layers {s}: bad end"))?;
+    let (a, b) = s
+        .split_once("..")
+        .with_context(|| format!("--layers {s}: expected A..B, e.g. 100..200"))?;
+    let a: usize = a
+        .trim()
+        .parse()
+        .with_context(|| format!("--layers {s}: bad start"))?;
+    let b: usize = b
+        .trim()
+        .parse()
+        .with_context(|| format!("--layers {s}: bad end"))?;
     if a >= b {
         bail!("--layers {s}: the start must be below the end");
     }
@@ -130,7 +142,10 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
         ),
         (None, None) => None,
     };
-    let hash = design_hash(&[l.source.as_bytes(), format!("{:?}", a.design.params).as_bytes()]);
+    let hash = design_hash(&[
+        l.source.as_bytes(),
+        format!("{:?}", a.design.params).as_bytes(),
+    ]);
     if let Some(t) = a.threads
         && t == 0
     {
@@ -146,7 +161,9 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
                 d => bail!("--dither {d}: expected random or diffusion"),
             };
             let p = PngParams {
-                voxel: voxel.context("--voxel or --preset is required for png (e.g. --voxel 0.1 or --preset j750)")?,
+                voxel: voxel.context(
+                    "--voxel or --preset is required for png (e.g. --voxel 0.1 or --preset j750)",
+                )?,
                 seed: a.seed,
                 dither,
                 layers: a.layers.as_deref().map(parse_layers).transpose()?,
@@ -163,7 +180,9 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
                 est.disk_bytes as f64 / 1e6,
                 est.memory_bytes as f64 / 1e6
             );
-            job::spawn(dest, hash, move |ctx| png_stack::export_png_stack(&model, &p, ctx))
+            job::spawn(dest, hash, move |ctx| {
+                png_stack::export_png_stack(&model, &p, ctx)
+            })
         }
         Kind::Mesh => {
             let by = match a.by.as_deref() {
@@ -174,11 +193,17 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
                 voxel: voxel.context("--voxel is required for mesh (e.g. --voxel 0.25)")?,
                 segments: a.segments,
                 by,
-                formats: MeshFormats { stl: true, obj: true, threemf: true },
+                formats: MeshFormats {
+                    stl: true,
+                    obj: true,
+                    threemf: true,
+                },
                 infill_expr: a.infill.clone(),
                 threads,
             };
-            job::spawn(dest, hash, move |ctx| volcad_compilers::mesh::export_meshes(&model, &p, ctx))
+            job::spawn(dest, hash, move |ctx| {
+                volcad_compilers::mesh::export_meshes(&model, &p, ctx)
+            })
         }
         Kind::Fea => {
             let element = match a.element.as_str() {
@@ -196,10 +221,14 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
                 max_cell: a.max_cell.unwrap_or(min_cell * 4.0),
                 sizing: a.sizing.clone().map_or(Sizing::Heterogeneity, Sizing::Expr),
                 seed: a.seed,
-                step: a.step.map(|d| StepParams { top_displacement: d }),
+                step: a.step.map(|d| StepParams {
+                    top_displacement: d,
+                }),
                 threads,
             };
-            job::spawn(dest, hash, move |ctx| volcad_compilers::fea::export_fea(&model, &p, ctx))
+            job::spawn(dest, hash, move |ctx| {
+                volcad_compilers::fea::export_fea(&model, &p, ctx)
+            })
         }
     };
     follow(handle)
@@ -214,8 +243,10 @@ fn follow(handle: job::JobHandle) -> anyhow::Result<()> {
     let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
     let bar = indicatif::ProgressBar::new(1000);
     bar.set_style(
-        indicatif::ProgressStyle::with_template("{spinner} {msg:<24} [{bar:30}] {percent:>3}% eta {eta}")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        indicatif::ProgressStyle::with_template(
+            "{spinner} {msg:<24} [{bar:30}] {percent:>3}% eta {eta}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     let dest = handle.destination().to_path_buf();
     while !handle.is_finished() {
@@ -230,7 +261,12 @@ fn follow(handle: job::JobHandle) -> anyhow::Result<()> {
     }
     bar.finish_and_clear();
     let summary = handle.join()?;
-    println!("{}: {} files in {}", summary.kind, summary.files.len(), dest.display());
+    println!(
+        "{}: {} files in {}",
+        summary.kind,
+        summary.files.len(),
+        dest.display()
+    );
     for (name, count) in &summary.counts {
         println!("  {name:<16} {count}");
     }

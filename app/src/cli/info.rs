@@ -1,7 +1,7 @@
 //! `volcad info`, `volcad eval` and `volcad bench`.
 
-use std::path::PathBuf;
 use glam::DVec3;
+use std::path::PathBuf;
 
 use super::DesignArgs;
 use super::design::load_design;
@@ -75,9 +75,15 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
     } else {
         args.designs.clone()
     };
-    println!("{:<28} {:>8} {:>14} {:>16}", "design", "nodes", "prepare (ms)", "points/s (±2mm)");
+    println!(
+        "{:<28} {:>8} {:>14} {:>16}",
+        "design", "nodes", "prepare (ms)", "points/s (±2mm)"
+    );
     for path in designs {
-        let d = super::DesignArgs { design: path.clone(), params: vec![] };
+        let d = super::DesignArgs {
+            design: path.clone(),
+            params: vec![],
+        };
         let l = match load_design(&d) {
             Ok(l) => l,
             Err(e) => {
@@ -89,7 +95,9 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
         let pps = volcad_core::bench::points_per_second(&l.model, &pts);
         println!(
             "{:<28} {:>8} {:>14.1} {:>16.3e}",
-            path.file_name().map(|f| f.to_string_lossy().to_string()).unwrap_or_default(),
+            path.file_name()
+                .map(|f| f.to_string_lossy().to_string())
+                .unwrap_or_default(),
             l.model.node_count(),
             l.model.prepare_time().as_secs_f64() * 1e3,
             pps

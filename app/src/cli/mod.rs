@@ -89,7 +89,11 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Info(d) => info::info(&d),
         Command::Eval { design, x, y, z } => info::eval(&design, x, y, z),
-        Command::Sample { design, points, out } => sample::sample(&design, &points, &out),
+        Command::Sample {
+            design,
+            points,
+            out,
+        } => sample::sample(&design, &points, &out),
         Command::Render(a) => render::render(&a),
         Command::Export(a) => export::export(&a),
         Command::FeaResult { frd, inp, out } => export::fea_result(&frd, &inp, &out),

@@ -12,29 +12,42 @@ use super::design::load_design;
 
 /// Read `x,y,z` rows (header required, column order free).
 fn read_points(path: &Path) -> anyhow::Result<Vec<DVec3>> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty());
     let Some((_, header)) = lines.next() else {
         bail!("{}: empty file; expected a header `x,y,z`", path.display());
     };
     let cols: Vec<String> = header.split(',').map(|c| c.trim().to_lowercase()).collect();
     let find = |n: &str| {
-        cols.iter()
-            .position(|c| c == n)
-            .with_context(|| format!("{}:1: no column `{n}` in the header (expected x,y,z)", path.display()))
+        cols.iter().position(|c| c == n).with_context(|| {
+            format!(
+                "{}:1: no column `{n}` in the header (expected x,y,z)",
+                path.display()
+            )
+        })
     };
     let (ix, iy, iz) = (find("x")?, find("y")?, find("z")?);
     let mut pts = Vec::new();
     for (i, line) in lines {
         let cells: Vec<&str> = line.split(',').map(str::trim).collect();
         let get = |c: usize, name: &str| -> anyhow::Result<f64> {
-            let s = cells
-                .get(c)
-                .with_context(|| format!("{}:{}: missing column `{name}`", path.display(), i + 1))?;
+            let s = cells.get(c).with_context(|| {
+                format!("{}:{}: missing column `{name}`", path.display(), i + 1)
+            })?;
             s.parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite())
-                .with_context(|| format!("{}:{}: `{name}` = {s:?} is not a finite number", path.display(), i + 1))
+                .with_context(|| {
+                    format!(
+                        "{}:{}: `{name}` = {s:?} is not a finite number",
+                        path.display(),
+                        i + 1
+                    )
+                })
         };
         pts.push(DVec3::new(get(ix, "x")?, get(iy, "y")?, get(iz, "z")?));
     }

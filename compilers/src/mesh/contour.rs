@@ -38,6 +38,7 @@
 //! kept: memory is proportional to a plane plus the output.
 
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -89,7 +90,14 @@ pub struct Plane {
 /// Edge-point parameter clamp: keeps every triangle off the sample points.
 const T_MIN: f64 = 1e-3;
 /// Axis orders of the six Kuhn tets.
-const PERMS: [[u8; 3]; 6] = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
+const PERMS: [[u8; 3]; 6] = [
+    [0, 1, 2],
+    [0, 2, 1],
+    [1, 0, 2],
+    [1, 2, 0],
+    [2, 0, 1],
+    [2, 1, 0],
+];
 /// Faces of a positively oriented tet (v0..v3), counter-clockwise seen from
 /// outside.
 const FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
@@ -97,6 +105,29 @@ const FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
 const FACE_KEY: u64 = 8;
 const TET_KEY: u64 = 72;
 const KEY_TYPES: u64 = 128;
+
+/// Hasher for the vertex keys (already well spread u64s): one multiply
+/// (Fibonacci hashing) instead of SipHash, which dominated the merge.
+#[derive(Default)]
+struct KeyHasher(u64);
+
+impl Hasher for KeyHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for b in bytes {
+            self.0 = (self.0 ^ u64::from(*b)).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+
+    fn write_u64(&mut self, k: u64) {
+        self.0 = k.wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(26);
+    }
+}
+
+type KeyMap = HashMap<u64, u32, BuildHasherDefault<KeyHasher>>;
 
 /// A point of the contour inside one cube, by the cube corners (bit masks
 /// x = 1, y = 2, z = 4) it is built from.
@@ -126,7 +157,11 @@ struct Tri {
 
 /// Order corner masks by inclusion (Kuhn corners are nested sets).
 fn by_inclusion(a: u8, b: u8) -> (u8, u8) {
-    if a.count_ones() < b.count_ones() { (a, b) } else { (b, a) }
+    if a.count_ones() < b.count_ones() {
+        (a, b)
+    } else {
+        (b, a)
+    }
 }
 
 fn edge(a: u8, b: u8) -> Pt {
@@ -149,7 +184,7 @@ pub struct Contourer {
     meshes: Vec<IndexedMesh>,
     /// Per label: key → vertex index, for keys based in the lower and the
     /// upper plane of the current cube layer.
-    maps: Vec<[HashMap<u64, u32>; 2]>,
+    maps: Vec<[KeyMap; 2]>,
     prev: Option<(usize, Plane)>,
 }
 
@@ -160,7 +195,9 @@ impl Contourer {
             grid,
             iface,
             meshes: vec![IndexedMesh::default(); labels],
-            maps: (0..labels).map(|_| [HashMap::new(), HashMap::new()]).collect(),
+            maps: (0..labels)
+                .map(|_| [KeyMap::default(), KeyMap::default()])
+                .collect(),
             prev: None,
         }
     }
@@ -172,8 +209,15 @@ impl Contourer {
     /// If a plane is skipped or has the wrong size.
     pub fn push_plane(&mut self, z: usize, plane: Plane) {
         let layer = self.grid.dims[0] * self.grid.dims[1];
-        assert!(plane.label.len() == layer && plane.dist.len() == layer, "plane size");
-        assert_eq!(plane.value.len(), layer * self.iface.stride(), "plane values");
+        assert!(
+            plane.label.len() == layer && plane.dist.len() == layer,
+            "plane size"
+        );
+        assert_eq!(
+            plane.value.len(),
+            layer * self.iface.stride(),
+            "plane values"
+        );
         let Some((pz, lo)) = self.prev.take() else {
             assert_eq!(z, 0, "planes must start at 0");
             self.prev = Some((z, plane));
@@ -181,7 +225,10 @@ impl Contourer {
         };
         assert_eq!(pz + 1, z, "planes must come in order");
         let ny = self.grid.dims[1];
-        let rows: Vec<Vec<Tri>> = (0..ny.saturating_sub(1)).into_par_iter().map(|j| self.row(pz, j, &lo, &plane)).collect();
+        let rows: Vec<Vec<Tri>> = (0..ny.saturating_sub(1))
+            .into_par_iter()
+            .map(|j| self.row(pz, j, &lo, &plane))
+            .collect();
         let plane_len = layer as u64;
         for tri in rows.iter().flatten() {
             let l = tri.label as usize - 1;
@@ -217,7 +264,11 @@ impl Contourer {
             let mut idx = [0usize; 8];
             for (c, (l, ix)) in label.iter_mut().zip(&mut idx).enumerate() {
                 *ix = (j + (c >> 1 & 1)) * nx + i + (c & 1);
-                *l = if c & 4 == 0 { lo.label[*ix] } else { hi.label[*ix] };
+                *l = if c & 4 == 0 {
+                    lo.label[*ix]
+                } else {
+                    hi.label[*ix]
+                };
             }
             if label.iter().all(|l| *l == label[0]) {
                 continue;
@@ -239,7 +290,11 @@ impl Contourer {
     /// Grid index (i, j, k) of corner `m` of the cube.
     fn corner(cube: &Cube, m: u8) -> [usize; 3] {
         let [i, j, k] = cube.base;
-        [i + (m & 1) as usize, j + (m >> 1 & 1) as usize, k + (m >> 2 & 1) as usize]
+        [
+            i + (m & 1) as usize,
+            j + (m >> 1 & 1) as usize,
+            k + (m >> 2 & 1) as usize,
+        ]
     }
 
     fn global(&self, c: [usize; 3]) -> u64 {
@@ -274,11 +329,18 @@ impl Contourer {
                 }
             }
         };
-        if t.is_finite() { t.clamp(T_MIN, 1.0 - T_MIN) } else { 0.5 }
+        if t.is_finite() {
+            t.clamp(T_MIN, 1.0 - T_MIN)
+        } else {
+            0.5
+        }
     }
 
     fn edge_pos(&self, cube: &Cube, a: u8, b: u8) -> DVec3 {
-        let (pa, pb) = (self.center(Self::corner(cube, a)), self.center(Self::corner(cube, b)));
+        let (pa, pb) = (
+            self.center(Self::corner(cube, a)),
+            self.center(Self::corner(cube, b)),
+        );
         pa + (pb - pa) * self.crossing(cube, a, b)
     }
 
@@ -290,8 +352,13 @@ impl Contourer {
                 (key, self.edge_pos(cube, a, b))
             }
             Pt::Face(a, b, c) => {
-                let key = self.global(Self::corner(cube, a)) * KEY_TYPES + FACE_KEY + u64::from(b ^ a) * 8 + u64::from(c ^ a);
-                let sum = self.edge_pos(cube, a, b) + self.edge_pos(cube, b, c) + self.edge_pos(cube, a, c);
+                let key = self.global(Self::corner(cube, a)) * KEY_TYPES
+                    + FACE_KEY
+                    + u64::from(b ^ a) * 8
+                    + u64::from(c ^ a);
+                let sum = self.edge_pos(cube, a, b)
+                    + self.edge_pos(cube, b, c)
+                    + self.edge_pos(cube, a, c);
                 (key, sum / 3.0)
             }
             Pt::Tet => {
@@ -307,7 +374,10 @@ impl Contourer {
                 (key, sum / n)
             }
         };
-        VRef { key, pos: pos.as_vec3().to_array() }
+        VRef {
+            key,
+            pos: pos.as_vec3().to_array(),
+        }
     }
 
     /// Contour tet `perm` of `cube` into `out`.
@@ -316,7 +386,11 @@ impl Contourer {
         let m1 = 1u8 << a1;
         let m2 = m1 | 1 << a2;
         // Even axis orders give positively oriented tets; swap for odd ones.
-        let v: [u8; 4] = if matches!(perm, 0 | 3 | 4) { [0, m1, m2, 7] } else { [0, m2, m1, 7] };
+        let v: [u8; 4] = if matches!(perm, 0 | 3 | 4) {
+            [0, m1, m2, 7]
+        } else {
+            [0, m2, m1, 7]
+        };
         let lab = v.map(|m| cube.label[m as usize]);
         if lab.iter().all(|l| *l == lab[0]) {
             return;
@@ -373,14 +447,21 @@ impl Contourer {
             } else {
                 (distinct[0], distinct[1])
             };
-            let mine: Vec<(Pt, Pt)> = segs.iter().filter(|s| s.0 == x).map(|s| (s.1, s.2)).collect();
+            let mine: Vec<(Pt, Pt)> = segs
+                .iter()
+                .filter(|s| s.0 == x)
+                .map(|s| (s.1, s.2))
+                .collect();
             if let Some(ring) = chain(&mine) {
                 let ring: Vec<VRef> = ring.into_iter().map(res).collect();
                 for i in 1..ring.len() - 1 {
                     let t = [ring[0], ring[i], ring[i + 1]];
                     out.push(Tri { label: x, v: t });
                     if y != 0 {
-                        out.push(Tri { label: y, v: [t[0], t[2], t[1]] });
+                        out.push(Tri {
+                            label: y,
+                            v: [t[0], t[2], t[1]],
+                        });
                     }
                 }
                 return;
@@ -390,7 +471,10 @@ impl Contourer {
         let apex = res(Pt::Tet);
         for (l, a, b) in segs {
             if l != 0 {
-                out.push(Tri { label: l, v: [res(a), res(b), apex] });
+                out.push(Tri {
+                    label: l,
+                    v: [res(a), res(b), apex],
+                });
             }
         }
     }
@@ -425,19 +509,35 @@ pub fn marching_cubes(grid: &Grid, values: &[f32]) -> IndexedMesh {
     for z in 0..nz {
         let dist = values[z * nx * ny..(z + 1) * nx * ny].to_vec();
         let label = border_void(&dist, [nx, ny, nz], z, |d| u16::from(d <= 0.0));
-        c.push_plane(z, Plane { label, dist, value: Vec::new() });
+        c.push_plane(
+            z,
+            Plane {
+                label,
+                dist,
+                value: Vec::new(),
+            },
+        );
     }
     c.finish().pop().unwrap_or_default()
 }
 
 /// Labels of plane `z` from `f`, with the grid's outer layer void.
-pub fn border_void(dist: &[f32], [nx, ny, nz]: [usize; 3], z: usize, f: impl Fn(f32) -> u16) -> Vec<u16> {
+pub fn border_void(
+    dist: &[f32],
+    [nx, ny, nz]: [usize; 3],
+    z: usize,
+    f: impl Fn(f32) -> u16,
+) -> Vec<u16> {
     let edge_plane = z == 0 || z + 1 == nz;
     dist.iter()
         .enumerate()
         .map(|(v, d)| {
             let (x, y) = (v % nx, v / nx);
-            if edge_plane || x == 0 || y == 0 || x + 1 == nx || y + 1 == ny { 0 } else { f(*d) }
+            if edge_plane || x == 0 || y == 0 || x + 1 == nx || y + 1 == ny {
+                0
+            } else {
+                f(*d)
+            }
         })
         .collect()
 }

@@ -7,6 +7,8 @@
 //! exactly two triangles, once in each direction (which also makes the
 //! orientation consistent), and no triangle repeats an index.
 
+use rayon::prelude::*;
+
 /// Triangles over shared vertices (mm), counter-clockwise seen from outside.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct IndexedMesh {
@@ -39,7 +41,11 @@ fn f64x3(p: [f32; 3]) -> [f64; 3] {
 }
 
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
@@ -88,22 +94,47 @@ impl IndexedMesh {
         let [a, b, c] = self.corners(t);
         let n = cross(sub(b, a), sub(c, a));
         let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        if len > 0.0 { n.map(|v| (v / len) as f32) } else { [0.0; 3] }
+        if len > 0.0 {
+            n.map(|v| (v / len) as f32)
+        } else {
+            [0.0; 3]
+        }
     }
 
     /// Count open, repeated and degenerate edges.
+    ///
+    /// Directed edges `a → b` are packed as `a·2³² + b`; the list and the
+    /// list of reversed edges are sorted (in parallel) and walked together:
+    /// an edge of the first with no partner in the second is open.
     pub fn edge_report(&self) -> EdgeReport {
         let mut r = EdgeReport::default();
-        let mut edges: Vec<(u32, u32)> = Vec::with_capacity(self.triangles.len() * 3);
+        let mut edges: Vec<u64> = Vec::with_capacity(self.triangles.len() * 3);
         for t in &self.triangles {
             if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
                 r.degenerate += 1;
             }
-            edges.extend([(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]);
+            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                edges.push(u64::from(a) << 32 | u64::from(b));
+            }
         }
-        edges.sort_unstable();
+        let mut reversed: Vec<u64> = edges.iter().map(|e| e.rotate_left(32)).collect();
+        rayon::join(
+            || edges.par_sort_unstable(),
+            || reversed.par_sort_unstable(),
+        );
         r.repeated = edges.windows(2).filter(|w| w[0] == w[1]).count();
-        r.open = edges.iter().filter(|(a, b)| edges.binary_search(&(*b, *a)).is_err()).count();
+        let (mut i, mut j) = (0, 0);
+        while i < edges.len() {
+            if j == reversed.len() || edges[i] < reversed[j] {
+                r.open += 1;
+                i += 1;
+            } else if edges[i] == reversed[j] {
+                i += 1;
+                j += 1;
+            } else {
+                j += 1;
+            }
+        }
         r
     }
 
@@ -119,9 +150,34 @@ mod tests {
 
     /// The unit cube, outward oriented (12 triangles from 3MF.md).
     pub(crate) fn cube() -> IndexedMesh {
-        let v = [[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.], [0., 0., 1.], [1., 0., 1.], [1., 1., 1.], [0., 1., 1.]];
-        let t = [[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4], [3, 7, 6], [3, 6, 2], [0, 4, 7], [0, 7, 3], [1, 2, 6], [1, 6, 5]];
-        IndexedMesh { vertices: v.to_vec(), triangles: t.to_vec() }
+        let v = [
+            [0., 0., 0.],
+            [1., 0., 0.],
+            [1., 1., 0.],
+            [0., 1., 0.],
+            [0., 0., 1.],
+            [1., 0., 1.],
+            [1., 1., 1.],
+            [0., 1., 1.],
+        ];
+        let t = [
+            [0, 2, 1],
+            [0, 3, 2],
+            [4, 5, 6],
+            [4, 6, 7],
+            [0, 1, 5],
+            [0, 5, 4],
+            [3, 7, 6],
+            [3, 6, 2],
+            [0, 4, 7],
+            [0, 7, 3],
+            [1, 2, 6],
+            [1, 6, 5],
+        ];
+        IndexedMesh {
+            vertices: v.to_vec(),
+            triangles: t.to_vec(),
+        }
     }
 
     #[test]

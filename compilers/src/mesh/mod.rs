@@ -19,6 +19,13 @@
 //! segment's range `(s + ½)/n` when splitting by a material, and the mean
 //! dominant fraction over the segment's voxels when splitting by dominant
 //! material.
+//!
+//! # Differences from pyvcad's `MeshCompiler`
+//!
+//! Any material (pyvcad always splits by material id 1) or the dominant
+//! one; binary STL (pyvcad: ASCII through VTK) plus OBJ and 3MF; segments
+//! share their interfaces exactly instead of being contoured one by one
+//! (which leaves gaps and overlaps); fractions are normalised by their sum.
 
 pub mod contour;
 pub mod indexed;
@@ -41,9 +48,9 @@ use volcad_core::{MaterialId, Model};
 pub use contour::marching_cubes;
 pub use indexed::{EdgeReport, IndexedMesh};
 
+use crate::design::{grid_for, palette};
 use crate::job::{ExportError, JobContext, Summary};
 use crate::png_io::folder_name;
-use crate::png_stack::grid_for;
 use crate::probe::probe;
 use crate::resources::{check_disk, check_memory, human_bytes, run_with_threads};
 use contour::Contourer;
@@ -82,7 +89,11 @@ pub struct MeshFormats {
 impl Default for MeshFormats {
     /// All three.
     fn default() -> Self {
-        Self { stl: true, obj: true, threemf: true }
+        Self {
+            stl: true,
+            obj: true,
+            threemf: true,
+        }
     }
 }
 
@@ -106,7 +117,14 @@ pub struct MeshParams {
 impl Default for MeshParams {
     /// 0.1 mm voxels, by dominant material, every format.
     fn default() -> Self {
-        Self { voxel: DVec3::splat(0.1), segments: 4, by: SegmentBy::Dominant, formats: MeshFormats::default(), infill_expr: None, threads: None }
+        Self {
+            voxel: DVec3::splat(0.1),
+            segments: 4,
+            by: SegmentBy::Dominant,
+            formats: MeshFormats::default(),
+            infill_expr: None,
+            threads: None,
+        }
     }
 }
 
@@ -160,21 +178,35 @@ fn plan(model: &Model, p: &MeshParams) -> Result<Plan, ExportError> {
             if id == 0 || model.table().get(id).is_none() {
                 return Err(ExportError::param(
                     "--material",
-                    format!("material id {id} is not in the material table ({}); it has ids 1..={}", model.table().origin(), model.table().len() - 1),
+                    format!(
+                        "material id {id} is not in the material table ({}); it has ids 1..={}",
+                        model.table().origin(),
+                        model.table().len() - 1
+                    ),
                 ));
             }
             if !(1..=MAX_SEGMENTS).contains(&p.segments) {
-                return Err(ExportError::param("--segments", format!("{} segments; use 1..={MAX_SEGMENTS}", p.segments)));
+                return Err(ExportError::param(
+                    "--segments",
+                    format!("{} segments; use 1..={MAX_SEGMENTS}", p.segments),
+                ));
             }
-            Classifier::Ranges { slot: model.materials().iter().position(|m| *m == id), n: p.segments }
+            Classifier::Ranges {
+                slot: model.materials().iter().position(|m| *m == id),
+                n: p.segments,
+            }
         }
     };
     if !(p.formats.stl || p.formats.obj || p.formats.threemf) {
-        return Err(ExportError::param("--format", "no output format chosen; pick stl, obj and/or 3mf"));
+        return Err(ExportError::param(
+            "--format",
+            "no output format chosen; pick stl, obj and/or 3mf",
+        ));
     }
     let src = p.infill_expr.as_deref().unwrap_or(DEFAULT_INFILL);
-    let infill = Expr::compile(src, &["f"]).map_err(|e| ExportError::param("--infill", e.to_string()))?;
-    crate::png_stack::palette(model)?;
+    let infill =
+        Expr::compile(src, &["f"]).map_err(|e| ExportError::param("--infill", e.to_string()))?;
+    palette(model)?;
     let grid = grid_for(model, p.voxel, p.voxel.max_element())?;
     let [nx, ny, nz] = grid.dims;
     let layer = nx * ny;
@@ -191,8 +223,13 @@ fn plan(model: &Model, p: &MeshParams) -> Result<Plan, ExportError> {
     let mesh_bytes = triangles * 12 + triangles / 2 * 40;
     let planes = (2 * layer * (2 + 4 + 4 * stride)) as u64;
     let memory_bytes = (slab_layers * per_layer) as u64 + planes + mesh_bytes;
-    check_memory(memory_bytes, &format!("meshing {nx} × {ny} × {nz} voxels (about {triangles} triangles)"))?;
-    let per_tri = f64::from(u8::from(p.formats.stl)) * 50.0 + f64::from(u8::from(p.formats.obj)) * 40.0 + f64::from(u8::from(p.formats.threemf)) * 20.0;
+    check_memory(
+        memory_bytes,
+        &format!("meshing {nx} × {ny} × {nz} voxels (about {triangles} triangles)"),
+    )?;
+    let per_tri = f64::from(u8::from(p.formats.stl)) * 50.0
+        + f64::from(u8::from(p.formats.obj)) * 40.0
+        + f64::from(u8::from(p.formats.threemf)) * 20.0;
     let estimate = MeshEstimate {
         grid,
         voxels: grid.count(),
@@ -202,7 +239,13 @@ fn plan(model: &Model, p: &MeshParams) -> Result<Plan, ExportError> {
         memory_bytes,
         disk_bytes: (triangles as f64 * per_tri) as u64 + 4096 * segments as u64,
     };
-    Ok(Plan { grid, classifier, infill, slab_layers, estimate })
+    Ok(Plan {
+        grid,
+        classifier,
+        infill,
+        slab_layers,
+        estimate,
+    })
 }
 
 /// Grid, memory, rough triangle count and output size; errors for bad
@@ -230,22 +273,36 @@ fn segment_names(model: &Model, p: &MeshParams, c: &Classifier) -> Vec<String> {
 /// Compute every segment's mesh in memory (`progress(layers_done, layers)`
 /// after each slab). The export writes these; tests and previews use them
 /// directly.
-pub fn segment_meshes(model: &Model, p: &MeshParams, cancel: &AtomicBool, progress: impl Fn(usize, usize) + Sync) -> Result<Vec<SegmentMesh>, ExportError> {
+pub fn segment_meshes(
+    model: &Model,
+    p: &MeshParams,
+    cancel: &AtomicBool,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<Vec<SegmentMesh>, ExportError> {
     let pl = plan(model, p)?;
     run_with_threads(p.threads, || build(model, p, &pl, cancel, &progress))
 }
 
-fn build(model: &Model, p: &MeshParams, pl: &Plan, cancel: &AtomicBool, progress: &(impl Fn(usize, usize) + Sync)) -> Result<Vec<SegmentMesh>, ExportError> {
+fn build(
+    model: &Model,
+    p: &MeshParams,
+    pl: &Plan,
+    cancel: &AtomicBool,
+    progress: &(impl Fn(usize, usize) + Sync),
+) -> Result<Vec<SegmentMesh>, ExportError> {
     let dims = pl.grid.dims;
     let nz = dims[2];
     let sampler = Sampler::new(model, pl.grid, true);
-    let mut contourer = Contourer::new(pl.grid, pl.classifier.segments(), pl.classifier.interface());
+    let mut contourer =
+        Contourer::new(pl.grid, pl.classifier.segments(), pl.classifier.interface());
     let mut tally = Tally::new(pl.classifier.segments());
     let mut slab = Slab::default();
     let mut z0 = 0;
     while z0 < nz {
         let z1 = (z0 + pl.slab_layers).min(nz);
-        sampler.sample_layers(z0, z1, &mut slab, cancel).map_err(|_| ExportError::Cancelled)?;
+        sampler
+            .sample_layers(z0, z1, &mut slab, cancel)
+            .map_err(|_| ExportError::Cancelled)?;
         for z in z0..z1 {
             let (plane, t) = pl.classifier.plane(&slab, z - z0, dims, z);
             tally.add(&t);
@@ -264,13 +321,28 @@ fn build(model: &Model, p: &MeshParams, pl: &Plan, cancel: &AtomicBool, progress
             let voxels = tally.voxels[s];
             let f = match pl.classifier {
                 Classifier::Ranges { .. } => (s as f64 + 0.5) / n as f64,
-                Classifier::Dominant { .. } => if voxels > 0 { tally.sum_f[s] / voxels as f64 } else { 1.0 },
+                Classifier::Dominant { .. } => {
+                    if voxels > 0 {
+                        tally.sum_f[s] / voxels as f64
+                    } else {
+                        1.0
+                    }
+                }
             };
             let v = pl.infill.eval(&[f]);
             if !v.is_finite() {
-                return Err(ExportError::param("--infill", format!("\"{}\" gives {v} at f = {f}", pl.infill.source())));
+                return Err(ExportError::param(
+                    "--infill",
+                    format!("\"{}\" gives {v} at f = {f}", pl.infill.source()),
+                ));
             }
-            Ok(SegmentMesh { name: names[s].clone(), mesh, voxels, f, infill_percent: v.clamp(0.0, 100.0) })
+            Ok(SegmentMesh {
+                name: names[s].clone(),
+                mesh,
+                voxels,
+                f,
+                infill_percent: v.clamp(0.0, 100.0),
+            })
         })
         .collect()
 }
@@ -281,13 +353,23 @@ fn percent_text(v: f64) -> String {
 }
 
 /// Write the segments' files into `ctx.staging()`.
-pub fn export_meshes(model: &Model, p: &MeshParams, ctx: &JobContext) -> Result<Summary, ExportError> {
+pub fn export_meshes(
+    model: &Model,
+    p: &MeshParams,
+    ctx: &JobContext,
+) -> Result<Summary, ExportError> {
     let pl = plan(model, p)?;
     check_disk(pl.estimate.disk_bytes, ctx.staging())?;
     run_with_threads(p.threads, || {
         let nz = pl.grid.dims[2];
         let segs = build(model, p, &pl, ctx.cancel_flag(), &|done, total| {
-            ctx.progress("meshing", done as u64, total as u64, "layers", 0.9 * done as f64 / total.max(1) as f64);
+            ctx.progress(
+                "meshing",
+                done as u64,
+                total as u64,
+                "layers",
+                0.9 * done as f64 / total.max(1) as f64,
+            );
         })?;
         debug_assert!(nz > 0);
         ctx.check_cancel()?;
@@ -298,7 +380,9 @@ pub fn export_meshes(model: &Model, p: &MeshParams, ctx: &JobContext) -> Result<
 }
 
 fn create(path: &std::path::Path) -> Result<BufWriter<File>, ExportError> {
-    File::create(path).map(|f| BufWriter::with_capacity(1 << 20, f)).map_err(|e| ExportError::io(path, e))
+    File::create(path)
+        .map(|f| BufWriter::with_capacity(1 << 20, f))
+        .map_err(|e| ExportError::io(path, e))
 }
 
 /// One output file.
@@ -311,7 +395,11 @@ enum FileJob<'a> {
 
 /// Write every file, all in parallel (each file's bytes depend only on its
 /// meshes); the list comes back in a fixed order.
-fn write_files(segs: &[SegmentMesh], p: &MeshParams, ctx: &JobContext) -> Result<Vec<String>, ExportError> {
+fn write_files(
+    segs: &[SegmentMesh],
+    p: &MeshParams,
+    ctx: &JobContext,
+) -> Result<Vec<String>, ExportError> {
     let present: Vec<&SegmentMesh> = segs.iter().filter(|s| !s.mesh.is_empty()).collect();
     if present.is_empty() {
         return Err(ExportError::Other("no segment has any voxel at this voxel size; the part is thinner than a voxel or empty".into()));
@@ -344,34 +432,59 @@ fn write_files(segs: &[SegmentMesh], p: &MeshParams, ctx: &JobContext) -> Result
                 FileJob::ThreeMf => {
                     let parts: Vec<threemf::Part> = present
                         .iter()
-                        .map(|s| threemf::Part { name: &s.name, mesh: &s.mesh, settings: vec![("fill_density", percent_text(s.infill_percent))] })
+                        .map(|s| threemf::Part {
+                            name: &s.name,
+                            mesh: &s.mesh,
+                            settings: vec![("fill_density", percent_text(s.infill_percent))],
+                        })
                         .collect();
                     threemf::write_3mf(&parts, "part", &mut w)
                 }
             };
-            r.and_then(|_| w.flush()).map_err(|e| ExportError::io(&path, e))?;
+            r.and_then(|_| w.flush())
+                .map_err(|e| ExportError::io(&path, e))?;
             Ok(name)
         })
         .collect()
 }
 
-fn summary(model: &Model, p: &MeshParams, pl: &Plan, segs: &[SegmentMesh], files: Vec<String>) -> Summary {
+fn summary(
+    model: &Model,
+    p: &MeshParams,
+    pl: &Plan,
+    segs: &[SegmentMesh],
+    files: Vec<String>,
+) -> Summary {
     let [nx, ny, nz] = pl.grid.dims;
-    let mut notes = vec![format!("grid {nx} × {ny} × {nz} (padded by one voxel), working memory about {}", human_bytes(pl.estimate.memory_bytes))];
-    if let SegmentBy::Material(id) = p.by {
-        if !model.materials().contains(&id) {
-            notes.push(format!("material {} is not in the design: its fraction is 0 everywhere", model.table().name(id)));
-        }
+    let mut notes = vec![format!(
+        "grid {nx} × {ny} × {nz} (padded by one voxel), working memory about {}",
+        human_bytes(pl.estimate.memory_bytes)
+    )];
+    if let SegmentBy::Material(id) = p.by
+        && !model.materials().contains(&id)
+    {
+        notes.push(format!(
+            "material {} is not in the design: its fraction is 0 everywhere",
+            model.table().name(id)
+        ));
     }
     let mut total_volume = 0.0;
     for s in segs {
         if s.mesh.is_empty() {
-            notes.push(format!("{}: empty (no voxel in this range), no file", s.name));
+            notes.push(format!(
+                "{}: empty (no voxel in this range), no file",
+                s.name
+            ));
             continue;
         }
         let v = s.mesh.volume();
         total_volume += v;
-        let tight = if s.mesh.is_watertight() { "watertight" } else { "NOT WATERTIGHT (please report)" };
+        // The contouring guarantees this; checked anyway (costs a sort of the edges).
+        let tight = if s.mesh.is_watertight() {
+            "watertight"
+        } else {
+            "NOT WATERTIGHT (please report)"
+        };
         notes.push(format!(
             "{}: {} triangles, {} vertices, {v:.3} mm³, {tight}, fill_density {}",
             s.name,
@@ -382,7 +495,9 @@ fn summary(model: &Model, p: &MeshParams, pl: &Plan, segs: &[SegmentMesh], files
     }
     notes.push(format!("total volume {total_volume:.3} mm³"));
     let by = match p.by {
-        SegmentBy::Material(id) => json!({ "material": model.table().name(id), "id": id, "segments": p.segments }),
+        SegmentBy::Material(id) => {
+            json!({ "material": model.table().name(id), "id": id, "segments": p.segments })
+        }
         SegmentBy::Dominant => json!("dominant"),
     };
     Summary {

@@ -52,7 +52,10 @@ pub struct Tally {
 impl Tally {
     /// Zero tallies for `n` segments.
     pub fn new(n: usize) -> Self {
-        Self { voxels: vec![0; n], sum_f: vec![0.0; n] }
+        Self {
+            voxels: vec![0; n],
+            sum_f: vec![0.0; n],
+        }
     }
 
     /// Add `other` (in a fixed order, so sums are deterministic).
@@ -89,7 +92,7 @@ impl Classifier {
     #[inline]
     fn classify(&self, f: &[f32], value: &mut [f32]) -> (u16, f32) {
         let total: f32 = f.iter().sum();
-        if !(total > MIN_TOTAL) {
+        if total.is_nan() || total <= MIN_TOTAL {
             value.fill(0.0);
             return (0, 0.0);
         }
@@ -116,7 +119,13 @@ impl Classifier {
 
     /// The plane of labels for layer `l` of `slab` (grid `[nx, ny, nz]`,
     /// global layer `z`), with its tallies.
-    pub fn plane(&self, slab: &Slab, l: usize, [nx, ny, nz]: [usize; 3], z: usize) -> (Plane, Tally) {
+    pub fn plane(
+        &self,
+        slab: &Slab,
+        l: usize,
+        [nx, ny, nz]: [usize; 3],
+        z: usize,
+    ) -> (Plane, Tally) {
         let layer = nx * ny;
         let k = slab.k;
         let stride = self.interface().stride();
@@ -140,7 +149,10 @@ impl Classifier {
                     if dist[v] > 0.0 {
                         continue;
                     }
-                    let (lab, f) = self.classify(&fracs[v * k..(v + 1) * k], &mut values[x * stride..(x + 1) * stride]);
+                    let (lab, f) = self.classify(
+                        &fracs[v * k..(v + 1) * k],
+                        &mut values[x * stride..(x + 1) * stride],
+                    );
                     labels[x] = lab;
                     if lab > 0 {
                         t.voxels[lab as usize - 1] += 1;
@@ -164,7 +176,10 @@ mod tests {
 
     #[test]
     fn ranges_close_the_top_and_normalise() {
-        let c = Classifier::Ranges { slot: Some(0), n: 4 };
+        let c = Classifier::Ranges {
+            slot: Some(0),
+            n: 4,
+        };
         let mut v = [0.0];
         assert_eq!(c.classify(&[1.0, 0.0], &mut v).0, 4);
         assert_eq!(c.classify(&[0.25, 0.75], &mut v).0, 2);

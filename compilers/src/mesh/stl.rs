@@ -14,12 +14,15 @@ pub fn write_stl(mesh: &IndexedMesh, name: &str, w: &mut impl Write) -> io::Resu
     let n = text.len().min(80);
     header[..n].copy_from_slice(&text.as_bytes()[..n]);
     w.write_all(&header)?;
-    let count = u32::try_from(mesh.triangles.len()).map_err(|_| io::Error::other("more than 2^32 triangles do not fit in STL"))?;
+    let count = u32::try_from(mesh.triangles.len())
+        .map_err(|_| io::Error::other("more than 2^32 triangles do not fit in STL"))?;
     w.write_all(&count.to_le_bytes())?;
     let mut rec = [0u8; 50];
     for (t, tri) in mesh.triangles.iter().enumerate() {
         let n = mesh.normal(t);
-        let vals = n.iter().chain(tri.iter().flat_map(|i| mesh.vertices[*i as usize].iter()));
+        let vals = n
+            .iter()
+            .chain(tri.iter().flat_map(|i| mesh.vertices[*i as usize].iter()));
         for (dst, v) in rec.chunks_exact_mut(4).zip(vals) {
             dst.copy_from_slice(&v.to_le_bytes());
         }
@@ -39,7 +42,10 @@ mod tests {
 
     #[test]
     fn layout_is_84_plus_50_per_triangle() {
-        let m = IndexedMesh { vertices: vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]], triangles: vec![[0, 1, 2]] };
+        let m = IndexedMesh {
+            vertices: vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]],
+            triangles: vec![[0, 1, 2]],
+        };
         let mut out = Vec::new();
         write_stl(&m, "x", &mut out).unwrap();
         assert_eq!(out.len() as u64, stl_size(1));

@@ -76,7 +76,8 @@ pub fn write_3mf<W: Write + Seek>(parts: &[Part<'_>], object_name: &str, w: W) -
         .unix_permissions(0o644)
         .large_file(triangles > 10_000_000);
     let mut zip = ZipWriter::new(w);
-    zip.start_file("[Content_Types].xml", opts).map_err(zip_err)?;
+    zip.start_file("[Content_Types].xml", opts)
+        .map_err(zip_err)?;
     zip.write_all(CONTENT_TYPES.as_bytes())?;
     zip.start_file("_rels/.rels", opts).map_err(zip_err)?;
     zip.write_all(RELS.as_bytes())?;
@@ -86,7 +87,8 @@ pub fn write_3mf<W: Write + Seek>(parts: &[Part<'_>], object_name: &str, w: W) -
         write_model(parts, object_name, &mut m)?;
         m.flush()?;
     }
-    zip.start_file("Metadata/Slic3r_PE_model.config", opts).map_err(zip_err)?;
+    zip.start_file("Metadata/Slic3r_PE_model.config", opts)
+        .map_err(zip_err)?;
     write_config(parts, object_name, &mut zip)?;
     zip.finish().map_err(zip_err)?;
     Ok(())
@@ -100,7 +102,11 @@ fn write_model(parts: &[Part<'_>], object_name: &str, m: &mut impl Write) -> io:
     )?;
     writeln!(m, r#" <metadata name="slic3rpe:Version3mf">1</metadata>"#)?;
     writeln!(m, " <resources>")?;
-    writeln!(m, r#"  <object id="1" name="{}" type="model">"#, xml_escape(object_name))?;
+    writeln!(
+        m,
+        r#"  <object id="1" name="{}" type="model">"#,
+        xml_escape(object_name)
+    )?;
     writeln!(m, "   <mesh>\n    <vertices>")?;
     for p in parts {
         for [x, y, z] in &p.mesh.vertices {
@@ -116,8 +122,14 @@ fn write_model(parts: &[Part<'_>], object_name: &str, m: &mut impl Write) -> io:
         }
         base += p.mesh.vertices.len() as u64;
     }
-    writeln!(m, "    </triangles>\n   </mesh>\n  </object>\n </resources>")?;
-    writeln!(m, " <build>\n  <item objectid=\"1\" printable=\"1\"/>\n </build>\n</model>")?;
+    writeln!(
+        m,
+        "    </triangles>\n   </mesh>\n  </object>\n </resources>"
+    )?;
+    writeln!(
+        m,
+        " <build>\n  <item objectid=\"1\" printable=\"1\"/>\n </build>\n</model>"
+    )?;
     Ok(())
 }
 
@@ -125,14 +137,27 @@ fn write_config(parts: &[Part<'_>], object_name: &str, c: &mut impl Write) -> io
     writeln!(c, r#"<?xml version="1.0" encoding="UTF-8"?>"#)?;
     writeln!(c, "<config>")?;
     writeln!(c, r#" <object id="1" instances_count="1">"#)?;
-    writeln!(c, r#"  <metadata type="object" key="name" value="{}"/>"#, xml_escape(object_name))?;
+    writeln!(
+        c,
+        r#"  <metadata type="object" key="name" value="{}"/>"#,
+        xml_escape(object_name)
+    )?;
     let mut first = 0usize;
     for p in parts {
         let last = first + p.mesh.triangles.len() - 1;
         writeln!(c, r#"  <volume firstid="{first}" lastid="{last}">"#)?;
-        writeln!(c, r#"   <metadata type="volume" key="name" value="{}"/>"#, xml_escape(p.name))?;
+        writeln!(
+            c,
+            r#"   <metadata type="volume" key="name" value="{}"/>"#,
+            xml_escape(p.name)
+        )?;
         for (k, v) in &p.settings {
-            writeln!(c, r#"   <metadata type="volume" key="{}" value="{}"/>"#, xml_escape(k), xml_escape(v))?;
+            writeln!(
+                c,
+                r#"   <metadata type="volume" key="{}" value="{}"/>"#,
+                xml_escape(k),
+                xml_escape(v)
+            )?;
         }
         writeln!(c, "  </volume>")?;
         first = last + 1;
@@ -147,15 +172,26 @@ mod tests {
     use std::io::{Cursor, Read};
 
     fn tri(z: f32) -> IndexedMesh {
-        IndexedMesh { vertices: vec![[0., 0., z], [1., 0., z], [0., 1., z]], triangles: vec![[0, 1, 2]] }
+        IndexedMesh {
+            vertices: vec![[0., 0., z], [1., 0., z], [0., 1., z]],
+            triangles: vec![[0, 1, 2]],
+        }
     }
 
     #[test]
     fn package_has_parts_with_ranges_and_settings() {
         let (a, b) = (tri(0.0), tri(1.0));
         let parts = [
-            Part { name: "s0", mesh: &a, settings: vec![("fill_density", "10%".into())] },
-            Part { name: "s<1>", mesh: &b, settings: vec![("fill_density", "90%".into())] },
+            Part {
+                name: "s0",
+                mesh: &a,
+                settings: vec![("fill_density", "10%".into())],
+            },
+            Part {
+                name: "s<1>",
+                mesh: &b,
+                settings: vec![("fill_density", "90%".into())],
+            },
         ];
         let mut buf = Cursor::new(Vec::new());
         write_3mf(&parts, "part", &mut buf).unwrap();
@@ -167,10 +203,19 @@ mod tests {
         let names: Vec<String> = z.file_names().map(String::from).collect();
         assert_eq!(names.len(), 4, "{names:?}");
         let mut model = String::new();
-        z.by_name("3D/3dmodel.model").unwrap().read_to_string(&mut model).unwrap();
-        assert!(model.contains(r#"<triangle v1="3" v2="4" v3="5"/>"#), "{model}");
+        z.by_name("3D/3dmodel.model")
+            .unwrap()
+            .read_to_string(&mut model)
+            .unwrap();
+        assert!(
+            model.contains(r#"<triangle v1="3" v2="4" v3="5"/>"#),
+            "{model}"
+        );
         let mut cfg = String::new();
-        z.by_name("Metadata/Slic3r_PE_model.config").unwrap().read_to_string(&mut cfg).unwrap();
+        z.by_name("Metadata/Slic3r_PE_model.config")
+            .unwrap()
+            .read_to_string(&mut cfg)
+            .unwrap();
         assert!(cfg.contains(r#"<volume firstid="1" lastid="1">"#), "{cfg}");
         assert!(cfg.contains(r#"value="s&lt;1&gt;""#), "{cfg}");
         assert!(cfg.contains(r#"key="fill_density" value="90%""#), "{cfg}");

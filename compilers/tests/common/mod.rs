@@ -37,7 +37,11 @@ pub fn read_tree(dir: &Path) -> BTreeMap<String, Vec<u8>> {
             if p.is_dir() {
                 stack.push(p);
             } else {
-                let rel = p.strip_prefix(dir).unwrap().to_string_lossy().replace('\\', "/");
+                let rel = p
+                    .strip_prefix(dir)
+                    .unwrap()
+                    .to_string_lossy()
+                    .replace('\\', "/");
                 if rel != "manifest.json" {
                     out.insert(rel, std::fs::read(&p).expect("readable file"));
                 }
@@ -57,11 +61,19 @@ pub struct Png {
 }
 
 pub fn decode(bytes: &[u8]) -> Png {
-    let mut r = png::Decoder::new(Cursor::new(bytes)).read_info().expect("png header");
+    let mut r = png::Decoder::new(Cursor::new(bytes))
+        .read_info()
+        .expect("png header");
     let mut buf = vec![0; r.output_buffer_size().expect("size")];
     let info = r.next_frame(&mut buf).expect("png data");
     buf.truncate(info.buffer_size());
-    Png { width: info.width as usize, height: info.height as usize, color: info.color_type, depth: info.bit_depth, data: buf }
+    Png {
+        width: info.width as usize,
+        height: info.height as usize,
+        color: info.color_type,
+        depth: info.bit_depth,
+        data: buf,
+    }
 }
 
 /// Pixels per RGBA colour over every `slice_*.png` at the top of a tree.
@@ -70,7 +82,11 @@ pub fn colour_counts(files: &BTreeMap<String, Vec<u8>>) -> BTreeMap<[u8; 4], u64
     for (name, bytes) in files {
         if name.starts_with("slice_") {
             let png = decode(bytes);
-            assert_eq!((png.color, png.depth), (png::ColorType::Rgba, png::BitDepth::Eight), "{name}");
+            assert_eq!(
+                (png.color, png.depth),
+                (png::ColorType::Rgba, png::BitDepth::Eight),
+                "{name}"
+            );
             for px in png.data.chunks_exact(4) {
                 *counts.entry([px[0], px[1], px[2], px[3]]).or_insert(0) += 1;
             }

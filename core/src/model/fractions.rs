@@ -166,9 +166,18 @@ impl NAry {
                 return;
             }
         } else {
+            // Sharp unions: containment is enough (cheap for meshes); the
+            // nearest child matters only in a smooth union's fillet.
+            let smooth = self.smooth > 0.0;
             for i in ids {
                 let c = &self.children[i];
-                let d = c.dist(p);
+                if !smooth {
+                    if c.contains(p) {
+                        return c.frac(p, out);
+                    }
+                    continue;
+                }
+                let d = self.child_dist(i, p);
                 if d <= 0.0 {
                     return c.frac(p, out);
                 }

@@ -153,6 +153,15 @@ impl Model {
         self.root.eval(p, fracs)
     }
 
+    /// Fractions at `p` into `fracs`, for a point already known to be inside
+    /// (samplers filling a solid tile): skips the distance, which for a mesh
+    /// or an FEA field deep inside the part is the expensive half.
+    #[inline]
+    pub fn fractions_inside(&self, p: DVec3, fracs: &mut [f64]) {
+        fracs.fill(0.0);
+        self.root.frac(p, fracs);
+    }
+
     /// Convenience: distance and (material id, fraction) pairs at one point;
     /// empty outside. Allocates; use the batch calls in loops.
     pub fn eval_point(&self, p: DVec3) -> (f64, Vec<(MaterialId, f64)>) {

@@ -205,6 +205,18 @@ pub const D_SLOT: usize = 8;
 pub const DERIVED_MASK: u64 = 0b0_1111_1000;
 
 impl PNode {
+    /// True when `p` is inside (distance ≤ 0). Meshes answer from their
+    /// coarse grid where they can (deep inside or far outside) instead of an
+    /// exact closest-triangle search: fraction lookups in a solid region ask
+    /// this for every voxel.
+    #[inline]
+    pub fn contains(&self, p: DVec3) -> bool {
+        match self {
+            PNode::Mesh { mesh, .. } => mesh.signed_distance_bound(p, 1e-9) <= 0.0,
+            _ => self.dist(p) <= 0.0,
+        }
+    }
+
     /// Signed distance at `p` (negative inside; a conservative bound where
     /// no closed form exists).
     pub fn dist(&self, p: DVec3) -> f64 {
