@@ -22,6 +22,24 @@ fn lipschitz(node: &PNode, b: &Aabb) -> Interval {
     Interval::new(d - r, d + r)
 }
 
+/// A mesh's interval from its bounded distance query: exact (`d ± r`) when
+/// the surface is within `2r` of the centre, else only the side that matters
+/// (`[d − r, ∞)` outside, `(−∞, d + r]` inside) from the mesh's coarse grid,
+/// without a closest-triangle search. Samplers ask this for every tile.
+fn mesh_interval(mesh: &crate::mesh::TriangleMesh, b: &Aabb) -> Interval {
+    let r = b.half_diagonal();
+    let reach = 2.0 * r + 1e-9;
+    let d = mesh.signed_distance_bound(b.center(), reach);
+    let floor = -mesh.bbox().half_diagonal();
+    if d.abs() < reach {
+        Interval::new((d - r).max(floor), d + r)
+    } else if d > 0.0 {
+        Interval::new(d - r, f64::INFINITY)
+    } else {
+        Interval::new(floor.min(d + r), d + r)
+    }
+}
+
 /// The box in the child's frame for `q = m·(p − about) + about`.
 fn rotate_box(b: &Aabb, m: &glam::DMat3, about: DVec3) -> Aabb {
     b.transformed(m, about)
@@ -64,8 +82,8 @@ impl PNode {
             | PNode::Strut { .. }
             | PNode::Prism { .. }
             | PNode::Lattice { .. }
-            | PNode::Mesh { .. }
             | PNode::SimField(_) => lipschitz(self, b),
+            PNode::Mesh { mesh, .. } => mesh_interval(mesh, b),
             PNode::Function {
                 expr,
                 clip_c,
@@ -199,7 +217,8 @@ impl NAry {
                 // within the current upper bound of `b`. Farther children
                 // cannot lower either end: their values exceed the distance
                 // to their box, which exceeds `hi` everywhere in `b`.
-                index.bvh().overlapping(&b.expand(b.half_diagonal()), |i| {
+                let near = b.expand(b.half_diagonal());
+                index.bvh().overlapping(&near, |i| {
                     take(&mut acc, self.children[i as usize].interval(b))
                 });
                 let reach = if acc.hi.is_finite() {
@@ -207,8 +226,11 @@ impl NAry {
                 } else {
                     Aabb::EVERYTHING
                 };
+                // The second pass skips what the first already took.
                 index.bvh().overlapping(&reach, |i| {
-                    take(&mut acc, self.children[i as usize].interval(b))
+                    if !self.boxes[i as usize].overlaps(&near) {
+                        take(&mut acc, self.children[i as usize].interval(b))
+                    }
                 });
             }
             None => {

@@ -480,3 +480,30 @@ fn prepare_errors() {
     .unwrap();
     assert!(e.contains("collinear"), "{e}");
 }
+
+#[test]
+fn mesh_intervals_contain_every_sample() {
+    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets/examples/data");
+    let opts = ScriptOptions {
+        base_dir: Some(dir),
+        ..ScriptOptions::default()
+    };
+    let src = "Union(false, [Mesh(\"bunny.obj\", 1), Strut(Vec3(0,0,0), Vec3(40,0,0), 2, 3)])";
+    let d = run_script(src, "t", &opts).unwrap();
+    let m = Model::prepare(&d.root, d.materials.clone()).unwrap();
+    let b = m.bbox().expand(5.0);
+    let mut r = rng(77);
+    for _ in 0..300 {
+        let c = b.min + DVec3::new(r(), r(), r()) * b.size();
+        let bx = Aabb::from_center_size(c, DVec3::new(r(), r(), r()) * 6.0);
+        let iv = m.interval(&bx);
+        for _ in 0..10 {
+            let p = bx.min + DVec3::new(r(), r(), r()) * bx.size();
+            let v = m.distance(p);
+            assert!(
+                iv.lo <= v + 1e-9 && v <= iv.hi + 1e-9,
+                "{v} not in {iv:?} over {bx:?}"
+            );
+        }
+    }
+}
