@@ -96,8 +96,21 @@ impl NAry {
                     visit(i as usize, &mut best, &mut first);
                 }
                 let mut done = false;
-                if let Candidates::Cell { items, margin, .. } = index.candidates(p) {
-                    for &i in items {
+                if let Candidates::Cell {
+                    items,
+                    lows,
+                    margin,
+                    ..
+                } = index.candidates(p)
+                {
+                    for (&i, &lo) in items.iter().zip(lows) {
+                        // Sorted by lower bound: once it is above both the
+                        // best so far and 0, no later child is lower or
+                        // contains p.
+                        let lo = f64::from(lo);
+                        if lo >= best && lo > 0.0 {
+                            break;
+                        }
                         visit(i as usize, &mut best, &mut first);
                     }
                     done = best < margin;
@@ -129,9 +142,26 @@ impl NAry {
     /// child's fractions are used, as pyvcad does (d3 in OPENVCAD.md §12).
     fn union_frac(&self, p: DVec3, out: &mut [f64]) {
         if let Some(index) = &self.index
-            && let Candidates::Cell { items, always, .. } = index.candidates(p)
+            && let Candidates::Cell {
+                items,
+                lows,
+                always,
+                ..
+            } = index.candidates(p)
         {
-            let mut ids = merge_sorted(items, always);
+            // Only children whose lower bound is ≤ 0 can contain p; they
+            // come first. Visit them in child order.
+            let n = lows.partition_point(|lo| *lo <= 0.0);
+            let mut inside: [u32; 64] = [0; 64];
+            if n <= inside.len() {
+                inside[..n].copy_from_slice(&items[..n]);
+                inside[..n].sort_unstable();
+                let mut ids = merge_sorted(&inside[..n], always);
+                return self.frac_among(&mut ids, p, out);
+            }
+            let mut sorted = items.to_vec();
+            sorted.sort_unstable();
+            let mut ids = merge_sorted(&sorted, always);
             return self.frac_among(&mut ids, p, out);
         }
         let mut all = (0..self.children.len() as u32).map(|i| i as usize);

@@ -334,8 +334,17 @@ impl NAry {
         for &i in index.always() {
             best = best.min(self.child_dist(i as usize, p));
         }
-        if let Candidates::Cell { items, margin, .. } = index.candidates(p) {
-            for &i in items {
+        if let Candidates::Cell {
+            items,
+            lows,
+            margin,
+            ..
+        } = index.candidates(p)
+        {
+            for (&i, &lo) in items.iter().zip(lows) {
+                if f64::from(lo) >= best {
+                    break; // the rest are bounded below by lo ≥ best
+                }
                 best = best.min(self.child_dist(i as usize, p));
             }
             if best < margin {

@@ -27,9 +27,12 @@ pub struct UnionIndex {
     grid_box: Aabb,
     dims: [usize; 3],
     inv_cell: DVec3,
-    /// CSR: children of cell c are `items[offsets[c]..offsets[c+1]]`.
+    /// CSR: children of cell c are `items[offsets[c]..offsets[c+1]]`,
+    /// sorted by `lows` (each child's lower bound over the cell), so a query
+    /// can stop once the next bound is above what it already found.
     offsets: Vec<u32>,
     items: Vec<u32>,
+    lows: Vec<f32>,
     margin: f64,
     always: Vec<u32>,
     bvh: Bvh,
@@ -40,8 +43,10 @@ pub struct UnionIndex {
 pub enum Candidates<'a> {
     /// Children to test, ascending; `margin` bounds the unlisted ones.
     Cell {
-        /// Listed children (ascending index).
+        /// Listed children, by ascending lower bound.
         items: &'a [u32],
+        /// Their lower bounds over the cell (ascending; rounded down to f32).
+        lows: &'a [f32],
         /// Children with infinite boxes (ascending index).
         always: &'a [u32],
         /// Every unlisted finite child's value exceeds this.
@@ -108,7 +113,7 @@ impl UnionIndex {
         // Per child (in parallel), the cells it is listed in; then CSR in
         // child order per cell.
         use rayon::prelude::*;
-        let lists: Vec<Vec<u32>> = finite
+        let lists: Vec<Vec<(u32, f32)>> = finite
             .par_iter()
             .map(|&i| {
                 let (lo, hi) = cell_range(&boxes[i as usize].expand(margin));
@@ -130,8 +135,19 @@ impl UnionIndex {
                             for z in bz..=ez {
                                 for y in by..=ey {
                                     for x in bx..=ex {
-                                        if lower_bound(i as usize, &cell_box(x, y, z)) < margin {
-                                            cells.push((x + dims[0] * (y + dims[1] * z)) as u32);
+                                        let lo = lower_bound(i as usize, &cell_box(x, y, z));
+                                        if lo < margin {
+                                            // f32 rounded toward -inf keeps it a lower bound.
+                                            let lo32 = lo as f32;
+                                            let lo32 = if (lo32 as f64) > lo {
+                                                lo32.next_down()
+                                            } else {
+                                                lo32
+                                            };
+                                            cells.push((
+                                                (x + dims[0] * (y + dims[1] * z)) as u32,
+                                                lo32,
+                                            ));
                                         }
                                     }
                                 }
@@ -144,7 +160,7 @@ impl UnionIndex {
             .collect();
         let mut offsets = vec![0u32; ncells + 1];
         for l in &lists {
-            for &c in l {
+            for &(c, _) in l {
                 offsets[c as usize + 1] += 1;
             }
         }
@@ -152,13 +168,19 @@ impl UnionIndex {
             offsets[c + 1] += offsets[c];
         }
         let mut fill = offsets.clone();
-        let mut items = vec![0u32; offsets[ncells] as usize];
+        let mut pairs = vec![(0f32, 0u32); offsets[ncells] as usize];
         for (&i, l) in finite.iter().zip(&lists) {
-            for &c in l {
-                items[fill[c as usize] as usize] = i;
+            for &(c, lo) in l {
+                pairs[fill[c as usize] as usize] = (lo, i);
                 fill[c as usize] += 1;
             }
         }
+        for c in 0..ncells {
+            pairs[offsets[c] as usize..offsets[c + 1] as usize]
+                .sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        }
+        let items = pairs.iter().map(|p| p.1).collect();
+        let lows = pairs.iter().map(|p| p.0).collect();
         let bvh = Bvh::build(boxes, &finite);
         Self {
             grid_box,
@@ -166,6 +188,7 @@ impl UnionIndex {
             inv_cell,
             offsets,
             items,
+            lows,
             margin,
             always,
             bvh,
@@ -186,6 +209,7 @@ impl UnionIndex {
         let (a, b) = (self.offsets[c] as usize, self.offsets[c + 1] as usize);
         Candidates::Cell {
             items: &self.items[a..b],
+            lows: &self.lows[a..b],
             always: &self.always,
             margin: self.margin,
         }
