@@ -10,6 +10,7 @@
 //! allocating, and [`Expr::eval_interval`] runs the same tape on [`Interval`]s for
 //! conservative bounds over a box.
 
+mod affine;
 mod ast;
 mod batch;
 mod fold;
@@ -96,6 +97,9 @@ pub struct Expr {
     source: String,
     /// `None` when the expression folded to a constant.
     tape: Option<tape::Tape>,
+    /// Set when the expression is affine in its variables: evaluated as a
+    /// dot product instead of the tape.
+    affine: Option<affine::Affine>,
     constant: Option<f64>,
     used: u64,
 }
@@ -125,6 +129,7 @@ impl Expr {
             return Ok(Expr {
                 source: source.to_string(),
                 tape: None,
+                affine: None,
                 constant: Some(v),
                 used: 0,
             });
@@ -142,6 +147,7 @@ impl Expr {
         Ok(Expr {
             source: source.to_string(),
             tape: Some(tape),
+            affine: affine::affine(&tree),
             constant: None,
             used,
         })
@@ -153,10 +159,24 @@ impl Expr {
     /// If a variable the expression uses has no slot (`slots` too short).
     #[inline]
     pub fn eval(&self, slots: &[f64]) -> f64 {
+        if let Some(a) = &self.affine {
+            return a.eval(slots);
+        }
         match &self.tape {
             Some(t) => t.eval(slots),
             None => self.constant.unwrap_or(f64::NAN),
         }
+    }
+
+    /// True when the expression is affine in its variables (`c + Σ kᵢ·vᵢ`).
+    pub fn is_affine(&self) -> bool {
+        self.affine.is_some()
+    }
+
+    /// The tape's value (bypassing the affine form), for tests.
+    #[cfg(test)]
+    pub(crate) fn eval_tape(&self, slots: &[f64]) -> f64 {
+        self.tape.as_ref().map_or(f64::NAN, |t| t.eval(slots))
     }
 
     /// Evaluates many points at once: point `k` has variable `i` equal to
