@@ -1,6 +1,6 @@
 //! Wavefront OBJ: one object, `v x y z` lines (mm) then `f a b c` lines
 //! (1-based vertex indices, counter-clockwise seen from outside). Numbers are
-//! written with Rust's shortest round-trip formatting, so the text is the
+//! written with the shortest round-trip formatting (ryu), so the text is the
 //! same on every run and reads back to the same f32 values.
 
 use std::io::{self, Write};
@@ -17,11 +17,25 @@ pub fn write_obj(mesh: &IndexedMesh, name: &str, w: &mut impl Write) -> io::Resu
         mesh.triangles.len()
     )?;
     writeln!(w, "o {name}")?;
+    // ryu/itoa: millions of numbers; `{}` formatting dominated the export.
+    let (mut f, mut i) = (ryu::Buffer::new(), itoa::Buffer::new());
     for [x, y, z] in &mesh.vertices {
-        writeln!(w, "v {x} {y} {z}")?;
+        w.write_all(b"v ")?;
+        w.write_all(f.format(*x).as_bytes())?;
+        w.write_all(b" ")?;
+        w.write_all(f.format(*y).as_bytes())?;
+        w.write_all(b" ")?;
+        w.write_all(f.format(*z).as_bytes())?;
+        w.write_all(b"\n")?;
     }
     for [a, b, c] in &mesh.triangles {
-        writeln!(w, "f {} {} {}", a + 1, b + 1, c + 1)?;
+        w.write_all(b"f ")?;
+        w.write_all(i.format(a + 1).as_bytes())?;
+        w.write_all(b" ")?;
+        w.write_all(i.format(b + 1).as_bytes())?;
+        w.write_all(b" ")?;
+        w.write_all(i.format(c + 1).as_bytes())?;
+        w.write_all(b"\n")?;
     }
     Ok(())
 }
@@ -40,7 +54,7 @@ mod tests {
         write_obj(&m, "seg", &mut out).unwrap();
         let text = String::from_utf8(out).unwrap();
         assert!(
-            text.contains("o seg\nv 0 0 0\nv 1.5 0 0\nv 0 0.1 0\nf 1 2 3\n"),
+            text.contains("o seg\nv 0.0 0.0 0.0\nv 1.5 0.0 0.0\nv 0.0 0.1 0.0\nf 1 2 3\n"),
             "{text}"
         );
     }

@@ -108,17 +108,31 @@ fn write_model(parts: &[Part<'_>], object_name: &str, m: &mut impl Write) -> io:
         xml_escape(object_name)
     )?;
     writeln!(m, "   <mesh>\n    <vertices>")?;
+    // ryu/itoa: millions of numbers; `{}` formatting dominated the export.
+    let (mut f, mut i) = (ryu::Buffer::new(), itoa::Buffer::new());
     for p in parts {
         for [x, y, z] in &p.mesh.vertices {
-            writeln!(m, r#"     <vertex x="{x}" y="{y}" z="{z}"/>"#)?;
+            m.write_all(b"     <vertex x=\"")?;
+            m.write_all(f.format(*x).as_bytes())?;
+            m.write_all(b"\" y=\"")?;
+            m.write_all(f.format(*y).as_bytes())?;
+            m.write_all(b"\" z=\"")?;
+            m.write_all(f.format(*z).as_bytes())?;
+            m.write_all(b"\"/>\n")?;
         }
     }
     writeln!(m, "    </vertices>\n    <triangles>")?;
     let mut base = 0u64;
     for p in parts {
         for t in &p.mesh.triangles {
-            let [a, b, c] = t.map(|i| base + u64::from(i));
-            writeln!(m, r#"     <triangle v1="{a}" v2="{b}" v3="{c}"/>"#)?;
+            let [a, b, c] = t.map(|v| base + u64::from(v));
+            m.write_all(b"     <triangle v1=\"")?;
+            m.write_all(i.format(a).as_bytes())?;
+            m.write_all(b"\" v2=\"")?;
+            m.write_all(i.format(b).as_bytes())?;
+            m.write_all(b"\" v3=\"")?;
+            m.write_all(i.format(c).as_bytes())?;
+            m.write_all(b"\"/>\n")?;
         }
         base += p.mesh.vertices.len() as u64;
     }

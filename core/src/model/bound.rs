@@ -81,9 +81,9 @@ impl PNode {
             | PNode::Cylinder { .. }
             | PNode::Strut { .. }
             | PNode::Prism { .. }
-            | PNode::Lattice { .. }
-            | PNode::SimField(_) => lipschitz(self, b),
+            | PNode::Lattice { .. } => lipschitz(self, b),
             PNode::Mesh { mesh, .. } => mesh_interval(mesh, b),
+            PNode::SimField(g) => mesh_interval(g.field.boundary_mesh(), b),
             PNode::Function {
                 expr,
                 clip_c,

@@ -4,7 +4,7 @@
 //! Two structures over the children's bounding boxes:
 //!
 //! * a **uniform grid**: each cell lists (in child order) the children whose
-//!   interval over the cell has a lower end below `margin` (two cell sizes).
+//!   interval over the cell has a lower end below `margin` (three cell sizes).
 //!   For a point in a cell, an unlisted child's value exceeds `margin`, so it
 //!   cannot be the minimum when a listed child is below `margin`, and it
 //!   cannot contain the point: "first child containing p" is found among the
@@ -85,8 +85,9 @@ impl UnionIndex {
             ((size.z / cell).ceil() as usize).clamp(1, 1024),
         ];
         let cell_size = size / DVec3::new(dims[0] as f64, dims[1] as f64, dims[2] as f64);
-        // Two cells: points within two cells of a child never need the BVH.
-        let margin = 2.0 * cell_size.max_element();
+        // Three cells: points within three cells of a child never need the
+        // BVH; lists are sorted by lower bound, so long lists cost little.
+        let margin = 3.0 * cell_size.max_element();
         let inv_cell = DVec3::ONE / cell_size;
         let ncells = dims[0] * dims[1] * dims[2];
         let cell_range = |b: &Aabb| {
