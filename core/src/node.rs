@@ -210,6 +210,26 @@ impl NodeKind {
         }
     }
 
+    /// The material ids this node itself assigns (a leaf's material, or an
+    /// FGrade's / SimulationField's list); not its children's.
+    pub fn own_materials(&self) -> &[MaterialId] {
+        match self {
+            NodeKind::Sphere { material, .. }
+            | NodeKind::RectPrism { material, .. }
+            | NodeKind::Cylinder { material, .. }
+            | NodeKind::Strut { material, .. }
+            | NodeKind::PolygonExtrude { material, .. }
+            | NodeKind::Function { material, .. }
+            | NodeKind::Tpms { material, .. }
+            | NodeKind::GraphLattice { material, .. }
+            | NodeKind::Mesh { material, .. } => std::slice::from_ref(material),
+            NodeKind::FGrade { materials, .. } | NodeKind::SimulationField { materials, .. } => {
+                materials
+            }
+            _ => &[],
+        }
+    }
+
     /// The children, in order (missing optional children are skipped).
     pub fn children(&self) -> Vec<&Node> {
         match self {

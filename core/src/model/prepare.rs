@@ -32,23 +32,7 @@ pub(super) fn collect_materials(root: &Node) -> Vec<MaterialId> {
         if !seen.insert(n.ptr()) {
             continue;
         }
-        match n.kind() {
-            NodeKind::Sphere { material, .. }
-            | NodeKind::RectPrism { material, .. }
-            | NodeKind::Cylinder { material, .. }
-            | NodeKind::Strut { material, .. }
-            | NodeKind::PolygonExtrude { material, .. }
-            | NodeKind::Function { material, .. }
-            | NodeKind::Tpms { material, .. }
-            | NodeKind::GraphLattice { material, .. }
-            | NodeKind::Mesh { material, .. } => {
-                set.insert(*material);
-            }
-            NodeKind::FGrade { materials, .. } | NodeKind::SimulationField { materials, .. } => {
-                set.extend(materials.iter().copied());
-            }
-            _ => {}
-        }
+        set.extend(n.kind().own_materials().iter().copied());
         // FGrade replaces its child's materials (pyvcad's material_list
         // leaves them out too), so its child is not visited.
         if !matches!(n.kind(), NodeKind::FGrade { .. }) {

@@ -20,7 +20,7 @@ use std::sync::{Arc, Mutex};
 use rhai::{Dynamic, Engine, EvalAltResult, NativeCallContext as Ctx, Position, Scope};
 
 use crate::material::MaterialTable;
-use crate::node::{LatticeType, Node, NodeKind};
+use crate::node::{LatticeType, Node};
 pub use values::Vec3;
 use values::{RResult, fail};
 
@@ -229,22 +229,7 @@ fn check_materials(root: &Node, table: &MaterialTable, name: &str) -> Result<(),
         if !seen.insert(n.ptr()) {
             continue;
         }
-        let ids: Vec<u8> = match n.kind() {
-            NodeKind::Sphere { material, .. }
-            | NodeKind::RectPrism { material, .. }
-            | NodeKind::Cylinder { material, .. }
-            | NodeKind::Strut { material, .. }
-            | NodeKind::PolygonExtrude { material, .. }
-            | NodeKind::Function { material, .. }
-            | NodeKind::Tpms { material, .. }
-            | NodeKind::GraphLattice { material, .. }
-            | NodeKind::Mesh { material, .. } => vec![*material],
-            NodeKind::FGrade { materials, .. } | NodeKind::SimulationField { materials, .. } => {
-                materials.clone()
-            }
-            _ => vec![],
-        };
-        for id in ids {
+        for &id in n.kind().own_materials() {
             if let Err(e) = table.check_id(id as i64) {
                 let o = n.origin();
                 return Err(ScriptError {
