@@ -224,6 +224,12 @@ impl StudioApp {
             .as_ref()
             .inspect(|rs| volcad_render::viewport::register(rs))
             .is_some();
+        // On a software adapter (lavapipe, llvmpipe) a full-resolution
+        // ray-marched frame costs most of a second; half resolution,
+        // upscaled, keeps orbiting usable (about 4x fewer pixels).
+        let software = cc.wgpu_render_state.as_ref().is_some_and(|rs| {
+            rs.adapter.get_info().device_type == egui_wgpu::wgpu::DeviceType::Cpu
+        });
         cc.egui_ctx.options_mut(|o| o.zoom_with_keyboard = false);
         commands::apply_theme(&cc.egui_ctx, settings.theme);
         let mut bottom = BottomPanel::default();
@@ -260,6 +266,9 @@ impl StudioApp {
         if !has_gpu {
             app.bottom
                 .log("no wgpu render state: the viewport cannot draw");
+        }
+        if software {
+            app.viewport.settings.render_scale = 0.5;
         }
         app.run_now();
         app
