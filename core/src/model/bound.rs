@@ -40,11 +40,6 @@ fn mesh_interval(mesh: &crate::mesh::TriangleMesh, b: &Aabb) -> Interval {
     }
 }
 
-/// The box in the child's frame for `q = m·(p − about) + about`.
-fn rotate_box(b: &Aabb, m: &glam::DMat3, about: DVec3) -> Aabb {
-    b.transformed(m, about)
-}
-
 /// The part of a Tile child's domain that box `b` maps to: the mapped box if
 /// `b` lies in one cell, else the whole cell.
 fn tile_box(b: &Aabb, cell: DVec3) -> Aabb {
@@ -67,9 +62,7 @@ pub fn coord_intervals(b: &Aabb, d: Interval) -> [Interval; COORD_SLOTS] {
     let r = (x.square() + y.square() + z.square()).sqrt();
     let angle = Interval::new(-std::f64::consts::PI, std::f64::consts::PI);
     let polar = Interval::new(0.0, std::f64::consts::PI);
-    let mut s = [x, y, z, rho, angle, r, angle, polar, d];
-    s[D_SLOT] = d;
-    s
+    [x, y, z, rho, angle, r, angle, polar, d]
 }
 
 impl PNode {
@@ -103,7 +96,7 @@ impl PNode {
                 to_local,
                 around,
                 child,
-            } => child.interval(&rotate_box(b, to_local, *around)),
+            } => child.interval(&b.transformed(to_local, *around)),
             PNode::Scale { inv, k, child } => {
                 let i = child.interval(&b.scaled(*inv));
                 Interval::new(i.lo * *k, i.hi * *k)
@@ -161,7 +154,7 @@ impl PNode {
                 to_local,
                 around,
                 child,
-            } => child.constant_fractions(&rotate_box(b, to_local, *around)),
+            } => child.constant_fractions(&b.transformed(to_local, *around)),
             PNode::Scale { inv, child, .. } => child.constant_fractions(&b.scaled(*inv)),
             PNode::Union(u) => u.union_constant(b),
             PNode::Intersection(n) => {

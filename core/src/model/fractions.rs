@@ -61,7 +61,7 @@ impl PNode {
             PNode::Union(u) => u.union_frac(p, out),
             PNode::Intersection(n) => {
                 if n.blend {
-                    average(n.children.iter().map(|c| &**c), p, out, |_| true);
+                    average(n.children.iter().map(|c| &**c), p, out);
                 } else {
                     n.children[0].frac(p, out);
                 }
@@ -159,7 +159,8 @@ impl NAry {
                 let mut ids = merge_sorted(&inside[..n], always);
                 return self.frac_among(&mut ids, p, out);
             }
-            let mut sorted = items.to_vec();
+            // More than 64 children may contain p (rare): same, on the heap.
+            let mut sorted = items[..n].to_vec();
             sorted.sort_unstable();
             let mut ids = merge_sorted(&sorted, always);
             return self.frac_among(&mut ids, p, out);
@@ -171,29 +172,17 @@ impl NAry {
     fn frac_among(&self, ids: &mut dyn Iterator<Item = usize>, p: DVec3, out: &mut [f64]) {
         let mut nearest = (f64::INFINITY, usize::MAX);
         if self.blend {
-            let mut acc = [0.0; MAX_MATERIALS];
-            let mut tmp = [0.0; MAX_MATERIALS];
-            let k = out.len();
-            let mut count = 0u32;
-            for i in ids {
-                let c = &self.children[i];
+            // Average over the children containing p; in a smooth union's
+            // fillet (none contains p) fall through to the nearest child.
+            let children = ids.map(|i| &*self.children[i]).filter(|c| c.contains(p));
+            if average(children, p, out) > 0 {
+                return;
+            }
+            for (i, c) in self.children.iter().enumerate() {
                 let d = c.dist(p);
-                if d <= 0.0 {
-                    tmp[..k].fill(0.0);
-                    c.frac(p, &mut tmp[..k]);
-                    for j in 0..k {
-                        acc[j] += tmp[j];
-                    }
-                    count += 1;
-                } else if d < nearest.0 {
+                if d < nearest.0 {
                     nearest = (d, i);
                 }
-            }
-            if count > 0 {
-                for j in 0..k {
-                    out[j] = acc[j] / count as f64;
-                }
-                return;
             }
         } else {
             // Sharp unions: containment is enough (cheap for meshes); the
@@ -246,20 +235,13 @@ fn merge_sorted<'a>(a: &'a [u32], b: &'a [u32]) -> impl Iterator<Item = usize> +
     })
 }
 
-/// Average of the fractions of `nodes` that `keep` accepts.
-fn average<'a>(
-    nodes: impl Iterator<Item = &'a PNode>,
-    p: DVec3,
-    out: &mut [f64],
-    keep: impl Fn(&PNode) -> bool,
-) {
+/// Average of the fractions of `nodes` into `out` (zero on entry); returns
+/// how many were averaged.
+fn average<'a>(nodes: impl Iterator<Item = &'a PNode>, p: DVec3, out: &mut [f64]) -> u32 {
     let k = out.len();
     let mut tmp = [0.0; MAX_MATERIALS];
     let mut count = 0u32;
     for c in nodes {
-        if !keep(c) {
-            continue;
-        }
         tmp[..k].fill(0.0);
         c.frac(p, &mut tmp[..k]);
         for j in 0..k {
@@ -273,6 +255,7 @@ fn average<'a>(
             *v *= inv;
         }
     }
+    count
 }
 
 impl Grade {

@@ -507,3 +507,29 @@ fn mesh_intervals_contain_every_sample() {
         }
     }
 }
+
+#[test]
+fn batch_calls_match_single_points() {
+    let m = model(DESIGNS[2]);
+    let xs: Vec<f64> = (0..50).map(|i| i as f64 * 0.4 - 10.0).collect();
+    let ys = vec![0.5; 50];
+    let zs = vec![-0.5; 50];
+    let pts = crate::Points {
+        x: &xs,
+        y: &ys,
+        z: &zs,
+    };
+    let k = m.materials().len();
+    let (mut d, mut f, mut d2) = (vec![0.0; 50], vec![0.0f32; 50 * k], vec![0.0; 50]);
+    m.eval_batch(pts, &mut d, &mut f);
+    m.distance_batch(pts, &mut d2);
+    for i in 0..50 {
+        let (di, fi) = m.eval_point(pts.get(i));
+        assert_eq!(d[i], di);
+        assert_eq!(d2[i], di);
+        for (j, id) in m.materials().iter().enumerate() {
+            let want = fi.iter().find(|(m, _)| m == id).map_or(0.0, |x| x.1) as f32;
+            assert_eq!(f[i * k + j], want, "point {i} material {id}");
+        }
+    }
+}
