@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 
 use volcad_core::Model;
-use volcad_core::bench::{near_surface_points, points_per_second};
+use volcad_core::bench::{near_surface_points, points_per_second, z_order};
 use volcad_core::script::{ScriptOptions, run_script};
 
 fn main() {
@@ -20,8 +20,8 @@ fn main() {
     let filter = std::env::args().skip(1).find(|a| !a.starts_with('-'));
     println!("threads: {}", rayon::current_num_threads());
     println!(
-        "{:<26} {:>7} {:>12} {:>12} {:>16}",
-        "design", "nodes", "script (s)", "prepare (s)", "points/s ±2mm"
+        "{:<26} {:>7} {:>12} {:>12} {:>16} {:>16}",
+        "design", "nodes", "script (s)", "prepare (s)", "random order", "z-order"
     );
     for path in files {
         let name = path.file_name().unwrap().to_string_lossy().to_string();
@@ -44,12 +44,17 @@ fn main() {
         let best = (0..3)
             .map(|_| points_per_second(&m, &pts))
             .fold(0.0, f64::max);
+        let pts = z_order(&m, &pts);
+        let ordered = (0..3)
+            .map(|_| points_per_second(&m, &pts))
+            .fold(0.0, f64::max);
         println!(
-            "{name:<26} {:>7} {:>12.3} {:>12.4} {:>16.3e}",
+            "{name:<26} {:>7} {:>12.3} {:>12.4} {:>16.3e} {:>16.3e}",
             m.node_count(),
             script,
             m.prepare_time().as_secs_f64(),
-            best
+            best,
+            ordered
         );
     }
 }

@@ -51,7 +51,7 @@ impl TriangleMesh {
 
     /// `+1` outside, `−1` inside, for a point whose nearest triangle is `slot`
     /// (at non-zero distance).
-    fn sign_at(&self, p: DVec3, slot: usize) -> f64 {
+    pub(super) fn sign_at(&self, p: DVec3, slot: usize) -> f64 {
         if let Some(ps) = &self.pseudo {
             let t = &self.tris[slot];
             let (c, feature) = t.closest(p);
@@ -83,7 +83,7 @@ impl TriangleMesh {
     /// Exact nearest triangle with no radius limit: the coarse grid's upper
     /// bound `|d(c)| + |p − c|` starts the search when `p` is in the grid.
     #[inline]
-    fn nearest_any(&self, p: DVec3) -> Option<(usize, f64)> {
+    pub(super) fn nearest_any(&self, p: DVec3) -> Option<(usize, f64)> {
         if let Some((dc, r)) = self.coarse.as_ref().and_then(|g| g.lookup(p)) {
             let upper = (dc.abs() + r) * (1.0 + 1e-12) + f64::MIN_POSITIVE;
             if let Some(found) = self.nearest(p, upper * upper) {
@@ -99,6 +99,9 @@ impl TriangleMesh {
         if !p.is_finite() {
             return f64::NAN;
         }
+        if let Some(d) = self.signed_from_candidates(p) {
+            return d;
+        }
         match self.nearest_any(p) {
             Some((slot, d2)) => signed(d2, || self.sign_at(p, slot)),
             // Squared distances overflowed: astronomically far, so outside.
@@ -106,10 +109,27 @@ impl TriangleMesh {
         }
     }
 
+    /// The exact signed distance from the candidate grid, when `p`'s cell
+    /// keeps a list (near the surface).
+    #[inline]
+    fn signed_from_candidates(&self, p: DVec3) -> Option<f64> {
+        let (slot, d2, side) = self.candidates.as_ref()?.nearest(self, p)?;
+        Some(signed(d2, || {
+            if side != 0 {
+                f64::from(side)
+            } else {
+                self.sign_at(p, slot)
+            }
+        }))
+    }
+
     /// Exact unsigned distance to the surface. NaN for a non-finite `p`.
     pub fn distance(&self, p: DVec3) -> f64 {
         if !p.is_finite() {
             return f64::NAN;
+        }
+        if let Some((_, d2, _)) = self.candidates.as_ref().and_then(|g| g.nearest(self, p)) {
+            return d2.sqrt();
         }
         match self.nearest_any(p) {
             Some((_, d2)) => d2.sqrt(),
@@ -134,6 +154,9 @@ impl TriangleMesh {
         }
         if !(max_dist > 0.0 && max_dist < f64::INFINITY) {
             return self.signed_distance(p);
+        }
+        if let Some(d) = self.signed_from_candidates(p) {
+            return d;
         }
         let mut side = 0.0;
         match self.coarse.as_ref().and_then(|g| g.lookup(p)) {

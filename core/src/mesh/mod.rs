@@ -21,6 +21,7 @@
 //! boxes follow from one evaluation at the centre.
 
 pub(crate) mod bvh;
+mod candidates;
 mod coarse;
 mod distance;
 mod load;
@@ -147,6 +148,8 @@ pub struct TriangleMesh {
     winding: WindingTree,
     /// Exact distances on a coarse grid (bounds far from the surface).
     coarse: Option<coarse::CoarseGrid>,
+    /// Per-cell nearest-triangle candidates (exact queries near the surface).
+    candidates: Option<candidates::CandidateGrid>,
     topology: Topology,
     bbox: Aabb,
     warnings: Vec<String>,
@@ -266,12 +269,14 @@ impl TriangleMesh {
             pseudo,
             winding,
             coarse: None,
+            candidates: None,
             topology,
             bbox,
             warnings,
         };
         mesh.coarse =
             coarse::CoarseGrid::new(&bbox, mesh.triangles.len(), |p| mesh.signed_distance(p));
+        mesh.candidates = candidates::CandidateGrid::new(&mesh);
         Ok(mesh)
     }
 

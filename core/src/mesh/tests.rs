@@ -169,6 +169,39 @@ fn bunny_near_surface_signs_match_winding() {
 }
 
 #[test]
+fn candidate_grid_matches_the_bvh() {
+    // The per-cell lists must give the same nearest distance (bit for bit)
+    // and the same side as the full BVH search, near and on the surface.
+    let m = bunny();
+    let g = m
+        .candidates
+        .as_ref()
+        .expect("the bunny gets a candidate grid");
+    let mut rng = Rng::new(5);
+    let region = m.bbox().expand(3.0);
+    let mut used = 0;
+    for i in 0..20000 {
+        let p = rng.in_box(&region);
+        let Some((slot, d2, side)) = g.nearest(&m, p) else {
+            continue;
+        };
+        used += 1;
+        let (bvh_slot, bvh_d2) = m.nearest_any(p).expect("finite point");
+        assert_eq!(d2, bvh_d2, "point {i} {p}: slots {slot} vs {bvh_slot}");
+        if d2 > 0.0 {
+            let s = if side != 0 {
+                f64::from(side)
+            } else {
+                m.sign_at(p, slot)
+            };
+            assert_eq!(s, m.sign_at(p, bvh_slot), "point {i} {p}");
+        }
+    }
+    // Most points within 3 mm of the box are near the surface: lists serve them.
+    assert!(used > 4000, "{used}");
+}
+
+#[test]
 fn bound_and_interval_are_consistent() {
     let m = bunny();
     let mut rng = Rng::new(99);

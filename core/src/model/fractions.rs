@@ -41,16 +41,11 @@ impl PNode {
 
     /// Fractions at `p` into `out` (zeroed by the caller).
     pub fn frac(&self, p: DVec3, out: &mut [f64]) {
+        if let Some(m) = self.leaf_material() {
+            out[m as usize] = 1.0;
+            return;
+        }
         match self {
-            PNode::Sphere { m, .. }
-            | PNode::Box { m, .. }
-            | PNode::Cylinder { m, .. }
-            | PNode::Strut { m, .. }
-            | PNode::Prism { m, .. }
-            | PNode::Function { m, .. }
-            | PNode::Tpms { m, .. }
-            | PNode::Lattice { m, .. }
-            | PNode::Mesh { m, .. } => out[*m as usize] = 1.0,
             PNode::Translate { t, child } => child.frac(p - *t, out),
             PNode::Rotate {
                 to_local,
@@ -72,11 +67,113 @@ impl PNode {
             PNode::FGrade(g) => g.frac(p, out),
             PNode::Blend { r, child } => blend_frac(child, *r, p, out),
             PNode::SimField(s) => s.frac(p, out),
+            _ => {} // leaves: above
+        }
+    }
+
+    /// The material of a leaf that assigns one material everywhere.
+    #[inline]
+    fn leaf_material(&self) -> Option<Slot> {
+        match self {
+            PNode::Sphere { m, .. }
+            | PNode::Box { m, .. }
+            | PNode::Cylinder { m, .. }
+            | PNode::Strut { m, .. }
+            | PNode::Prism { m, .. }
+            | PNode::Function { m, .. }
+            | PNode::Tpms { m, .. }
+            | PNode::Lattice { m, .. }
+            | PNode::Mesh { m, .. } => Some(*m),
+            _ => None,
+        }
+    }
+}
+
+/// Fractions that are the same at every point of a node (a primitive, a
+/// moved primitive, an FGrade of constants: every strut of the bunny
+/// lattice). A union keeps one per child so the winning child's material
+/// is one table read, not a walk down the child's tree and its expression
+/// tapes (those pointer chases dominated random-order profiles).
+#[derive(Clone, Copy, Debug)]
+pub struct FixedFractions {
+    len: u8,
+    slots: [Slot; 4],
+    values: [f64; 4],
+}
+
+impl FixedFractions {
+    fn one(m: Slot) -> Self {
+        Self {
+            len: 1,
+            slots: [m, 0, 0, 0],
+            values: [1.0, 0.0, 0.0, 0.0],
+        }
+    }
+
+    /// Add the fractions into `out` (zero on entry), as `frac` would.
+    #[inline]
+    pub fn write(&self, out: &mut [f64]) {
+        for i in 0..self.len as usize {
+            out[self.slots[i] as usize] += self.values[i];
+        }
+    }
+}
+
+impl PNode {
+    /// The node's fractions when they do not depend on the point; the
+    /// values are computed exactly as `frac` computes them.
+    pub fn fixed_fractions(&self) -> Option<FixedFractions> {
+        if let Some(m) = self.leaf_material() {
+            return Some(FixedFractions::one(m));
+        }
+        match self {
+            PNode::Translate { child, .. }
+            | PNode::Rotate { child, .. }
+            | PNode::Scale { child, .. }
+            | PNode::Offset { child, .. }
+            | PNode::Shell { child, .. }
+            | PNode::Tile { child, .. } => child.fixed_fractions(),
+            PNode::Difference { a, .. } => a.fixed_fractions(),
+            PNode::Intersection(n) if !n.blend => n.children[0].fixed_fractions(),
+            PNode::FGrade(g) if g.exprs.len() <= 4 => {
+                if g.exprs.iter().any(|e| e.constant().is_none()) {
+                    return None;
+                }
+                // The same arithmetic as `normalised`, so the values are
+                // bit-identical to the evaluated ones.
+                let mut out = [0.0; MAX_MATERIALS];
+                let slots = [0.0; COORD_SLOTS];
+                normalised::<4>(&g.exprs, &g.mats, &slots, &mut out);
+                let mut f = FixedFractions {
+                    len: 0,
+                    slots: [0; 4],
+                    values: [0.0; 4],
+                };
+                for &m in &g.mats {
+                    if f.slots[..f.len as usize].contains(&m) {
+                        continue;
+                    }
+                    f.slots[f.len as usize] = m;
+                    f.values[f.len as usize] = out[m as usize];
+                    f.len += 1;
+                }
+                Some(f)
+            }
+            _ => None,
         }
     }
 }
 
 impl NAry {
+    /// Fractions of child `i` at `p` (a table read for fixed ones).
+    #[inline]
+    pub fn child_frac(&self, i: usize, p: DVec3, out: &mut [f64]) {
+        match &self.fixed[i] {
+            Some(f) => f.write(out),
+            None => self.children[i].frac(p, out),
+        }
+    }
+
     /// Sharp, non-blending union: minimum and first containing child at once.
     fn union_eval(&self, p: DVec3, out: &mut [f64]) -> f64 {
         let mut best = f64::INFINITY;
@@ -97,21 +194,18 @@ impl NAry {
                 }
                 let mut done = false;
                 if let Candidates::Cell {
-                    items,
-                    lows,
-                    margin,
-                    ..
+                    entries, margin, ..
                 } = index.candidates(p)
                 {
-                    for (&i, &lo) in items.iter().zip(lows) {
+                    for e in entries {
                         // Sorted by lower bound: once it is above both the
                         // best so far and 0, no later child is lower or
                         // contains p.
-                        let lo = f64::from(lo);
+                        let lo = f64::from(e.lo);
                         if lo >= best && lo > 0.0 {
                             break;
                         }
-                        visit(i as usize, &mut best, &mut first);
+                        visit(e.child as usize, &mut best, &mut first);
                     }
                     done = best < margin;
                 }
@@ -131,7 +225,7 @@ impl NAry {
             }
         }
         if best <= 0.0 && first != usize::MAX {
-            self.children[first].frac(p, out);
+            self.child_frac(first, p, out);
         }
         best
     }
@@ -143,24 +237,23 @@ impl NAry {
     fn union_frac(&self, p: DVec3, out: &mut [f64]) {
         if let Some(index) = &self.index
             && let Candidates::Cell {
-                items,
-                lows,
-                always,
-                ..
+                entries, always, ..
             } = index.candidates(p)
         {
             // Only children whose lower bound is ≤ 0 can contain p; they
             // come first. Visit them in child order.
-            let n = lows.partition_point(|lo| *lo <= 0.0);
+            let n = entries.partition_point(|e| e.lo <= 0.0);
             let mut inside: [u32; 64] = [0; 64];
             if n <= inside.len() {
-                inside[..n].copy_from_slice(&items[..n]);
+                for (o, e) in inside.iter_mut().zip(&entries[..n]) {
+                    *o = e.child;
+                }
                 inside[..n].sort_unstable();
                 let mut ids = merge_sorted(&inside[..n], always);
                 return self.frac_among(&mut ids, p, out);
             }
             // More than 64 children may contain p (rare): same, on the heap.
-            let mut sorted = items[..n].to_vec();
+            let mut sorted: Vec<u32> = entries[..n].iter().map(|e| e.child).collect();
             sorted.sort_unstable();
             let mut ids = merge_sorted(&sorted, always);
             return self.frac_among(&mut ids, p, out);
@@ -192,7 +285,7 @@ impl NAry {
                 let c = &self.children[i];
                 if !smooth {
                     if c.contains(p) {
-                        return c.frac(p, out);
+                        return self.child_frac(i, p, out);
                     }
                     continue;
                 }

@@ -176,6 +176,8 @@ pub struct NAry {
     /// Children whose distance is a capsule (a strut, or a graded strut),
     /// evaluated inline in the candidate loop without pointer chasing.
     pub capsules: Vec<Option<Capsule>>,
+    /// Children whose fractions do not depend on the point.
+    pub fixed: Vec<Option<super::fractions::FixedFractions>>,
 }
 
 /// FGrade: fractions from expressions over the child.
@@ -304,7 +306,7 @@ impl NAry {
     }
 
     /// Distance of child `i` (inline for capsules).
-    #[inline]
+    #[inline(always)]
     pub fn child_dist(&self, i: usize, p: DVec3) -> f64 {
         match &self.capsules[i] {
             Some(c) => c.dist(p),
@@ -336,17 +338,14 @@ impl NAry {
             best = best.min(self.child_dist(i as usize, p));
         }
         if let Candidates::Cell {
-            items,
-            lows,
-            margin,
-            ..
+            entries, margin, ..
         } = index.candidates(p)
         {
-            for (&i, &lo) in items.iter().zip(lows) {
-                if f64::from(lo) >= best {
+            for e in entries {
+                if f64::from(e.lo) >= best {
                     break; // the rest are bounded below by lo ≥ best
                 }
-                best = best.min(self.child_dist(i as usize, p));
+                best = best.min(self.child_dist(e.child as usize, p));
             }
             if best < margin {
                 return best;

@@ -413,6 +413,7 @@ impl Preparer {
         let index = (is_union && smooth <= 0.0 && children.len() >= INDEX_MIN_CHILDREN)
             .then(|| UnionIndex::build(&boxes, |i, cell| nodes[i].interval(cell).lo));
         let capsules = nodes.iter().map(|n| NAry::capsule_of(n)).collect();
+        let fixed = nodes.iter().map(|n| n.fixed_fractions()).collect();
         Ok((
             NAry {
                 children: nodes,
@@ -421,6 +422,7 @@ impl Preparer {
                 blend,
                 index,
                 capsules,
+                fixed,
             },
             bbox,
         ))

@@ -27,15 +27,24 @@ pub struct UnionIndex {
     grid_box: Aabb,
     dims: [usize; 3],
     inv_cell: DVec3,
-    /// CSR: children of cell c are `items[offsets[c]..offsets[c+1]]`,
-    /// sorted by `lows` (each child's lower bound over the cell), so a query
-    /// can stop once the next bound is above what it already found.
+    /// CSR: children of cell c are `entries[offsets[c]..offsets[c+1]]`,
+    /// sorted by lower bound over the cell, so a query can stop once the
+    /// next bound is above what it already found. Bound and index sit side
+    /// by side: a query touches one cache line, not two arrays.
     offsets: Vec<u32>,
-    items: Vec<u32>,
-    lows: Vec<f32>,
+    entries: Vec<Entry>,
     margin: f64,
     always: Vec<u32>,
     bvh: Bvh,
+}
+
+/// One listed child of a cell.
+#[derive(Debug, Clone, Copy)]
+pub struct Entry {
+    /// Lower bound of the child's value over the cell (rounded down to f32).
+    pub lo: f32,
+    /// The child's index in the union.
+    pub child: u32,
 }
 
 /// What a query may visit: the listed children of the point's cell, or
@@ -44,9 +53,7 @@ pub enum Candidates<'a> {
     /// Children to test, ascending; `margin` bounds the unlisted ones.
     Cell {
         /// Listed children, by ascending lower bound.
-        items: &'a [u32],
-        /// Their lower bounds over the cell (ascending; rounded down to f32).
-        lows: &'a [f32],
+        entries: &'a [Entry],
         /// Children with infinite boxes (ascending index).
         always: &'a [u32],
         /// Every unlisted finite child's value exceeds this.
@@ -169,27 +176,24 @@ impl UnionIndex {
             offsets[c + 1] += offsets[c];
         }
         let mut fill = offsets.clone();
-        let mut pairs = vec![(0f32, 0u32); offsets[ncells] as usize];
+        let mut entries = vec![Entry { lo: 0.0, child: 0 }; offsets[ncells] as usize];
         for (&i, l) in finite.iter().zip(&lists) {
             for &(c, lo) in l {
-                pairs[fill[c as usize] as usize] = (lo, i);
+                entries[fill[c as usize] as usize] = Entry { lo, child: i };
                 fill[c as usize] += 1;
             }
         }
         for c in 0..ncells {
-            pairs[offsets[c] as usize..offsets[c + 1] as usize]
-                .sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            entries[offsets[c] as usize..offsets[c + 1] as usize]
+                .sort_unstable_by(|a, b| a.lo.total_cmp(&b.lo).then(a.child.cmp(&b.child)));
         }
-        let items = pairs.iter().map(|p| p.1).collect();
-        let lows = pairs.iter().map(|p| p.0).collect();
         let bvh = Bvh::build(boxes, &finite);
         Self {
             grid_box,
             dims,
             inv_cell,
             offsets,
-            items,
-            lows,
+            entries,
             margin,
             always,
             bvh,
@@ -202,15 +206,15 @@ impl UnionIndex {
         if !self.grid_box.contains(p) {
             return Candidates::Outside;
         }
-        let g = ((p - self.grid_box.min) * self.inv_cell).floor();
+        // Non-negative inside the box, so truncation is floor.
+        let g = (p - self.grid_box.min) * self.inv_cell;
         let x = (g.x as usize).min(self.dims[0] - 1);
         let y = (g.y as usize).min(self.dims[1] - 1);
         let z = (g.z as usize).min(self.dims[2] - 1);
         let c = x + self.dims[0] * (y + self.dims[1] * z);
         let (a, b) = (self.offsets[c] as usize, self.offsets[c + 1] as usize);
         Candidates::Cell {
-            items: &self.items[a..b],
-            lows: &self.lows[a..b],
+            entries: &self.entries[a..b],
             always: &self.always,
             margin: self.margin,
         }

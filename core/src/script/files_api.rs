@@ -7,6 +7,7 @@ use std::sync::Arc;
 use rhai::{Dynamic, Engine, Map, NativeCallContext as Ctx};
 
 use super::RunContext;
+use super::file_cache;
 use super::values::*;
 use crate::expr::{COORD_VARS, Expr};
 use crate::node::{Node, NodeKind};
@@ -28,7 +29,8 @@ pub(super) fn register(engine: &mut Engine, ctx: &RunContext) {
     let mesh = move |cc: &Ctx, path: &str, m: Option<&Dynamic>| -> RResult<Node> {
         let p = cc.call_position();
         let full = c.resolve(path, p)?;
-        let mesh = crate::mesh::TriangleMesh::load(&full).or_else(|e| fail(p, e.to_string()))?;
+        let mesh = file_cache::cached(&[&full], || crate::mesh::TriangleMesh::load(&full))
+            .or_else(|e| fail(p, e.to_string()))?;
         {
             let mut st = c.lock();
             for w in mesh.warnings() {
@@ -37,10 +39,7 @@ pub(super) fn register(engine: &mut Engine, ctx: &RunContext) {
         }
         let material = m.map_or(Ok(1), |m| material(m, p))?;
         Ok(Node::with_origin(
-            NodeKind::Mesh {
-                mesh: Arc::new(mesh),
-                material,
-            },
+            NodeKind::Mesh { mesh, material },
             origin(p),
         ))
     };
@@ -62,7 +61,7 @@ pub(super) fn register(engine: &mut Engine, ctx: &RunContext) {
             }
             let inp_path = c.resolve(inp, p)?;
             let csv_path = c.resolve(csv, p)?;
-            let field = crate::simfield::SimField::load(&inp_path, &csv_path).or_else(|e| fail(p, e.to_string()))?;
+            let field = file_cache::cached(&[&inp_path, &csv_path], || crate::simfield::SimField::load(&inp_path, &csv_path)).or_else(|e| fail(p, e.to_string()))?;
             let names = field.variable_names();
             let mut vars: Vec<&str> = COORD_VARS.to_vec();
             vars.extend(names.iter().map(String::as_str));
@@ -81,7 +80,7 @@ pub(super) fn register(engine: &mut Engine, ctx: &RunContext) {
                     st.warnings.push(format!("SimulationField: {w}"));
                 }
             }
-            Ok(Node::with_origin(NodeKind::SimulationField { field: Arc::new(field), exprs, materials: mats }, origin(p)))
+            Ok(Node::with_origin(NodeKind::SimulationField { field, exprs, materials: mats }, origin(p)))
         },
     );
 }

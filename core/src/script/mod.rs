@@ -8,6 +8,7 @@
 //! runaway script stops at an operation limit or when its cancel flag is set.
 //! The design is the script's final value, or else a variable named `root`.
 
+mod file_cache;
 mod files_api;
 mod nodes_api;
 mod values;
