@@ -1,11 +1,12 @@
 //! Bake and frame timings (plain timers, `harness = false`):
 //!
-//! `cargo bench -p volcad-render` prints, per test design, the bake time at
+//! `cargo bench -p volcad-render` prints, per example and test design, the bake time at
 //! 64/128/256 voxels, the time to a first coarse image (bake 64 + upload +
 //! one frame), and the frame time at 1280×800 in Solid and Volume modes;
 //! then the thin-feature coverage of the BCC sphere with and without the
 //! bias. Images go to `target/bench-images/`. Set `VOLCAD_BENCH_QUICK=1` to
-//! skip the 256 level.
+//! skip the 256 level; `cargo bench -p volcad-render -- bunny` runs only
+//! the designs whose name contains `bunny`.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -14,6 +15,7 @@ use std::time::Instant;
 
 use common::*;
 use glam::Vec3;
+use volcad_core::Model;
 use volcad_render::{Camera, Offscreen, StandardView, ViewMode, ViewSettings, bake_blocking};
 
 const FRAME: [u32; 2] = [1280, 800];
@@ -27,6 +29,28 @@ fn many_node_sphere() -> String {
         "let m = default_materials(); Union(false, [{}])",
         spheres.join(", ")
     )
+}
+
+/// The examples in `assets/examples`, run from their files (they read data
+/// beside them), sorted by name.
+fn examples() -> Vec<(String, Model)> {
+    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets/examples");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "rhai"))
+        .collect();
+    files.sort();
+    files
+        .iter()
+        .map(|path| {
+            let src = std::fs::read_to_string(path).unwrap();
+            let name = path.file_stem().unwrap().to_string_lossy().to_string();
+            let opts = volcad_core::script::ScriptOptions::for_file(path);
+            let d = volcad_core::script::run_script(&src, &name, &opts).unwrap();
+            (name, Model::prepare(&d.root, d.materials.clone()).unwrap())
+        })
+        .collect()
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -46,23 +70,30 @@ fn main() {
         rayon::current_num_threads()
     );
 
-    let designs: Vec<(&str, String)> = vec![
-        ("graded_bar", GRADED_BAR.to_owned()),
-        ("bcc_sphere", BCC_SPHERE.to_owned()),
-        ("calibration_sheet", calibration_sheet()),
-        ("sphere_1_node", SPHERE.to_owned()),
-        ("sphere_200_nodes", many_node_sphere()),
-    ];
+    // Every example (optionally filtered by a name fragment), then the
+    // 1-node / 200-node sphere pair that shows frame time does not depend
+    // on node count.
+    let filter = std::env::args().skip(1).find(|a| !a.starts_with('-'));
+    let mut designs: Vec<(String, Model)> = examples()
+        .into_iter()
+        .chain([
+            ("sphere_1_node".to_owned(), model(SPHERE)),
+            ("sphere_200_nodes".to_owned(), model(&many_node_sphere())),
+        ])
+        .collect();
+    if let Some(f) = &filter {
+        designs.retain(|(n, _)| n.contains(f.as_str()));
+    }
     println!(
         "{:<18} {:>6} {:>9} {:>10} {:>10} {:>10} {:>10} {:>10}",
         "design", "level", "bake s", "voxels", "solid ms", "half ms", "volume ms", "iso ms"
     );
     let mut reference: Vec<Vec<u16>> = Vec::new();
-    for (name, src) in &designs {
-        let model = model(src);
+    for (name, model) in &designs {
+        let name = name.as_str();
         // Coarse first image: bake 64 + upload + one frame.
         let t = Instant::now();
-        let b = bake_blocking(&model, 64).unwrap();
+        let b = bake_blocking(model, 64).unwrap();
         off.upload(&b);
         let cam = Camera::fit(&model.bbox(), StandardView::Iso);
         let solid = ViewSettings {
@@ -72,7 +103,7 @@ fn main() {
         off.render(&solid).unwrap();
         let first = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        let b = bake_blocking(&model, 64).unwrap();
+        let b = bake_blocking(model, 64).unwrap();
         off.upload(&b);
         off.render(&ViewSettings {
             render_scale: 0.5,
@@ -84,7 +115,7 @@ fn main() {
             "{name:<18} first coarse image (bake 64 + upload + 1280x800 frame + readback): {first:.3} s, at render_scale 0.5: {first_half:.3} s"
         );
         for &level in levels {
-            let b = bake_blocking(&model, level).unwrap();
+            let b = bake_blocking(model, level).unwrap();
             off.upload(&b);
             let volume = ViewSettings {
                 mode: ViewMode::Volume,
@@ -127,9 +158,9 @@ fn main() {
                 b.bake_seconds,
                 b.voxel_count()
             );
-            if *name == "sphere_1_node" {
+            if name == "sphere_1_node" {
                 reference.push(b.distance.clone());
-            } else if *name == "sphere_200_nodes" {
+            } else if name == "sphere_200_nodes" {
                 let same = reference.get(levels.iter().position(|l| *l == level).unwrap())
                     == Some(&b.distance);
                 println!(
@@ -150,6 +181,9 @@ fn main() {
         }
     }
 
+    if filter.is_some() {
+        return;
+    }
     // Thin features: coverage of the BCC sphere's disk (front, orthographic)
     // by level and bias. The finest level without bias is the reference.
     let model = model(BCC_SPHERE);

@@ -66,6 +66,37 @@ pub fn coord_intervals(b: &Aabb, d: Interval) -> [Interval; COORD_SLOTS] {
 }
 
 impl PNode {
+    /// True when the node's value is 1-Lipschitz (`|f(p) − f(q)| ≤ |p − q|`),
+    /// so `f(c) ± r` bounds it over a ball of radius `r`: exact Euclidean
+    /// distances, and what min, max, offsets, shells, rigid motions and the
+    /// metric Scale make of them. Math-string functions, TPMS sheets (an
+    /// approximation) and Tile (its repetition breaks continuity at cell
+    /// borders when the child is larger than the cell) are not.
+    pub fn is_lipschitz(&self) -> bool {
+        match self {
+            PNode::Sphere { .. }
+            | PNode::Box { .. }
+            | PNode::Cylinder { .. }
+            | PNode::Strut { .. }
+            | PNode::Prism { .. }
+            | PNode::Lattice { .. }
+            | PNode::Mesh { .. }
+            | PNode::SimField(_) => true,
+            PNode::Function { .. } | PNode::Tpms { .. } | PNode::Tile { .. } => false,
+            PNode::Translate { child, .. }
+            | PNode::Rotate { child, .. }
+            | PNode::Scale { child, .. }
+            | PNode::Offset { child, .. }
+            | PNode::Shell { child, .. }
+            | PNode::Blend { child, .. } => child.is_lipschitz(),
+            PNode::FGrade(g) => g.child.is_lipschitz(),
+            PNode::Union(n) | PNode::Intersection(n) => n.lipschitz,
+            PNode::Difference { a, b, smooth } => {
+                *smooth <= 0.0 && a.is_lipschitz() && b.is_lipschitz()
+            }
+        }
+    }
+
     /// A conservative interval of the distance over `b`.
     pub fn interval(&self, b: &Aabb) -> Interval {
         match self {
@@ -101,6 +132,10 @@ impl PNode {
                 let i = child.interval(&b.scaled(*inv));
                 Interval::new(i.lo * *k, i.hi * *k)
             }
+            // A sharp union of 1-Lipschitz children is 1-Lipschitz: one
+            // indexed query at the centre gives the same interval as the
+            // minimum over every child's `d(c) ± r`, without visiting them.
+            PNode::Union(u) if u.lipschitz && b.is_finite() => lipschitz(self, b),
             PNode::Union(u) => u.union_interval(b),
             PNode::Intersection(n) => {
                 let mut i = n.children[0].interval(b);
@@ -136,16 +171,10 @@ impl PNode {
 
     /// True when the fractions are the same wherever the node is inside `b`.
     pub fn constant_fractions(&self, b: &Aabb) -> bool {
+        if self.leaf_material().is_some() {
+            return true;
+        }
         match self {
-            PNode::Sphere { .. }
-            | PNode::Box { .. }
-            | PNode::Cylinder { .. }
-            | PNode::Strut { .. }
-            | PNode::Prism { .. }
-            | PNode::Function { .. }
-            | PNode::Tpms { .. }
-            | PNode::Lattice { .. }
-            | PNode::Mesh { .. } => true,
             PNode::SimField(_) => false,
             PNode::Translate { t, child } => {
                 child.constant_fractions(&Aabb::new(b.min - *t, b.max - *t))
@@ -185,6 +214,7 @@ impl PNode {
                 })
             }
             PNode::Blend { .. } => false,
+            _ => true, // leaves: above
         }
     }
 

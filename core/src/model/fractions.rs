@@ -73,7 +73,7 @@ impl PNode {
 
     /// The material of a leaf that assigns one material everywhere.
     #[inline]
-    fn leaf_material(&self) -> Option<Slot> {
+    pub(super) fn leaf_material(&self) -> Option<Slot> {
         match self {
             PNode::Sphere { m, .. }
             | PNode::Box { m, .. }

@@ -176,6 +176,8 @@ pub struct NAry {
     /// Children whose distance is a capsule (a strut, or a graded strut),
     /// evaluated inline in the candidate loop without pointer chasing.
     pub capsules: Vec<Option<Capsule>>,
+    /// Sharp, and every child 1-Lipschitz (see `PNode::is_lipschitz`).
+    pub lipschitz: bool,
     /// Children whose fractions do not depend on the point.
     pub fixed: Vec<Option<super::fractions::FixedFractions>>,
 }

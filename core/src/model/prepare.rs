@@ -414,6 +414,7 @@ impl Preparer {
             .then(|| UnionIndex::build(&boxes, |i, cell| nodes[i].interval(cell).lo));
         let capsules = nodes.iter().map(|n| NAry::capsule_of(n)).collect();
         let fixed = nodes.iter().map(|n| n.fixed_fractions()).collect();
+        let lipschitz = smooth <= 0.0 && nodes.iter().all(|n| n.is_lipschitz());
         Ok((
             NAry {
                 children: nodes,
@@ -423,6 +424,7 @@ impl Preparer {
                 index,
                 capsules,
                 fixed,
+                lipschitz,
             },
             bbox,
         ))
