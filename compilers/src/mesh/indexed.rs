@@ -7,8 +7,6 @@
 //! exactly two triangles, once in each direction (which also makes the
 //! orientation consistent), and no triangle repeats an index.
 
-use rayon::prelude::*;
-
 /// Triangles over shared vertices (mm), counter-clockwise seen from outside.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct IndexedMesh {
@@ -103,36 +101,50 @@ impl IndexedMesh {
 
     /// Count open, repeated and degenerate edges.
     ///
-    /// Directed edges `a → b` are packed as `a·2³² + b`; the list and the
-    /// list of reversed edges are sorted (in parallel) and walked together:
-    /// an edge of the first with no partner in the second is open.
+    /// Directed edges `a → b` are grouped by their start vertex (a counting
+    /// sort, linear in the edge count; each vertex has a handful), each
+    /// group sorted. `a → b` repeated is counted once per extra copy; an
+    /// edge is open when `a → b` occurs more often than `b → a` (each copy
+    /// of `b → a` pairs with one copy of `a → b`).
     pub fn edge_report(&self) -> EdgeReport {
         let mut r = EdgeReport::default();
-        let mut edges: Vec<u64> = Vec::with_capacity(self.triangles.len() * 3);
+        let nv = self.vertices.len();
+        let mut start = vec![0u32; nv + 1];
         for t in &self.triangles {
             if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
                 r.degenerate += 1;
             }
-            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
-                edges.push(u64::from(a) << 32 | u64::from(b));
+            for a in t {
+                start[*a as usize + 1] += 1;
             }
         }
-        let mut reversed: Vec<u64> = edges.iter().map(|e| e.rotate_left(32)).collect();
-        rayon::join(
-            || edges.par_sort_unstable(),
-            || reversed.par_sort_unstable(),
-        );
-        r.repeated = edges.windows(2).filter(|w| w[0] == w[1]).count();
-        let (mut i, mut j) = (0, 0);
-        while i < edges.len() {
-            if j == reversed.len() || edges[i] < reversed[j] {
-                r.open += 1;
-                i += 1;
-            } else if edges[i] == reversed[j] {
-                i += 1;
-                j += 1;
-            } else {
-                j += 1;
+        for v in 0..nv {
+            start[v + 1] += start[v];
+        }
+        let mut fill = start.clone();
+        let mut ends = vec![0u32; start[nv] as usize];
+        for t in &self.triangles {
+            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                ends[fill[a as usize] as usize] = b;
+                fill[a as usize] += 1;
+            }
+        }
+        for v in 0..nv {
+            ends[start[v] as usize..start[v + 1] as usize].sort_unstable();
+        }
+        let out = |v: u32| &ends[start[v as usize] as usize..start[v as usize + 1] as usize];
+        let count = |list: &[u32], x: u32| {
+            list.partition_point(|&e| e <= x) - list.partition_point(|&e| e < x)
+        };
+        for a in 0..nv as u32 {
+            let list = out(a);
+            let mut i = 0;
+            while i < list.len() {
+                let b = list[i];
+                let m = count(&list[i..], b);
+                r.repeated += m - 1;
+                r.open += m.saturating_sub(count(out(b), a));
+                i += m;
             }
         }
         r

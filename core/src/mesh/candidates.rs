@@ -24,10 +24,14 @@ use rayon::prelude::*;
 use super::TriangleMesh;
 use crate::bounds::Aabb;
 
-/// Cells along the longest side of the (padded) mesh box.
+/// Fewest cells along the longest side of the mesh box.
 const CELLS: f64 = 64.0;
+/// Most cells in one grid (5 bytes each plus the lists).
+const MAX_TOTAL: f64 = 4.0e6;
 /// Cells farther than this many cell sizes from the surface keep no list.
-const FAR: f64 = 4.0;
+const FAR: f64 = 1.5;
+/// Longest block list (2×2×2 cells) gathered; beyond it the cells keep none.
+const MAX_BLOCK: usize = 160;
 /// Longest list kept; cells that need more fall back to the BVH.
 const MAX_LIST: usize = 40;
 
@@ -62,36 +66,117 @@ impl CandidateGrid {
         if !(extent > 0.0 && extent.is_finite()) {
             return None;
         }
-        let cell = extent / CELLS;
+        // Cells about half a typical triangle across (sqrt(area / count)),
+        // and at least `CELLS` along the longest side: lists stay a few
+        // triangles long for coarse meshes (the seat's 10 k big faces) and
+        // fine ones (the bunny). At most `MAX_TOTAL` cells.
+        let area: f64 = mesh
+            .tris
+            .iter()
+            .map(|t| 0.5 * t.ab.cross(t.ac).length())
+            .sum();
+        let typical = (area / mesh.tris.len() as f64).sqrt();
+        let size = b.size();
+        let mut cell = (extent / CELLS).min(0.5 * typical).max(extent * 1e-6);
+        let cells_for = |c: f64| {
+            let n = (size + DVec3::splat(4.0 * c)) / c;
+            n.x.ceil() * n.y.ceil() * n.z.ceil()
+        };
+        while cells_for(cell) > MAX_TOTAL {
+            cell *= 1.25;
+        }
         let min = b.min - DVec3::splat(2.0 * cell);
-        let n = ((b.max + DVec3::splat(2.0 * cell) - min) / cell).ceil();
+        // Dimensions rounded up to even: cells are built in 2×2×2 blocks.
+        let n = ((b.max + DVec3::splat(2.0 * cell) - min) / cell / 2.0).ceil() * 2.0;
         let dims = [n.x as usize, n.y as usize, n.z as usize];
         let r = 0.5 * cell * 3f64.sqrt();
         let count = dims[0] * dims[1] * dims[2];
-        let lists: Vec<(i8, Vec<Candidate>)> = (0..count)
+        let slack = |v: f64| v * (1.0 + 1e-9) + 1e-12 * extent;
+        let bdims = [dims[0] / 2, dims[1] / 2, dims[2] / 2];
+        // Per block: one BVH range query for all eight cells. A cell's list
+        // needs d(c_i, t) ≤ u_i + 2r; with |c_i − c_B| = r and
+        // u_i ≤ U + r, those t have d(c_B, t) ≤ U + 4r, so the block's
+        // list holds every cell's list and every cell's nearest triangle.
+        let blocks: Vec<[(i8, Vec<Candidate>); 8]> = (0..bdims[0] * bdims[1] * bdims[2])
             .into_par_iter()
-            .map(|i| {
-                let (x, y, z) = (i % dims[0], i / dims[0] % dims[1], i / (dims[0] * dims[1]));
-                let c = min + (DVec3::new(x as f64, y as f64, z as f64) + 0.5) * cell;
-                // Cells the coarse grid proves far from the surface keep no
-                // list (their points are rarely asked; the BVH answers them).
-                if let Some((dc, rr)) = mesh.coarse.as_ref().and_then(|g| g.lookup(c))
-                    && dc.abs() - rr - r > FAR * cell
+            .map(|bi| {
+                let (bx, by, bz) = (
+                    bi % bdims[0],
+                    bi / bdims[0] % bdims[1],
+                    bi / (bdims[0] * bdims[1]),
+                );
+                let corner = min + DVec3::new(bx as f64, by as f64, bz as f64) * 2.0 * cell;
+                let cb = corner + DVec3::splat(cell);
+                let mut out: [(i8, Vec<Candidate>); 8] = Default::default();
+                // Blocks the coarse grid proves far from the surface keep no
+                // lists (their points are rarely asked; the BVH answers them).
+                if let Some((dc, rr)) = mesh.coarse.as_ref().and_then(|g| g.lookup(cb))
+                    && dc.abs() - rr - 2.0 * r > FAR * cell
                 {
-                    return (if dc < 0.0 { -1 } else { 1 }, Vec::new());
+                    return out.map(|_| (if dc < 0.0 { -1 } else { 1 }, Vec::new()));
                 }
-                let d = mesh.signed_distance(c);
-                let u = d.abs();
-                // The inequality with a relative slack for rounding.
-                let side = if u > r * (1.0 + 1e-9) {
-                    if d < 0.0 { -1 } else { 1 }
-                } else {
-                    0
+                let d_block = mesh.signed_distance(cb);
+                let u_block = d_block.abs();
+                if u_block - 2.0 * r > FAR * cell {
+                    // The whole block is on one side, far from the surface.
+                    return out.map(|_| (if d_block < 0.0 { -1 } else { 1 }, Vec::new()));
+                }
+                let Some(block) = mesh.within(cb, slack(u_block + 4.0 * r), MAX_BLOCK) else {
+                    return out;
                 };
-                let reach = (u + 2.0 * r) * (1.0 + 1e-9) + 1e-12 * extent;
-                (side, mesh.within(c, reach, MAX_LIST).unwrap_or_default())
+                let mut d2s = vec![0.0; block.len()];
+                for (k, o) in out.iter_mut().enumerate() {
+                    let off = DVec3::new((k & 1) as f64, (k >> 1 & 1) as f64, (k >> 2) as f64);
+                    let c = corner + (off + 0.5) * cell;
+                    let mut best = (f64::INFINITY, 0usize);
+                    for (d2, e) in d2s.iter_mut().zip(&block) {
+                        *d2 = mesh.tris[e.slot as usize].distance_squared(c);
+                        if *d2 < best.0 {
+                            best = (*d2, e.slot as usize);
+                        }
+                    }
+                    let u = best.0.sqrt();
+                    // No point of the cell is on the surface when u > r
+                    // (1-Lipschitz), so the cell has the centre's side.
+                    let side = if u > r * (1.0 + 1e-9) {
+                        if mesh.sign_at(c, best.1) < 0.0 { -1 } else { 1 }
+                    } else {
+                        0
+                    };
+                    let reach2 = slack(u + 2.0 * r).powi(2);
+                    let list: Vec<Candidate> = d2s
+                        .iter()
+                        .zip(&block)
+                        .filter(|(d2, _)| **d2 <= reach2)
+                        .map(|(d2, e)| Candidate {
+                            dc: f32_down(d2.sqrt()),
+                            slot: e.slot,
+                        })
+                        .collect();
+                    *o = (
+                        side,
+                        if list.len() <= MAX_LIST {
+                            list
+                        } else {
+                            Vec::new()
+                        },
+                    );
+                }
+                out
             })
             .collect();
+        let mut lists: Vec<(i8, Vec<Candidate>)> = vec![(0, Vec::new()); count];
+        for (bi, block) in blocks.into_iter().enumerate() {
+            let (bx, by, bz) = (
+                bi % bdims[0],
+                bi / bdims[0] % bdims[1],
+                bi / (bdims[0] * bdims[1]),
+            );
+            for (k, l) in block.into_iter().enumerate() {
+                let (x, y, z) = (2 * bx + (k & 1), 2 * by + (k >> 1 & 1), 2 * bz + (k >> 2));
+                lists[x + dims[0] * (y + dims[1] * z)] = l;
+            }
+        }
         let mut offsets = Vec::with_capacity(count + 1);
         let mut items = Vec::new();
         let mut side = Vec::with_capacity(count);
@@ -175,10 +260,10 @@ impl TriangleMesh {
                         if out.len() == max {
                             return None;
                         }
-                        let d = d2.sqrt();
-                        let f = d as f32;
-                        let dc = if f as f64 > d { f.next_down() } else { f };
-                        out.push(Candidate { dc, slot: s });
+                        out.push(Candidate {
+                            dc: f32_down(d2.sqrt()),
+                            slot: s,
+                        });
                     }
                 }
             } else {
@@ -189,4 +274,10 @@ impl TriangleMesh {
         }
         Some(out)
     }
+}
+
+/// Largest `f32` not above `x` (keeps a stored distance a lower bound).
+fn f32_down(x: f64) -> f32 {
+    let f = x as f32;
+    if f as f64 > x { f.next_down() } else { f }
 }
