@@ -76,8 +76,8 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
         args.designs.clone()
     };
     println!(
-        "{:<28} {:>8} {:>14} {:>16}",
-        "design", "nodes", "prepare (ms)", "points/s (±2mm)"
+        "{:<28} {:>8} {:>14} {:>16} {:>16}",
+        "design", "nodes", "prepare (ms)", "random order", "Z-order"
     );
     for path in designs {
         let d = super::DesignArgs {
@@ -93,14 +93,17 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
         };
         let pts = volcad_core::bench::near_surface_points(&l.model, args.points, 2.0, 7);
         let pps = volcad_core::bench::points_per_second(&l.model, &pts);
+        let sorted = volcad_core::bench::z_order(&l.model, &pts);
+        let pps_z = volcad_core::bench::points_per_second(&l.model, &sorted);
         println!(
-            "{:<28} {:>8} {:>14.1} {:>16.3e}",
+            "{:<28} {:>8} {:>14.1} {:>16.3e} {:>16.3e}",
             path.file_name()
                 .map(|f| f.to_string_lossy().to_string())
                 .unwrap_or_default(),
             l.model.node_count(),
             l.model.prepare_time().as_secs_f64() * 1e3,
-            pps
+            pps,
+            pps_z
         );
     }
     Ok(())
