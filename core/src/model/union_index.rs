@@ -4,7 +4,7 @@
 //! Two structures over the children's bounding boxes:
 //!
 //! * a **uniform grid**: each cell lists (in child order) the children whose
-//!   interval over the cell has a lower end below `margin` (three cell sizes).
+//!   interval over the cell has a lower end below `margin` (two cell sizes).
 //!   For a point in a cell, an unlisted child's value exceeds `margin`, so it
 //!   cannot be the minimum when a listed child is below `margin`, and it
 //!   cannot contain the point: "first child containing p" is found among the
@@ -81,20 +81,25 @@ impl UnionIndex {
                 always.push(i as u32);
             }
         }
-        // About 64 cubic cells per finite child, at most 2 million cells.
+        // About 16 cubic cells per finite child, at most 2 million cells.
+        // Finer grids list fewer candidates per cell but outgrow the caches:
+        // on the bunny's 3,286 struts, 64 cells per child and a three-cell
+        // margin evaluated Z-ordered points 15 % faster and random ones
+        // 1.7 times slower (DRAM misses on the longer lists), and took
+        // three times longer to build.
         let n = finite.len().max(1) as f64;
         let size = grid_box.size().max(DVec3::splat(1e-9));
         let volume = size.x * size.y * size.z;
-        let cell = (volume / (64.0 * n)).cbrt().max((volume / 2.0e6).cbrt());
+        let cell = (volume / (16.0 * n)).cbrt().max((volume / 2.0e6).cbrt());
         let dims = [
             ((size.x / cell).ceil() as usize).clamp(1, 1024),
             ((size.y / cell).ceil() as usize).clamp(1, 1024),
             ((size.z / cell).ceil() as usize).clamp(1, 1024),
         ];
         let cell_size = size / DVec3::new(dims[0] as f64, dims[1] as f64, dims[2] as f64);
-        // Three cells: points within three cells of a child never need the
-        // BVH; lists are sorted by lower bound, so long lists cost little.
-        let margin = 3.0 * cell_size.max_element();
+        // Two cells: points within two cells of a child never need the BVH;
+        // lists are sorted by lower bound, so long lists cost little.
+        let margin = 2.0 * cell_size.max_element();
         let inv_cell = DVec3::ONE / cell_size;
         let ncells = dims[0] * dims[1] * dims[2];
         let cell_range = |b: &Aabb| {
