@@ -252,6 +252,41 @@ fn export_png_mesh_and_fea() {
         files.iter().filter(|f| f.ends_with(".stl")).count() >= 2,
         "{files:?}"
     );
+    // Only the formats asked for; a bad list is refused before any work.
+    let only = d.join("mesh_3mf");
+    ok(&volcad(&[
+        "export",
+        "mesh",
+        &example("graded_bar.rhai"),
+        "--out",
+        only.to_str().unwrap(),
+        "--voxel",
+        "0.5",
+        "--formats",
+        "3mf",
+    ]));
+    let files = files_in(&only);
+    assert!(files.iter().any(|f| f.ends_with(".3mf")), "{files:?}");
+    assert!(
+        !files
+            .iter()
+            .any(|f| f.ends_with(".stl") || f.ends_with(".obj")),
+        "{files:?}"
+    );
+    let bad = volcad(&[
+        "export",
+        "mesh",
+        &example("graded_bar.rhai"),
+        "--out",
+        d.join("bad").to_str().unwrap(),
+        "--voxel",
+        "0.5",
+        "--formats",
+        "stl,ply",
+    ]);
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown format `ply`"));
+    assert!(!d.join("bad").exists());
 
     let fea = d.join("fea");
     ok(&volcad(&[

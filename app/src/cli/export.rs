@@ -69,6 +69,9 @@ pub struct ExportArgs {
     /// mesh: 3MF infill percent as a math string of f (the segment's mid fraction).
     #[arg(long)]
     pub infill: Option<String>,
+    /// mesh: files to write, a comma list of stl, obj, 3mf.
+    #[arg(long, default_value = "stl,obj,3mf")]
+    pub formats: String,
     /// fea: c3d8r (bricks) or c3d4 (adaptive tets).
     #[arg(long, default_value = "c3d8r")]
     pub element: String,
@@ -122,6 +125,27 @@ fn parse_layers(s: &str) -> anyhow::Result<std::ops::Range<usize>> {
         bail!("--layers {s}: the start must be below the end");
     }
     Ok(a..b)
+}
+
+/// `--formats stl,obj,3mf` (any subset, any order).
+fn parse_formats(s: &str) -> anyhow::Result<MeshFormats> {
+    let mut f = MeshFormats {
+        stl: false,
+        obj: false,
+        threemf: false,
+    };
+    for part in s.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        match part.to_ascii_lowercase().as_str() {
+            "stl" => f.stl = true,
+            "obj" => f.obj = true,
+            "3mf" => f.threemf = true,
+            other => bail!("--formats {s}: unknown format `{other}`; use stl, obj and 3mf"),
+        }
+    }
+    if !(f.stl || f.obj || f.threemf) {
+        bail!("--formats {s}: name at least one of stl, obj, 3mf");
+    }
+    Ok(f)
 }
 
 /// Run `volcad export`.
@@ -193,11 +217,7 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
                 voxel: voxel.context("--voxel is required for mesh (e.g. --voxel 0.25)")?,
                 segments: a.segments,
                 by,
-                formats: MeshFormats {
-                    stl: true,
-                    obj: true,
-                    threemf: true,
-                },
+                formats: parse_formats(&a.formats)?,
                 infill_expr: a.infill.clone(),
                 threads,
             };
