@@ -155,6 +155,37 @@ struct Tri {
     v: [VRef; 3],
 }
 
+/// One row's triangles over its own vertex list, deduplicated per label
+/// (first appearance order, so the merged meshes list vertices in the same
+/// order as a triangle-by-triangle merge would).
+struct RowMesh {
+    /// Label, key and position of each distinct (label, key).
+    verts: Vec<(u16, u64, [f32; 3])>,
+    /// Label and row-local vertex indices.
+    tris: Vec<(u16, [u32; 3])>,
+}
+
+impl RowMesh {
+    fn new(tris: Vec<Tri>) -> RowMesh {
+        let mut local: HashMap<(u16, u64), u32, BuildHasherDefault<KeyHasher>> =
+            HashMap::with_capacity_and_hasher(tris.len(), Default::default());
+        let mut verts = Vec::with_capacity(tris.len());
+        let tris = tris
+            .iter()
+            .map(|t| {
+                let idx = t.v.map(|v| {
+                    *local.entry((t.label, v.key)).or_insert_with(|| {
+                        verts.push((t.label, v.key, v.pos));
+                        (verts.len() - 1) as u32
+                    })
+                });
+                (t.label, idx)
+            })
+            .collect();
+        RowMesh { verts, tris }
+    }
+}
+
 /// Order corner masks by inclusion (Kuhn corners are nested sets).
 fn by_inclusion(a: u8, b: u8) -> (u8, u8) {
     if a.count_ones() < b.count_ones() {
@@ -225,22 +256,32 @@ impl Contourer {
         };
         assert_eq!(pz + 1, z, "planes must come in order");
         let ny = self.grid.dims[1];
-        let rows: Vec<Vec<Tri>> = (0..ny.saturating_sub(1))
+        // Rows in parallel, each with its vertices deduplicated per label;
+        // then one sequential pass gives each new vertex its index in its
+        // label's mesh (one map lookup per row vertex instead of one per
+        // triangle corner: the sequential part was a third of contouring).
+        let rows: Vec<RowMesh> = (0..ny.saturating_sub(1))
             .into_par_iter()
-            .map(|j| self.row(pz, j, &lo, &plane))
+            .map(|j| RowMesh::new(self.row(pz, j, &lo, &plane)))
             .collect();
         let plane_len = layer as u64;
-        for tri in rows.iter().flatten() {
-            let l = tri.label as usize - 1;
-            let (mesh, maps) = (&mut self.meshes[l], &mut self.maps[l]);
-            let idx = tri.v.map(|v| {
-                let slot = ((v.key / KEY_TYPES) / plane_len - pz as u64) as usize;
-                *maps[slot].entry(v.key).or_insert_with(|| {
-                    mesh.vertices.push(v.pos);
+        let mut global = Vec::new();
+        for row in &rows {
+            global.clear();
+            for &(label, key, pos) in &row.verts {
+                let l = label as usize - 1;
+                let (mesh, maps) = (&mut self.meshes[l], &mut self.maps[l]);
+                let slot = ((key / KEY_TYPES) / plane_len - pz as u64) as usize;
+                global.push(*maps[slot].entry(key).or_insert_with(|| {
+                    mesh.vertices.push(pos);
                     (mesh.vertices.len() - 1) as u32
-                })
-            });
-            mesh.triangles.push(idx);
+                }));
+            }
+            for &(label, t) in &row.tris {
+                self.meshes[label as usize - 1]
+                    .triangles
+                    .push(t.map(|i| global[i as usize]));
+            }
         }
         for m in &mut self.maps {
             m.swap(0, 1);
