@@ -194,14 +194,18 @@ impl NAry {
                 }
                 let mut done = false;
                 if let Candidates::Cell {
-                    entries, margin, ..
+                    entries,
+                    margin,
+                    slack,
+                    ..
                 } = index.candidates(p)
                 {
+                    let slack = if self.lipschitz { slack } else { 0.0 };
                     for e in entries {
                         // Sorted by lower bound: once it is above both the
                         // best so far and 0, no later child is lower or
                         // contains p.
-                        let lo = f64::from(e.lo);
+                        let lo = f64::from(e.lo) + slack;
                         if lo >= best && lo > 0.0 {
                             break;
                         }
@@ -237,12 +241,16 @@ impl NAry {
     fn union_frac(&self, p: DVec3, out: &mut [f64]) {
         if let Some(index) = &self.index
             && let Candidates::Cell {
-                entries, always, ..
+                entries,
+                always,
+                slack,
+                ..
             } = index.candidates(p)
         {
             // Only children whose lower bound is ≤ 0 can contain p; they
             // come first. Visit them in child order.
-            let n = entries.partition_point(|e| e.lo <= 0.0);
+            let slack = if self.lipschitz { slack } else { 0.0 };
+            let n = entries.partition_point(|e| f64::from(e.lo) + slack <= 0.0);
             let mut inside: [u32; 64] = [0; 64];
             if n <= inside.len() {
                 for (o, e) in inside.iter_mut().zip(&entries[..n]) {

@@ -51,6 +51,26 @@ impl Capsule {
     }
 }
 
+/// A capsule alone on a 64-byte cache line (a union's candidate loop reads
+/// one per visited child, in random order; `Option<Capsule>` took 72 bytes,
+/// so most straddled two lines). `r` is NaN for a child that is not a
+/// capsule.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub struct LineCapsule(pub Capsule);
+
+impl LineCapsule {
+    /// The capsule of a child, or the NaN marker.
+    pub fn of(c: Option<Capsule>) -> Self {
+        LineCapsule(c.unwrap_or(Capsule {
+            a: DVec3::ZERO,
+            ab: DVec3::ZERO,
+            inv_ab2: 0.0,
+            r: f64::NAN,
+        }))
+    }
+}
+
 /// A planar polygon extruded along its normal, in its own frame.
 #[derive(Clone, Debug)]
 pub struct Prism {
@@ -173,9 +193,10 @@ pub struct NAry {
     pub blend: bool,
     /// Present for large, sharp unions.
     pub index: Option<UnionIndex>,
-    /// Children whose distance is a capsule (a strut, or a graded strut),
-    /// evaluated inline in the candidate loop without pointer chasing.
-    pub capsules: Vec<Option<Capsule>>,
+    /// Per child, its capsule when its distance is one (a strut, or a
+    /// graded strut), evaluated inline in the candidate loop without pointer
+    /// chasing; empty when no child is a capsule.
+    pub capsules: Vec<LineCapsule>,
     /// Sharp, and every child 1-Lipschitz (see `PNode::is_lipschitz`).
     pub lipschitz: bool,
     /// Children whose fractions do not depend on the point.
@@ -310,9 +331,9 @@ impl NAry {
     /// Distance of child `i` (inline for capsules).
     #[inline(always)]
     pub fn child_dist(&self, i: usize, p: DVec3) -> f64 {
-        match &self.capsules[i] {
-            Some(c) => c.dist(p),
-            None => self.children[i].dist(p),
+        match self.capsules.get(i) {
+            Some(LineCapsule(c)) if !c.r.is_nan() => c.dist(p),
+            _ => self.children[i].dist(p),
         }
     }
 
@@ -340,11 +361,15 @@ impl NAry {
             best = best.min(self.child_dist(i as usize, p));
         }
         if let Candidates::Cell {
-            entries, margin, ..
+            entries,
+            margin,
+            slack,
+            ..
         } = index.candidates(p)
         {
+            let slack = if self.lipschitz { slack } else { 0.0 };
             for e in entries {
-                if f64::from(e.lo) >= best {
+                if f64::from(e.lo) + slack >= best {
                     break; // the rest are bounded below by lo ≥ best
                 }
                 best = best.min(self.child_dist(e.child as usize, p));

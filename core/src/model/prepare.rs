@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use glam::{DMat3, DVec2, DVec3};
 
-use super::pnode::{Capsule, Grade, NAry, PNode, Prism, SimGrade, Slot};
+use super::pnode::{Capsule, Grade, LineCapsule, NAry, PNode, Prism, SimGrade, Slot};
 use super::tpms::Tpms;
 use super::union_index::UnionIndex;
 use super::{MAX_MATERIALS, PrepareError};
@@ -410,11 +410,28 @@ impl Preparer {
             boxes.push(b);
             bbox = bbox.union(&b);
         }
-        let index = (is_union && smooth <= 0.0 && children.len() >= INDEX_MIN_CHILDREN)
-            .then(|| UnionIndex::build(&boxes, |i, cell| nodes[i].interval(cell).lo));
-        let capsules = nodes.iter().map(|n| NAry::capsule_of(n)).collect();
-        let fixed = nodes.iter().map(|n| n.fixed_fractions()).collect();
         let lipschitz = smooth <= 0.0 && nodes.iter().all(|n| n.is_lipschitz());
+        // 1-Lipschitz children are listed by `d(centre) − half diagonal`, so
+        // queries can tighten it to `d(centre) − |p − centre|` (the slack).
+        let index =
+            (is_union && smooth <= 0.0 && children.len() >= INDEX_MIN_CHILDREN).then(|| {
+                UnionIndex::build(&boxes, |i, cell| {
+                    if lipschitz {
+                        nodes[i].dist(cell.center()) - cell.half_diagonal()
+                    } else {
+                        nodes[i].interval(cell).lo
+                    }
+                })
+            });
+        let capsules = if nodes.iter().any(|n| NAry::capsule_of(n).is_some()) {
+            nodes
+                .iter()
+                .map(|n| LineCapsule::of(NAry::capsule_of(n)))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let fixed = nodes.iter().map(|n| n.fixed_fractions()).collect();
         Ok((
             NAry {
                 children: nodes,

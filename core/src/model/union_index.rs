@@ -27,6 +27,7 @@ pub struct UnionIndex {
     grid_box: Aabb,
     dims: [usize; 3],
     inv_cell: DVec3,
+    cell_size: DVec3,
     /// CSR: children of cell c are `entries[offsets[c]..offsets[c+1]]`,
     /// sorted by lower bound over the cell, so a query can stop once the
     /// next bound is above what it already found. Bound and index sit side
@@ -58,6 +59,11 @@ pub enum Candidates<'a> {
         always: &'a [u32],
         /// Every unlisted finite child's value exceeds this.
         margin: f64,
+        /// `r − |p − c|` (rounded down) for the cell's centre `c` and half
+        /// diagonal `r`. When the bounds were built as `d(c) − r` of
+        /// 1-Lipschitz children (see [`UnionIndex::build`]), a child's value
+        /// at `p` is at least `lo + slack`: a tighter stop for the query.
+        slack: f64,
     },
     /// The point is outside the grid.
     Outside,
@@ -69,6 +75,8 @@ impl UnionIndex {
     /// interval's `lo`); a child is listed in a cell when that bound is below
     /// the margin, so an unlisted child's value exceeds the margin anywhere in
     /// the cell (this needs only sound intervals, no Lipschitz assumption).
+    /// Callers that pass `d(centre) − half diagonal` of 1-Lipschitz children
+    /// may also use the query's `slack`.
     pub fn build(boxes: &[Aabb], lower_bound: impl Fn(usize, &Aabb) -> f64 + Sync) -> Self {
         let mut always = Vec::new();
         let mut finite: Vec<u32> = Vec::new();
@@ -197,6 +205,7 @@ impl UnionIndex {
             grid_box,
             dims,
             inv_cell,
+            cell_size,
             offsets,
             entries,
             margin,
@@ -218,10 +227,14 @@ impl UnionIndex {
         let z = (g.z as usize).min(self.dims[2] - 1);
         let c = x + self.dims[0] * (y + self.dims[1] * z);
         let (a, b) = (self.offsets[c] as usize, self.offsets[c + 1] as usize);
+        let centre =
+            self.grid_box.min + (DVec3::new(x as f64, y as f64, z as f64) + 0.5) * self.cell_size;
+        let r = 0.5 * self.cell_size.length();
         Candidates::Cell {
             entries: &self.entries[a..b],
             always: &self.always,
             margin: self.margin,
+            slack: (r - p.distance(centre)).max(0.0) - 1e-12 * r,
         }
     }
 
