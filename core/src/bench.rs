@@ -9,10 +9,15 @@ use rayon::prelude::*;
 
 use crate::Model;
 
-/// `n` points within `band` mm of the surface, drawn deterministically
-/// (xorshift from `seed`) from the bounding box by rejection: the hard case
+/// `n` points within `band` mm of the surface, uniformly distributed over
+/// that band, drawn deterministically (xorshift from `seed`): the hard case
 /// for evaluation (far points are cheap, and samplers cull them anyway).
-/// Returns fewer points if the band is too thin to find them.
+/// The box is cut into 32³ equal cells and the cells whose distance
+/// interval proves them outside the band are dropped; points are drawn
+/// uniformly from the remaining cells and kept when `|d| ≤ band` (rejection
+/// within equal cells keeps the distribution uniform, and skips the far
+/// points whose exact distance is the slow part of drawing). Returns fewer
+/// points if the band is too thin to find them.
 pub fn near_surface_points(model: &Model, n: usize, band: f64, seed: u64) -> Vec<DVec3> {
     let b = model.bbox();
     let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
@@ -22,11 +27,27 @@ pub fn near_surface_points(model: &Model, n: usize, band: f64, seed: u64) -> Vec
         state ^= state << 17;
         (state >> 11) as f64 / (1u64 << 53) as f64
     };
+    const CELLS: usize = 32;
+    let cell = b.size() / CELLS as f64;
+    let near: Vec<DVec3> = (0..CELLS * CELLS * CELLS)
+        .map(|i| {
+            let (x, y, z) = (i % CELLS, i / CELLS % CELLS, i / (CELLS * CELLS));
+            b.min + DVec3::new(x as f64, y as f64, z as f64) * cell
+        })
+        .filter(|lo| {
+            let iv = model.interval(&crate::Aabb::new(*lo, *lo + cell));
+            iv.lo <= band && iv.hi >= -band
+        })
+        .collect();
     let mut out = Vec::with_capacity(n);
+    if near.is_empty() {
+        return out;
+    }
     let mut tries = 0usize;
     while out.len() < n && tries < n.saturating_mul(400) {
         tries += 1;
-        let p = b.min + DVec3::new(next(), next(), next()) * b.size();
+        let k = ((next() * near.len() as f64) as usize).min(near.len() - 1);
+        let p = near[k] + DVec3::new(next(), next(), next()) * cell;
         if model.distance(p).abs() <= band {
             out.push(p);
         }
@@ -77,4 +98,27 @@ pub fn z_order(model: &Model, pts: &[DVec3]) -> Vec<DVec3> {
     let mut keyed: Vec<(u64, DVec3)> = pts.iter().map(|p| (key(p), *p)).collect();
     keyed.sort_by_key(|k| k.0);
     keyed.into_iter().map(|k| k.1).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::script::{ScriptOptions, run_script};
+
+    #[test]
+    fn band_points_fill_the_band_evenly() {
+        let src = r#"let m = default_materials(); Sphere(Vec3(0,0,0), 10, m.id("red"))"#;
+        let d = run_script(src, "t", &ScriptOptions::default()).unwrap();
+        let m = Model::prepare(&d.root, d.materials).unwrap();
+        let pts = near_surface_points(&m, 20_000, 2.0, 7);
+        assert_eq!(pts.len(), 20_000);
+        assert!(pts.iter().all(|p| m.distance(*p).abs() <= 2.0));
+        // Uniform over the band clipped to the box [−10, 10]³: the part
+        // inside the sphere (8 < r < 10) holds 48.2 % of that volume (Monte
+        // Carlo with 2 million points).
+        let inner = pts.iter().filter(|p| p.length() < 10.0).count() as f64 / 2e4;
+        assert!((inner - 0.482).abs() < 0.015, "{inner}");
+        // Same seed, same points.
+        assert_eq!(pts[..10], near_surface_points(&m, 10, 2.0, 7)[..]);
+    }
 }
