@@ -534,7 +534,14 @@ fn broken_files_report_line_or_size() {
 #[test]
 #[ignore]
 fn perf_bunny_band() {
+    // Build time: load, weld, BVH, winding tree, coarse and candidate grids.
+    let t = std::time::Instant::now();
     let m = bunny();
+    println!(
+        "bunny load and build ({} triangles, all threads): {:.3} s",
+        m.triangle_count(),
+        t.elapsed().as_secs_f64()
+    );
     let mut rng = Rng::new(1);
     let v = m.vertices().to_vec();
     let tris = m.triangles().to_vec();

@@ -329,7 +329,13 @@ fn errors_name_file_and_line() {
 #[test]
 #[ignore]
 fn perf_seat_sample() {
+    // Build time: parse, tet BVH, boundary mesh and its grids.
+    let t = std::time::Instant::now();
     let f = SimField::load(&seat("seat.inp"), &seat("seat_displacement.csv")).unwrap();
+    println!(
+        "seat load and build (.inp + .csv, all threads): {:.3} s",
+        t.elapsed().as_secs_f64()
+    );
     let mut rng = Rng::new(3);
     let mut out = [0.0; 4];
     let mut pts = Vec::new();
