@@ -300,6 +300,7 @@ impl Contourer {
         let nx = self.grid.dims[0];
         let s = self.iface.stride();
         let mut out = Vec::new();
+        let mut scratch = Scratch::default();
         for i in 0..nx.saturating_sub(1) {
             let mut label = [0u16; 8];
             let mut idx = [0usize; 8];
@@ -322,7 +323,7 @@ impl Contourer {
                 value: std::array::from_fn(|c| &plane(c).value[idx[c] * s..(idx[c] + 1) * s]),
             };
             for perm in 0..6 {
-                self.tet(&cube, perm, &mut out);
+                self.tet(&cube, perm, &mut scratch, &mut out);
             }
         }
         out
@@ -421,8 +422,9 @@ impl Contourer {
         }
     }
 
-    /// Contour tet `perm` of `cube` into `out`.
-    fn tet(&self, cube: &Cube, perm: usize, out: &mut Vec<Tri>) {
+    /// Contour tet `perm` of `cube` into `out` (`scratch`: buffers reused
+    /// from tet to tet, so the hot loop does not allocate).
+    fn tet(&self, cube: &Cube, perm: usize, scratch: &mut Scratch, out: &mut Vec<Tri>) {
         let [a1, a2, _] = PERMS[perm];
         let m1 = 1u8 << a1;
         let m2 = m1 | 1 << a2;
@@ -446,7 +448,13 @@ impl Contourer {
         }
         // Oriented curve segments on the faces, per label: (label, from, to)
         // with the label's region on the left seen from outside the tet.
-        let mut segs: Vec<(u16, Pt, Pt)> = Vec::with_capacity(24);
+        let Scratch {
+            segs,
+            mine,
+            ring,
+            refs,
+        } = scratch;
+        segs.clear();
         for f in FACES {
             let [u, w, x] = f.map(|i| v[i]);
             let [lu, lw, lx] = f.map(|i| lab[i]);
@@ -488,15 +496,13 @@ impl Contourer {
             } else {
                 (distinct[0], distinct[1])
             };
-            let mine: Vec<(Pt, Pt)> = segs
-                .iter()
-                .filter(|s| s.0 == x)
-                .map(|s| (s.1, s.2))
-                .collect();
-            if let Some(ring) = chain(&mine) {
-                let ring: Vec<VRef> = ring.into_iter().map(res).collect();
-                for i in 1..ring.len() - 1 {
-                    let t = [ring[0], ring[i], ring[i + 1]];
+            mine.clear();
+            mine.extend(segs.iter().filter(|s| s.0 == x).map(|s| (s.1, s.2)));
+            if chain(mine, ring) {
+                refs.clear();
+                refs.extend(ring.iter().map(|p| res(*p)));
+                for i in 1..refs.len() - 1 {
+                    let t = [refs[0], refs[i], refs[i + 1]];
                     out.push(Tri { label: x, v: t });
                     if y != 0 {
                         out.push(Tri {
@@ -510,7 +516,7 @@ impl Contourer {
             debug_assert!(false, "two-label tet without a single loop: {lab:?}");
         }
         let apex = res(Pt::Tet);
-        for (l, a, b) in segs {
+        for &(l, a, b) in segs.iter() {
             if l != 0 {
                 out.push(Tri {
                     label: l,
@@ -521,19 +527,38 @@ impl Contourer {
     }
 }
 
-/// Join segments `(from, to)` into one closed loop of points; `None` if they
-/// do not form exactly one loop.
-fn chain(segs: &[(Pt, Pt)]) -> Option<Vec<Pt>> {
-    let (first, mut end) = *segs.first()?;
-    let mut ring = vec![first];
+/// Join segments `(from, to)` into one closed loop of points in `ring`;
+/// false if they do not form exactly one loop.
+fn chain(segs: &[(Pt, Pt)], ring: &mut Vec<Pt>) -> bool {
+    ring.clear();
+    let Some(&(first, mut end)) = segs.first() else {
+        return false;
+    };
+    ring.push(first);
     while end != first {
         if ring.len() > segs.len() {
-            return None;
+            return false;
         }
         ring.push(end);
-        end = segs.iter().find(|s| s.0 == end)?.1;
+        match segs.iter().find(|s| s.0 == end) {
+            Some(s) => end = s.1,
+            None => return false,
+        }
     }
-    (ring.len() == segs.len() && ring.len() >= 3).then_some(ring)
+    ring.len() == segs.len() && ring.len() >= 3
+}
+
+/// Buffers one row's tets reuse.
+#[derive(Default)]
+struct Scratch {
+    /// Oriented curve segments on the tet's faces: (label, from, to).
+    segs: Vec<(u16, Pt, Pt)>,
+    /// One label's segments.
+    mine: Vec<(Pt, Pt)>,
+    /// Their loop.
+    ring: Vec<Pt>,
+    /// The loop's vertices.
+    refs: Vec<VRef>,
 }
 
 /// Mesh the region `{v ≤ 0}` of a field sampled at the centres of `grid`
