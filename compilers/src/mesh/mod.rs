@@ -469,7 +469,13 @@ fn summary(
         ));
     }
     let mut total_volume = 0.0;
-    for s in segs {
+    // The contouring guarantees watertightness; checked anyway (a linear
+    // pass over the edges), every segment on its own thread.
+    let checks: Vec<(f64, bool)> = segs
+        .par_iter()
+        .map(|s| (s.mesh.volume(), s.mesh.is_watertight()))
+        .collect();
+    for (s, &(v, watertight)) in segs.iter().zip(&checks) {
         if s.mesh.is_empty() {
             notes.push(format!(
                 "{}: empty (no voxel in this range), no file",
@@ -477,10 +483,8 @@ fn summary(
             ));
             continue;
         }
-        let v = s.mesh.volume();
         total_volume += v;
-        // The contouring guarantees this; checked anyway (costs a sort of the edges).
-        let tight = if s.mesh.is_watertight() {
+        let tight = if watertight {
             "watertight"
         } else {
             "NOT WATERTIGHT (please report)"
