@@ -26,16 +26,9 @@ pub fn slice_name(z: usize, digits: usize) -> String {
 /// `+` kept, anything else `_`; empty or dot-only names become
 /// `material_<id>`.
 pub fn folder_name(name: &str, id: u8) -> String {
-    let s: String = name
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || "-_.+".contains(c) {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect();
+    let s = volcad_core::names::underscore_other(name, |c| {
+        c.is_ascii_alphanumeric() || "-_.+".contains(c)
+    });
     if s.chars().all(|c| c == '.' || c == '_') {
         format!("material_{id}")
     } else {

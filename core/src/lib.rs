@@ -32,6 +32,7 @@ pub mod lattice;
 pub mod material;
 pub mod mesh;
 pub mod model;
+pub mod names;
 pub mod node;
 pub mod sampler;
 pub mod script;

@@ -22,6 +22,7 @@
 //! fixed rule, so the bytes depend only on the mesh.
 
 use std::io::{self, Write};
+use volcad_core::names::underscore_other;
 
 use super::{Element, FeaMesh};
 
@@ -80,16 +81,7 @@ pub fn num(x: f64) -> String {
 /// and `_`, at most 60 characters (so `E_` + name stays under 80), unique
 /// case-insensitively among `taken`.
 pub fn sanitize(name: &str, taken: &mut Vec<String>) -> String {
-    let mut s: String = name
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '_' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect();
+    let mut s = underscore_other(name, |c| c.is_ascii_alphanumeric() || c == '_');
     if !s.starts_with(|c: char| c.is_ascii_alphabetic()) {
         s.insert(0, 'M');
     }

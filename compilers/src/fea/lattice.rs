@@ -87,19 +87,11 @@ impl Lattice {
             tets: Vec::new(),
             max_level: (3 * cycles + 3).min(255) as u8,
         };
-        const PERMS: [[usize; 3]; 6] = [
-            [0, 1, 2],
-            [0, 2, 1],
-            [1, 0, 2],
-            [1, 2, 0],
-            [2, 0, 1],
-            [2, 1, 0],
-        ];
         for k in 0..dims[2] {
             for j in 0..dims[1] {
                 for i in 0..dims[0] {
                     let b = IVec3::new(i, j, k) * step;
-                    for p in PERMS {
+                    for p in crate::mesh::contour::PERMS.map(|p| p.map(usize::from)) {
                         let mut x1 = b;
                         x1[p[0]] += step;
                         let mut x2 = x1;

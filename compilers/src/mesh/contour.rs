@@ -89,8 +89,10 @@ pub struct Plane {
 
 /// Edge-point parameter clamp: keeps every triangle off the sample points.
 const T_MIN: f64 = 1e-3;
-/// Axis orders of the six Kuhn tets.
-const PERMS: [[u8; 3]; 6] = [
+/// Axis orders of the six Kuhn tets (tet `π`: corners `0`, `e_π1`,
+/// `e_π1 + e_π2`, `(1,1,1)`); the FEA tet lattice splits its cubes the same
+/// way.
+pub(crate) const PERMS: [[u8; 3]; 6] = [
     [0, 1, 2],
     [0, 2, 1],
     [1, 0, 2],

@@ -51,8 +51,8 @@ pub(crate) struct CandidateGrid {
     inv_cell: f64,
     dims: [usize; 3],
     offsets: Vec<u32>,
-    /// Per cell: +1 or −1 when the whole cell is on that side, 0 when the
-    /// surface may cross it.
+    /// Per cell with a list: +1 or −1 when the whole cell is on that side,
+    /// 0 when the surface may cross it (cells without a list: 0, unused).
     side: Vec<i8>,
     items: Vec<Candidate>,
 }
@@ -114,13 +114,11 @@ impl CandidateGrid {
                 if let Some((dc, rr)) = mesh.coarse.as_ref().and_then(|g| g.lookup(cb))
                     && dc.abs() - rr - 2.0 * r > FAR * cell
                 {
-                    return out.map(|_| (if dc < 0.0 { -1 } else { 1 }, Vec::new()));
+                    return out;
                 }
-                let d_block = mesh.signed_distance(cb);
-                let u_block = d_block.abs();
+                let u_block = mesh.distance(cb);
                 if u_block - 2.0 * r > FAR * cell {
-                    // The whole block is on one side, far from the surface.
-                    return out.map(|_| (if d_block < 0.0 { -1 } else { 1 }, Vec::new()));
+                    return out; // far from the surface too
                 }
                 let Some(block) = mesh.within(cb, slack(u_block + 4.0 * r), MAX_BLOCK) else {
                     return out;

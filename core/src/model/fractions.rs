@@ -188,40 +188,10 @@ impl NAry {
             }
         };
         match &self.index {
-            Some(index) => {
-                for &i in index.always() {
-                    visit(i as usize, &mut best, &mut first);
-                }
-                let mut done = false;
-                if let Candidates::Cell {
-                    entries,
-                    margin,
-                    slack,
-                    ..
-                } = index.candidates(p)
-                {
-                    let slack = if self.lipschitz { slack } else { 0.0 };
-                    for e in entries {
-                        // Sorted by lower bound: once it is above both the
-                        // best so far and 0, no later child is lower or
-                        // contains p.
-                        let lo = f64::from(e.lo) + slack;
-                        if lo >= best && lo > 0.0 {
-                            break;
-                        }
-                        visit(e.child as usize, &mut best, &mut first);
-                    }
-                    done = best < margin;
-                }
-                if !done {
-                    // Exact minimum through the BVH; a containing child is
-                    // always among the visited ones (its box holds p).
-                    index.bvh().nearest(p, best, |i| {
-                        visit(i as usize, &mut best, &mut first);
-                        best
-                    });
-                }
-            }
+            Some(index) => self.walk_indexed(index, p, true, |i| {
+                visit(i, &mut best, &mut first);
+                best
+            }),
             None => {
                 for i in 0..self.children.len() {
                     visit(i, &mut best, &mut first);
@@ -243,13 +213,13 @@ impl NAry {
             && let Candidates::Cell {
                 entries,
                 always,
-                slack,
+                centre,
                 ..
             } = index.candidates(p)
         {
             // Only children whose lower bound is ≤ 0 can contain p; they
             // come first. Visit them in child order.
-            let slack = if self.lipschitz { slack } else { 0.0 };
+            let slack = self.slack(index, p, centre);
             let n = entries.partition_point(|e| f64::from(e.lo) + slack <= 0.0);
             let mut inside: [u32; 64] = [0; 64];
             if n <= inside.len() {

@@ -59,11 +59,8 @@ pub enum Candidates<'a> {
         always: &'a [u32],
         /// Every unlisted finite child's value exceeds this.
         margin: f64,
-        /// `r − |p − c|` (rounded down) for the cell's centre `c` and half
-        /// diagonal `r`. When the bounds were built as `d(c) − r` of
-        /// 1-Lipschitz children (see [`UnionIndex::build`]), a child's value
-        /// at `p` is at least `lo + slack`: a tighter stop for the query.
-        slack: f64,
+        /// The cell's centre, for [`UnionIndex::slack`].
+        centre: DVec3,
     },
     /// The point is outside the grid.
     Outside,
@@ -76,7 +73,7 @@ impl UnionIndex {
     /// the margin, so an unlisted child's value exceeds the margin anywhere in
     /// the cell (this needs only sound intervals, no Lipschitz assumption).
     /// Callers that pass `d(centre) − half diagonal` of 1-Lipschitz children
-    /// may also use the query's `slack`.
+    /// may also use [`UnionIndex::slack`].
     pub fn build(boxes: &[Aabb], lower_bound: impl Fn(usize, &Aabb) -> f64 + Sync) -> Self {
         let mut always = Vec::new();
         let mut finite: Vec<u32> = Vec::new();
@@ -227,15 +224,23 @@ impl UnionIndex {
         let z = (g.z as usize).min(self.dims[2] - 1);
         let c = x + self.dims[0] * (y + self.dims[1] * z);
         let (a, b) = (self.offsets[c] as usize, self.offsets[c + 1] as usize);
-        let centre =
-            self.grid_box.min + (DVec3::new(x as f64, y as f64, z as f64) + 0.5) * self.cell_size;
-        let r = 0.5 * self.cell_size.length();
         Candidates::Cell {
             entries: &self.entries[a..b],
             always: &self.always,
             margin: self.margin,
-            slack: (r - p.distance(centre)).max(0.0) - 1e-12 * r,
+            centre: self.grid_box.min
+                + (DVec3::new(x as f64, y as f64, z as f64) + 0.5) * self.cell_size,
         }
+    }
+
+    /// `r − |p − c|` (rounded down) for the cell centre `c` of `p` and the
+    /// cells' half diagonal `r`. When the bounds were built as `d(c) − r`
+    /// of 1-Lipschitz children, a child's value at `p` is at least
+    /// `lo + slack` (`d(p) ≥ d(c) − |p − c|`): a tighter stop for a query.
+    #[inline]
+    pub fn slack(&self, p: DVec3, centre: DVec3) -> f64 {
+        let r = 0.5 * self.cell_size.length();
+        (r - p.distance(centre)).max(0.0) - 1e-12 * r
     }
 
     /// Children with infinite boxes.

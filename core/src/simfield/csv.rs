@@ -186,16 +186,7 @@ fn sanitize(raw: &str, k: usize) -> String {
     if raw.is_empty() {
         return format!("column{}", k + 1);
     }
-    let mut s: String = raw
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '_' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect();
+    let mut s = crate::names::underscore_other(raw, |c| c.is_ascii_alphanumeric() || c == '_');
     if s.starts_with(|c: char| c.is_ascii_digit()) {
         s.insert(0, '_');
     }
