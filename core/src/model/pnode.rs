@@ -354,34 +354,15 @@ impl NAry {
         d
     }
 
-    /// Sharp minimum through the spatial index (see `union_index`).
+    /// Sharp minimum through the spatial index (see `union_index`): the
+    /// children with infinite boxes, then `p`'s cell list in order of lower
+    /// bound until a bound reaches the best value so far, then the BVH when
+    /// the cell cannot prove the minimum (best ≥ margin, or `p` outside the
+    /// grid). `union_eval` walks the same way.
     fn indexed_min(&self, index: &UnionIndex, p: DVec3) -> f64 {
         let mut best = f64::INFINITY;
-        self.walk_indexed(index, p, false, |i| {
-            best = best.min(self.child_dist(i, p));
-            best
-        });
-        best
-    }
-
-    /// The walk both indexed union queries share: the children with
-    /// infinite boxes, then `p`'s cell list in order of lower bound until a
-    /// bound rules out the rest (at or above the best value so far, and
-    /// with `containing` also above 0, so every child that can contain `p`
-    /// is visited), then the BVH when the cell cannot prove the minimum
-    /// (best ≥ margin, or `p` outside the grid). `visit(i)` evaluates child
-    /// `i` and returns the best value so far.
-    #[inline(always)]
-    pub(super) fn walk_indexed(
-        &self,
-        index: &UnionIndex,
-        p: DVec3,
-        containing: bool,
-        mut visit: impl FnMut(usize) -> f64,
-    ) {
-        let mut best = f64::INFINITY;
         for &i in index.always() {
-            best = visit(i as usize);
+            best = best.min(self.child_dist(i as usize, p));
         }
         if let Candidates::Cell {
             entries,
@@ -392,19 +373,21 @@ impl NAry {
         {
             let slack = self.slack(index, p, centre);
             for e in entries {
-                let lo = f64::from(e.lo) + slack;
-                if lo >= best && (!containing || lo > 0.0) {
-                    break;
+                if f64::from(e.lo) + slack >= best {
+                    break; // the rest are bounded below by lo ≥ best
                 }
-                best = visit(e.child as usize);
+                best = best.min(self.child_dist(e.child as usize, p));
             }
             if best < margin {
-                return;
+                return best;
             }
         }
-        // Exact minimum through the BVH; a containing child is always among
-        // the visited ones (its box holds p).
-        index.bvh().nearest(p, best, |i| visit(i as usize));
+        index.bvh().nearest(p, best, |i| {
+            let d = self.child_dist(i as usize, p);
+            best = best.min(d);
+            best
+        });
+        best
     }
 
     /// The per-point tightening of the cell bounds, for 1-Lipschitz
