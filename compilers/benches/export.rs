@@ -5,6 +5,7 @@
 //! PNG stack it also times the stages on their own (sampling; sampling and
 //! choosing materials) to show what limits the whole: evaluation, PNG
 //! encoding or the disk. Output goes to a temporary folder that is removed.
+//! `--mesh` or `--png` runs only that export.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -134,6 +135,13 @@ fn bytes_of(dir: &Path) -> u64 {
 
 fn main() {
     let filter = std::env::args().skip(1).find(|a| !a.starts_with('-'));
+    // `--mesh` / `--png`: only that export.
+    let only = |what: &str| {
+        let flags: Vec<String> = std::env::args()
+            .filter(|a| a == "--mesh" || a == "--png")
+            .collect();
+        flags.is_empty() || flags.iter().any(|f| f[2..] == *what)
+    };
     let tmp = tempfile::tempdir().expect("temp dir");
     println!("threads: {}", rayon::current_num_threads());
     let cases = [
@@ -178,6 +186,9 @@ fn main() {
             continue;
         }
         for dither in [Dither::Random, Dither::Diffusion] {
+            if !only("png") {
+                break;
+            }
             let (voxels, sample, choose) = stage_times(&c.model, c.png_voxel, dither);
             let p = PngParams {
                 voxel: DVec3::splat(c.png_voxel),
@@ -209,6 +220,9 @@ fn main() {
                 s.files.len(),
                 size as f64 / 1e6
             );
+        }
+        if !only("mesh") {
+            continue;
         }
         let p = MeshParams {
             voxel: DVec3::splat(c.mesh_voxel),

@@ -44,6 +44,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use volcad_core::sampler::Grid;
 
+use super::flat::{FlatKey, Regions, flat_key};
 use super::indexed::IndexedMesh;
 
 /// How an edge between two inside samples of different labels is cut.
@@ -88,7 +89,7 @@ pub struct Plane {
 }
 
 /// Edge-point parameter clamp: keeps every triangle off the sample points.
-const T_MIN: f64 = 1e-3;
+pub(super) const T_MIN: f64 = 1e-3;
 /// Axis orders of the six Kuhn tets (tet `π`: corners `0`, `e_π1`,
 /// `e_π1 + e_π2`, `(1,1,1)`); the FEA tet lattice splits its cubes the same
 /// way.
@@ -134,7 +135,7 @@ type KeyMap = HashMap<u64, u32, BuildHasherDefault<KeyHasher>>;
 /// A point of the contour inside one cube, by the cube corners (bit masks
 /// x = 1, y = 2, z = 4) it is built from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Pt {
+pub(super) enum Pt {
     /// On the edge between two corners (lower mask first).
     Edge(u8, u8),
     /// Centroid of a three-label face (corners by inclusion).
@@ -145,16 +146,16 @@ enum Pt {
 
 /// A vertex: its key (shared across cubes) and position.
 #[derive(Clone, Copy, Debug)]
-struct VRef {
-    key: u64,
-    pos: [f32; 3],
+pub(super) struct VRef {
+    pub key: u64,
+    pub pos: [f32; 3],
 }
 
 /// A triangle for one label, before vertex sharing.
 #[derive(Clone, Copy, Debug)]
-struct Tri {
-    label: u16,
-    v: [VRef; 3],
+pub(super) struct Tri {
+    pub label: u16,
+    pub v: [VRef; 3],
 }
 
 /// One row's triangles over its own vertex list, deduplicated per label
@@ -203,12 +204,18 @@ fn edge(a: u8, b: u8) -> Pt {
 }
 
 /// The 8 samples of one cube.
-struct Cube<'a> {
-    base: [usize; 3],
-    label: [u16; 8],
-    dist: [f32; 8],
-    value: [&'a [f32]; 8],
+pub(super) struct Cube<'a> {
+    pub base: [usize; 3],
+    pub label: [u16; 8],
+    pub dist: [f32; 8],
+    pub value: [&'a [f32]; 8],
 }
+
+/// A flat cube of one row: its x index, region key and unit normal.
+type RowFlat = (usize, FlatKey, DVec3);
+
+/// No flat cube here (layer tables of region ids).
+const NOT_FLAT: u32 = u32::MAX;
 
 /// Builds label meshes plane by plane.
 pub struct Contourer {
@@ -219,6 +226,14 @@ pub struct Contourer {
     /// upper plane of the current cube layer.
     maps: Vec<[KeyMap; 2]>,
     prev: Option<(usize, Plane)>,
+    /// Merge flat regions (see [`super::flat`]); off: plain marching
+    /// tetrahedra.
+    merge: bool,
+    regions: Regions,
+    /// Region id per cube of the previous layer, or [`NOT_FLAT`], and the
+    /// cubes that have one.
+    prev_flat: Vec<u32>,
+    prev_list: Vec<(usize, u8)>,
 }
 
 impl Contourer {
@@ -232,7 +247,24 @@ impl Contourer {
                 .map(|_| [KeyMap::default(), KeyMap::default()])
                 .collect(),
             prev: None,
+            merge: true,
+            regions: Regions::new(iface.stride()),
+            prev_flat: Vec::new(),
+            prev_list: Vec::new(),
         }
+    }
+
+    /// Turn flat-region merging on (the default) or off.
+    pub fn with_flat_merge(mut self, merge: bool) -> Self {
+        self.merge = merge;
+        self
+    }
+
+    /// Merge flat regions but contour each with its fallback (tests).
+    #[cfg(test)]
+    pub(super) fn with_fallback_only(mut self) -> Self {
+        self.regions.triangulate = false;
+        self
     }
 
     /// Add plane `z` (planes come in order from 0); contours the cube layer
@@ -262,28 +294,28 @@ impl Contourer {
         // then one sequential pass gives each new vertex its index in its
         // label's mesh (one map lookup per row vertex instead of one per
         // triangle corner: the sequential part was a third of contouring).
-        let rows: Vec<RowMesh> = (0..ny.saturating_sub(1))
+        let rows: Vec<(RowMesh, Vec<RowFlat>)> = (0..ny.saturating_sub(1))
             .into_par_iter()
-            .map(|j| RowMesh::new(self.row(pz, j, &lo, &plane)))
+            .map(|j| {
+                let (tris, flats) = self.row(pz, j, &lo, &plane);
+                (RowMesh::new(tris), flats)
+            })
             .collect();
-        let plane_len = layer as u64;
         let mut global = Vec::new();
-        for row in &rows {
+        for (row, _) in &rows {
             global.clear();
             for &(label, key, pos) in &row.verts {
-                let l = label as usize - 1;
-                let (mesh, maps) = (&mut self.meshes[l], &mut self.maps[l]);
-                let slot = ((key / KEY_TYPES) / plane_len - pz as u64) as usize;
-                global.push(*maps[slot].entry(key).or_insert_with(|| {
-                    mesh.vertices.push(pos);
-                    (mesh.vertices.len() - 1) as u32
-                }));
+                global.push(self.index_of(pz, label, VRef { key, pos }));
             }
             for &(label, t) in &row.tris {
                 self.meshes[label as usize - 1]
                     .triangles
                     .push(t.map(|i| global[i as usize]));
             }
+        }
+        if self.merge {
+            let flats: Vec<Vec<RowFlat>> = rows.into_iter().map(|r| r.1).collect();
+            self.flat_layer(pz, &lo, &plane, &flats);
         }
         for m in &mut self.maps {
             m.swap(0, 1);
@@ -292,43 +324,175 @@ impl Contourer {
         self.prev = Some((z, plane));
     }
 
-    /// The meshes, label 1 first.
-    pub fn finish(self) -> Vec<IndexedMesh> {
-        self.meshes
+    /// Index in `label`'s mesh of vertex `v` (added when new), for the
+    /// cube layer above plane `pz`.
+    fn index_of(&mut self, pz: usize, label: u16, v: VRef) -> u32 {
+        let l = label as usize - 1;
+        let plane_len = (self.grid.dims[0] * self.grid.dims[1]) as u64;
+        let (mesh, maps) = (&mut self.meshes[l], &mut self.maps[l]);
+        let slot = ((v.key / KEY_TYPES) / plane_len - pz as u64) as usize;
+        *maps[slot].entry(v.key).or_insert_with(|| {
+            mesh.vertices.push(v.pos);
+            (mesh.vertices.len() - 1) as u32
+        })
     }
 
-    /// Triangles of the cubes in row `j` between planes `z` and `z + 1`.
-    fn row(&self, z: usize, j: usize, lo: &Plane, hi: &Plane) -> Vec<Tri> {
+    /// The meshes, label 1 first (flat regions triangulated now).
+    pub fn finish(mut self) -> Vec<IndexedMesh> {
+        let regions = std::mem::replace(&mut self.regions, Regions::new(0));
+        let mut meshes = std::mem::take(&mut self.meshes);
+        regions.finish(&mut meshes, &|cube, out| {
+            let mut scratch = Scratch::default();
+            for perm in 0..6 {
+                self.tet(cube, perm, &mut scratch, out);
+            }
+        });
+        meshes
+    }
+
+    /// The cube with lowest corner `(i, j, z)`, from planes `z` and `z + 1`.
+    fn cube<'a>(&self, [i, j, z]: [usize; 3], lo: &'a Plane, hi: &'a Plane) -> Cube<'a> {
         let nx = self.grid.dims[0];
         let s = self.iface.stride();
+        let idx: [usize; 8] = std::array::from_fn(|c| (j + (c >> 1 & 1)) * nx + i + (c & 1));
+        let plane = |c: usize| if c & 4 == 0 { lo } else { hi };
+        Cube {
+            base: [i, j, z],
+            label: std::array::from_fn(|c| plane(c).label[idx[c]]),
+            dist: std::array::from_fn(|c| plane(c).dist[idx[c]]),
+            value: std::array::from_fn(|c| &plane(c).value[idx[c] * s..(idx[c] + 1) * s]),
+        }
+    }
+
+    /// Triangles of the cubes in row `j` between planes `z` and `z + 1`,
+    /// and the row's flat cubes (left for [`Self::flat_layer`]).
+    fn row(&self, z: usize, j: usize, lo: &Plane, hi: &Plane) -> (Vec<Tri>, Vec<RowFlat>) {
+        let nx = self.grid.dims[0];
         let mut out = Vec::new();
+        let mut flats = Vec::new();
         let mut scratch = Scratch::default();
         for i in 0..nx.saturating_sub(1) {
-            let mut label = [0u16; 8];
-            let mut idx = [0usize; 8];
-            for (c, (l, ix)) in label.iter_mut().zip(&mut idx).enumerate() {
-                *ix = (j + (c >> 1 & 1)) * nx + i + (c & 1);
-                *l = if c & 4 == 0 {
-                    lo.label[*ix]
-                } else {
-                    hi.label[*ix]
-                };
-            }
-            if label.iter().all(|l| *l == label[0]) {
+            let first = lo.label[j * nx + i];
+            let same = |p: &Plane, r: usize| {
+                p.label[r * nx + i] == first && p.label[r * nx + i + 1] == first
+            };
+            if same(lo, j) && same(lo, j + 1) && same(hi, j) && same(hi, j + 1) {
                 continue;
             }
-            let plane = |c: usize| if c & 4 == 0 { lo } else { hi };
-            let cube = Cube {
-                base: [i, j, z],
-                label,
-                dist: std::array::from_fn(|c| plane(c).dist[idx[c]]),
-                value: std::array::from_fn(|c| &plane(c).value[idx[c] * s..(idx[c] + 1) * s]),
-            };
+            let cube = self.cube([i, j, z], lo, hi);
+            if self.merge
+                && let Some((key, n)) = flat_key(self.grid.voxel, self.iface, &cube)
+            {
+                flats.push((i, key, n));
+                continue;
+            }
             for perm in 0..6 {
                 self.tet(&cube, perm, &mut scratch, &mut out);
             }
         }
-        out
+        (out, flats)
+    }
+
+    /// Register one layer's flat cubes: join them with flat neighbours of
+    /// the same key (left, front, below) and give each region the cut
+    /// segments of its faces shared with anything else. Faces towards the
+    /// next layer are settled when that layer comes.
+    fn flat_layer(&mut self, pz: usize, lo: &Plane, hi: &Plane, flats: &[Vec<RowFlat>]) {
+        let [nx, ny, _] = self.grid.dims;
+        let (cw, ch) = (nx - 1, ny - 1);
+        let mut cur = vec![NOT_FLAT; cw * ch];
+        // (cube, corners labelled x as a bit mask)
+        let mut list = Vec::new();
+        for (j, row) in flats.iter().enumerate() {
+            for &(i, key, n) in row {
+                let cube = self.cube([i, j, pz], lo, hi);
+                cur[j * cw + i] = self.regions.add(key, n, &cube);
+                list.push((j * cw + i, corner_mask(&cube, key.x)));
+            }
+        }
+        if self.prev_flat.len() != cur.len() {
+            self.prev_flat = vec![NOT_FLAT; cur.len()];
+        }
+        for &(c, mask) in &list {
+            let (i, j) = (c % cw, c / cw);
+            let id = cur[c];
+            let key = self.regions.key(id);
+            for (axis, side) in [(0, 0), (0, 1), (1, 0), (1, 1), (2, 0)] {
+                if !face_cut(mask, axis, side) {
+                    continue;
+                }
+                let nb = match (axis, side) {
+                    (0, 0) if i > 0 => cur[c - 1],
+                    (0, 1) if i + 1 < cw => cur[c + 1],
+                    (1, 0) if j > 0 => cur[c - cw],
+                    (1, 1) if j + 1 < ch => cur[c + cw],
+                    (2, 0) => self.prev_flat[c],
+                    _ => NOT_FLAT,
+                };
+                if nb != NOT_FLAT && self.regions.key(nb) == key {
+                    if side == 0 {
+                        self.regions.union(id, nb);
+                    }
+                    continue;
+                }
+                let cube = self.cube([i, j, pz], lo, hi);
+                self.outline(pz, id, &cube, axis, side, false);
+            }
+        }
+        // Top faces of the layer below, against this layer's cubes.
+        for (c, mask) in std::mem::take(&mut self.prev_list) {
+            let id = self.prev_flat[c];
+            if !face_cut(mask, 2, 1)
+                || (cur[c] != NOT_FLAT && self.regions.key(cur[c]) == self.regions.key(id))
+            {
+                continue;
+            }
+            let cube = self.cube([c % cw, c / cw, pz], lo, hi);
+            self.outline(pz, id, &cube, 2, 0, true);
+        }
+        self.prev_flat = cur;
+        self.prev_list = list;
+    }
+
+    /// Add the cut of `cube`'s face (`axis`, `side`) to region `id`'s
+    /// outline, oriented as seen from `cube` (or from the cube across the
+    /// face when `reverse`).
+    fn outline(&mut self, pz: usize, id: u32, cube: &Cube, axis: usize, side: u8, reverse: bool) {
+        let key = self.regions.key(id);
+        for perm in 0..6 {
+            let v = tet_corners(perm);
+            let lab = v.map(|m| cube.label[m as usize]);
+            for f in FACES {
+                let corners = f.map(|i| v[i]);
+                if corners.iter().any(|m| m >> axis & 1 != side) {
+                    continue;
+                }
+                let Some((o, p, s, lo, rest)) = odd_one_out(corners, f.map(|i| lab[i])) else {
+                    continue;
+                };
+                let (mut a, mut b) = if lo == key.x {
+                    (edge(p, o), edge(o, s))
+                } else if rest == key.x {
+                    (edge(o, s), edge(p, o))
+                } else {
+                    continue;
+                };
+                if reverse {
+                    std::mem::swap(&mut a, &mut b);
+                }
+                let (ra, rb) = (
+                    self.resolve(cube, perm, &v, a),
+                    self.resolve(cube, perm, &v, b),
+                );
+                let xi = [ra, rb].map(|r| self.index_of(pz, key.x, r));
+                let yi = if key.y == 0 {
+                    [0; 2]
+                } else {
+                    [ra, rb].map(|r| self.index_of(pz, key.y, r))
+                };
+                self.regions.add_edge(id, [ra.key, rb.key], xi, yi);
+            }
+        }
     }
 
     /// Grid index (i, j, k) of corner `m` of the cube.
@@ -427,15 +591,7 @@ impl Contourer {
     /// Contour tet `perm` of `cube` into `out` (`scratch`: buffers reused
     /// from tet to tet, so the hot loop does not allocate).
     fn tet(&self, cube: &Cube, perm: usize, scratch: &mut Scratch, out: &mut Vec<Tri>) {
-        let [a1, a2, _] = PERMS[perm];
-        let m1 = 1u8 << a1;
-        let m2 = m1 | 1 << a2;
-        // Even axis orders give positively oriented tets; swap for odd ones.
-        let v: [u8; 4] = if matches!(perm, 0 | 3 | 4) {
-            [0, m1, m2, 7]
-        } else {
-            [0, m2, m1, 7]
-        };
+        let v = tet_corners(perm);
         let lab = v.map(|m| cube.label[m as usize]);
         if lab.iter().all(|l| *l == lab[0]) {
             return;
@@ -460,19 +616,10 @@ impl Contourer {
         for f in FACES {
             let [u, w, x] = f.map(|i| v[i]);
             let [lu, lw, lx] = f.map(|i| lab[i]);
-            // Odd one out `o` with its predecessor `p` and successor `s`.
-            let odd = if lu == lw && lw == lx {
+            if lu == lw && lw == lx {
                 continue;
-            } else if lu == lw {
-                Some((x, w, u, lx, lu))
-            } else if lw == lx {
-                Some((u, x, w, lu, lw))
-            } else if lx == lu {
-                Some((w, u, x, lw, lx))
-            } else {
-                None
-            };
-            match odd {
+            }
+            match odd_one_out([u, w, x], [lu, lw, lx]) {
                 Some((o, p, s, lo, lrest)) => {
                     segs.push((lo, edge(p, o), edge(o, s)));
                     segs.push((lrest, edge(o, s), edge(p, o)));
@@ -529,6 +676,51 @@ impl Contourer {
     }
 }
 
+/// Corners of Kuhn tet `perm`, positively oriented.
+fn tet_corners(perm: usize) -> [u8; 4] {
+    let [a1, a2, _] = PERMS[perm];
+    let m1 = 1u8 << a1;
+    let m2 = m1 | 1 << a2;
+    // Even axis orders give positively oriented tets; swap for odd ones.
+    if matches!(perm, 0 | 3 | 4) {
+        [0, m1, m2, 7]
+    } else {
+        [0, m2, m1, 7]
+    }
+}
+
+/// On a tet face with corners `[u, w, x]` (counter-clockwise from outside)
+/// and two labels: the odd corner `o`, its predecessor `p` and successor
+/// `s`, the odd label and the other. `None` with one or three labels.
+fn odd_one_out([u, w, x]: [u8; 3], [lu, lw, lx]: [u16; 3]) -> Option<(u8, u8, u8, u16, u16)> {
+    if lu == lw && lw == lx {
+        None
+    } else if lu == lw {
+        Some((x, w, u, lx, lu))
+    } else if lw == lx {
+        Some((u, x, w, lu, lw))
+    } else if lx == lu {
+        Some((w, u, x, lw, lx))
+    } else {
+        None
+    }
+}
+
+/// The corners of `cube` labelled `label`, as bits.
+fn corner_mask(cube: &Cube, label: u16) -> u8 {
+    (0..8).fold(0, |m, c| m | u8::from(cube.label[c] == label) << c)
+}
+
+/// Whether the face (`axis`, `side`) of a two-label cube is cut, from the
+/// mask of one label's corners.
+fn face_cut(mask: u8, axis: usize, side: u8) -> bool {
+    // Corners with bit `axis` clear, per axis; the other side is the rest.
+    const LOW: [u8; 3] = [0b0101_0101, 0b0011_0011, 0b0000_1111];
+    let face = if side == 0 { LOW[axis] } else { !LOW[axis] };
+    let m = mask & face;
+    m != 0 && m != face
+}
+
 /// Join segments `(from, to)` into one closed loop of points in `ring`;
 /// false if they do not form exactly one loop.
 fn chain(segs: &[(Pt, Pt)], ring: &mut Vec<Pt>) -> bool {
@@ -561,51 +753,4 @@ struct Scratch {
     ring: Vec<Pt>,
     /// The loop's vertices.
     refs: Vec<VRef>,
-}
-
-/// Mesh the region `{v ≤ 0}` of a field sampled at the centres of `grid`
-/// (`values` x fastest, then y, then z): marching cubes, each cube split
-/// into six tetrahedra (see the module docs). Samples on the grid's outer
-/// layer count as outside, so the mesh is always closed.
-///
-/// # Panics
-/// If `values` does not have one value per voxel.
-pub fn marching_cubes(grid: &Grid, values: &[f32]) -> IndexedMesh {
-    let [nx, ny, nz] = grid.dims;
-    assert_eq!(values.len(), nx * ny * nz, "one value per voxel");
-    let mut c = Contourer::new(*grid, 1, Interface::Midpoint);
-    for z in 0..nz {
-        let dist = values[z * nx * ny..(z + 1) * nx * ny].to_vec();
-        let label = border_void(&dist, [nx, ny, nz], z, |d| u16::from(d <= 0.0));
-        c.push_plane(
-            z,
-            Plane {
-                label,
-                dist,
-                value: Vec::new(),
-            },
-        );
-    }
-    c.finish().pop().unwrap_or_default()
-}
-
-/// Labels of plane `z` from `f`, with the grid's outer layer void.
-pub fn border_void(
-    dist: &[f32],
-    [nx, ny, nz]: [usize; 3],
-    z: usize,
-    f: impl Fn(f32) -> u16,
-) -> Vec<u16> {
-    let edge_plane = z == 0 || z + 1 == nz;
-    dist.iter()
-        .enumerate()
-        .map(|(v, d)| {
-            let (x, y) = (v % nx, v / nx);
-            if edge_plane || x == 0 || y == 0 || x + 1 == nx || y + 1 == ny {
-                0
-            } else {
-                f(*d)
-            }
-        })
-        .collect()
 }

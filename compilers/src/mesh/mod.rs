@@ -28,6 +28,8 @@
 //! (which leaves gaps and overlaps); fractions are normalised by their sum.
 
 pub mod contour;
+mod field;
+mod flat;
 pub mod indexed;
 pub mod obj;
 pub mod segment;
@@ -45,7 +47,7 @@ use volcad_core::expr::Expr;
 use volcad_core::sampler::{Grid, Sampler, Slab};
 use volcad_core::{MaterialId, Model};
 
-pub use contour::marching_cubes;
+pub use field::marching_cubes;
 pub use indexed::{EdgeReport, IndexedMesh};
 
 use crate::design::{grid_for, palette};
