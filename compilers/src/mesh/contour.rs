@@ -89,7 +89,7 @@ pub struct Plane {
 }
 
 /// Edge-point parameter clamp: keeps every triangle off the sample points.
-pub(super) const T_MIN: f64 = 1e-3;
+const T_MIN: f64 = 1e-3;
 /// Axis orders of the six Kuhn tets (tet `π`: corners `0`, `e_π1`,
 /// `e_π1 + e_π2`, `(1,1,1)`); the FEA tet lattice splits its cubes the same
 /// way.

@@ -11,10 +11,13 @@
 //! `f_y − f_x` for dominant materials; negative on `x`) is affine over the
 //! cube: every edge difference along an axis equals that axis' mean
 //! difference within `FLAT_TOL` of `|Δx| + |Δy| + |Δz|`. Its sign must
-//! agree with the labels at every corner and no corner may lie within
-//! `2·T_MIN` of the cut, so no edge parameter is clamped. Then every
-//! marching-tetrahedra point of the cube lies on the plane `g = 0` and the
-//! cube's triangles tile the polygon `{g = 0} ∩ cube`.
+//! agree with the labels at every corner. Then every marching-tetrahedra
+//! point of the cube lies on the plane `g = 0` and the cube's triangles
+//! tile the polygon `{g = 0} ∩ cube`; where a sample lies on the plane
+//! (`g = 0`), the contourer's clamp `T_MIN` moves the points next to it by
+//! at most `T_MIN` voxels along their edges, the same in the merged and
+//! the unmerged mesh (a face through a whole plane of samples stays
+//! exactly flat, shifted by `T_MIN`).
 //!
 //! # Regions
 //! Flat cubes with the same labels and the same unit normal, quantised to
@@ -45,7 +48,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 
-use super::contour::{Cube, Interface, T_MIN, Tri};
+use super::contour::{Cube, Interface, Tri};
 use super::indexed::IndexedMesh;
 
 /// Largest deviation of an edge difference from its axis mean, relative to
@@ -92,8 +95,17 @@ pub(super) fn flat_key(voxel: DVec3, iface: Interface, cube: &Cube) -> Option<(F
         }
         (_, Interface::Midpoint) => return None,
     };
+    // Which side holds `g = 0` exactly, as the labels put it: inside for
+    // distances (d ≤ 0), the upper range for ranges (⌊f·n⌋), the lower slot
+    // for dominant ties.
+    let zero_is_x = !matches!((y, iface), (1.., Interface::Ranges { .. }));
     for (l, v) in cube.label.iter().zip(&g) {
-        if (*l == x && *v >= 0.0) || (*l == y && *v <= 0.0) || !v.is_finite() {
+        let ok = if *l == x {
+            *v < 0.0 || (*v == 0.0 && zero_is_x)
+        } else {
+            *v > 0.0 || (*v == 0.0 && !zero_is_x)
+        };
+        if !ok || !v.is_finite() {
             return None;
         }
     }
@@ -115,7 +127,7 @@ pub(super) fn flat_key(voxel: DVec3, iface: Interface, cube: &Cube) -> Option<(F
         .zip(&diffs)
         .all(|(m, d)| d.iter().all(|v| (v - m).abs() <= tol));
     // (`scale` is finite: every g is.)
-    if !affine || scale <= 0.0 || g.iter().any(|v| v.abs() < 2.0 * T_MIN * scale) {
+    if !affine || scale <= 0.0 {
         return None;
     }
     let n = DVec3::new(mean[0] / voxel.x, mean[1] / voxel.y, mean[2] / voxel.z).normalize();
@@ -542,6 +554,14 @@ mod tests {
             merged.triangles.len(),
             plain.triangles.len()
         );
+    }
+
+    #[test]
+    fn faces_through_samples_merge_too() {
+        // Faces at x = −2.75 and 3.25 (and y, z alike) pass through sample
+        // centres: g = 0 there, and the clamp keeps the points flat.
+        let [merged, plain, _] = check(|p| (p - DVec3::splat(0.25)).abs().max_element() - 3.0);
+        assert!(merged.triangles.len() * 4 < plain.triangles.len());
     }
 
     #[test]
