@@ -136,12 +136,10 @@ fn bytes_of(dir: &Path) -> u64 {
 fn main() {
     let filter = std::env::args().skip(1).find(|a| !a.starts_with('-'));
     // `--mesh` / `--png`: only that export.
-    let only = |what: &str| {
-        let flags: Vec<String> = std::env::args()
-            .filter(|a| a == "--mesh" || a == "--png")
-            .collect();
-        flags.is_empty() || flags.iter().any(|f| f[2..] == *what)
-    };
+    let flags: Vec<String> = std::env::args()
+        .filter(|a| a == "--mesh" || a == "--png")
+        .collect();
+    let only = |what: &str| flags.is_empty() || flags.iter().any(|f| f[2..] == *what);
     let tmp = tempfile::tempdir().expect("temp dir");
     println!("threads: {}", rayon::current_num_threads());
     let cases = [

@@ -135,7 +135,7 @@ type KeyMap = HashMap<u64, u32, BuildHasherDefault<KeyHasher>>;
 /// A point of the contour inside one cube, by the cube corners (bit masks
 /// x = 1, y = 2, z = 4) it is built from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Pt {
+enum Pt {
     /// On the edge between two corners (lower mask first).
     Edge(u8, u8),
     /// Centroid of a three-label face (corners by inclusion).
@@ -211,8 +211,8 @@ pub(super) struct Cube<'a> {
     pub value: [&'a [f32]; 8],
 }
 
-/// A flat cube of one row: its x index, region key and unit normal.
-type RowFlat = (usize, FlatKey, DVec3);
+/// A flat cube of one row: its x index and region key.
+type RowFlat = (usize, FlatKey);
 
 /// No flat cube here (layer tables of region ids).
 const NOT_FLAT: u32 = u32::MAX;
@@ -381,9 +381,9 @@ impl Contourer {
             }
             let cube = self.cube([i, j, z], lo, hi);
             if self.merge
-                && let Some((key, n)) = flat_key(self.grid.voxel, self.iface, &cube)
+                && let Some(key) = flat_key(self.grid.voxel, self.iface, &cube)
             {
-                flats.push((i, key, n));
+                flats.push((i, key));
                 continue;
             }
             for perm in 0..6 {
@@ -404,9 +404,9 @@ impl Contourer {
         // (cube, corners labelled x as a bit mask)
         let mut list = Vec::new();
         for (j, row) in flats.iter().enumerate() {
-            for &(i, key, n) in row {
+            for &(i, key) in row {
                 let cube = self.cube([i, j, pz], lo, hi);
-                cur[j * cw + i] = self.regions.add(key, n, &cube);
+                cur[j * cw + i] = self.regions.add(key, &cube);
                 list.push((j * cw + i, corner_mask(&cube, key.x)));
             }
         }
@@ -417,6 +417,7 @@ impl Contourer {
             let (i, j) = (c % cw, c / cw);
             let id = cur[c];
             let key = self.regions.key(id);
+            let mut cube = None;
             for (axis, side) in [(0, 0), (0, 1), (1, 0), (1, 1), (2, 0)] {
                 if !face_cut(mask, axis, side) {
                     continue;
@@ -435,8 +436,8 @@ impl Contourer {
                     }
                     continue;
                 }
-                let cube = self.cube([i, j, pz], lo, hi);
-                self.outline(pz, id, &cube, axis, side, false);
+                let cube = cube.get_or_insert_with(|| self.cube([i, j, pz], lo, hi));
+                self.outline(pz, id, cube, axis, side, false);
             }
         }
         // Top faces of the layer below, against this layer's cubes.
@@ -467,14 +468,11 @@ impl Contourer {
                 if corners.iter().any(|m| m >> axis & 1 != side) {
                     continue;
                 }
-                let Some((o, p, s, lo, rest)) = odd_one_out(corners, f.map(|i| lab[i])) else {
+                let Some(odd) = odd_one_out(corners, f.map(|i| lab[i])) else {
                     continue;
                 };
-                let (mut a, mut b) = if lo == key.x {
-                    (edge(p, o), edge(o, s))
-                } else if rest == key.x {
-                    (edge(o, s), edge(p, o))
-                } else {
+                let Some(&(_, mut a, mut b)) = two_label_cut(odd).iter().find(|c| c.0 == key.x)
+                else {
                     continue;
                 };
                 if reverse {
@@ -518,24 +516,10 @@ impl Contourer {
     fn crossing(&self, cube: &Cube, a: u8, b: u8) -> f64 {
         let (a, b) = (a as usize, b as usize);
         let (la, lb) = (cube.label[a], cube.label[b]);
-        let t = if la == 0 || lb == 0 {
-            let (da, db) = (f64::from(cube.dist[a]), f64::from(cube.dist[b]));
-            da / (da - db)
-        } else {
-            let (fa, fb) = (cube.value[a], cube.value[b]);
-            match self.iface {
-                Interface::Midpoint => 0.5,
-                Interface::Ranges { n } => {
-                    let c = f64::from(la + lb - 1) / (2 * n) as f64;
-                    (c - f64::from(fa[0])) / f64::from(fb[0] - fa[0])
-                }
-                Interface::Dominant { .. } => {
-                    let (sa, sb) = (la as usize - 1, lb as usize - 1);
-                    let ga = f64::from(fa[sa]) - f64::from(fa[sb]);
-                    let gb = f64::from(fb[sa]) - f64::from(fb[sb]);
-                    ga / (ga - gb)
-                }
-            }
+        let cut = |c: usize| cut_field(self.iface, la, lb, cube.dist[c], cube.value[c]);
+        let t = match (cut(a), cut(b)) {
+            (Some(ga), Some(gb)) => ga / (ga - gb),
+            _ => 0.5,
         };
         if t.is_finite() {
             t.clamp(T_MIN, 1.0 - T_MIN)
@@ -620,10 +604,7 @@ impl Contourer {
                 continue;
             }
             match odd_one_out([u, w, x], [lu, lw, lx]) {
-                Some((o, p, s, lo, lrest)) => {
-                    segs.push((lo, edge(p, o), edge(o, s)));
-                    segs.push((lrest, edge(o, s), edge(p, o)));
-                }
+                Some(odd) => segs.extend(two_label_cut(odd)),
                 None => {
                     let (a, b) = by_inclusion(u, w);
                     let (b, c) = by_inclusion(b, x);
@@ -640,11 +621,7 @@ impl Contourer {
         if nd == 2 {
             // One interface: chain the first non-void label's segments into
             // a loop and fan it; the other label gets the reverse.
-            let (x, y) = if distinct[0] == 0 || (distinct[1] != 0 && distinct[1] < distinct[0]) {
-                (distinct[1], distinct[0])
-            } else {
-                (distinct[0], distinct[1])
-            };
+            let (x, y) = front_back(distinct[0], distinct[1]);
             mine.clear();
             mine.extend(segs.iter().filter(|s| s.0 == x).map(|s| (s.1, s.2)));
             if chain(mine, ring) {
@@ -709,6 +686,41 @@ fn odd_one_out([u, w, x]: [u8; 3], [lu, lw, lx]: [u16; 3]) -> Option<(u8, u8, u8
 /// The corners of `cube` labelled `label`, as bits.
 fn corner_mask(cube: &Cube, label: u16) -> u8 {
     (0..8).fold(0, |m, c| m | u8::from(cube.label[c] == label) << c)
+}
+
+/// The cut of a two-label tet face (from [`odd_one_out`]) as one oriented
+/// segment per label, `(label, from, to)`, with the label's side on the
+/// left seen from outside the tet.
+fn two_label_cut((o, p, s, lo, rest): (u8, u8, u8, u16, u16)) -> [(u16, Pt, Pt); 2] {
+    [(lo, edge(p, o), edge(o, s)), (rest, edge(o, s), edge(p, o))]
+}
+
+/// The two labels of an interface in contouring order: `x`, whose
+/// triangles face `y`, is the non-void one, or the lower of two segments.
+pub(super) fn front_back(a: u16, b: u16) -> (u16, u16) {
+    if a == 0 || (b != 0 && b < a) {
+        (b, a)
+    } else {
+        (a, b)
+    }
+}
+
+/// The field whose zero cuts edges between labels `la` and `lb`, at a
+/// sample with distance `d` and interface values `f` (the distance next to
+/// void, `f − c` at the range boundary `c`, `f_lb − f_la` for dominant
+/// materials); `None` for [`Interface::Midpoint`] between segments. With
+/// `(la, lb)` from [`front_back`] it is negative on `la`'s side.
+pub(super) fn cut_field(iface: Interface, la: u16, lb: u16, d: f32, f: &[f32]) -> Option<f64> {
+    if la == 0 || lb == 0 {
+        return Some(f64::from(d));
+    }
+    match iface {
+        Interface::Midpoint => None,
+        Interface::Ranges { n } => Some(f64::from(f[0]) - f64::from(la + lb - 1) / (2 * n) as f64),
+        Interface::Dominant { .. } => {
+            Some(f64::from(f[lb as usize - 1]) - f64::from(f[la as usize - 1]))
+        }
+    }
 }
 
 /// Whether the face (`axis`, `side`) of a two-label cube is cut, from the

@@ -48,7 +48,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 
-use super::contour::{Cube, Interface, Tri};
+use super::contour::{Cube, Interface, Tri, cut_field, front_back};
 use super::indexed::IndexedMesh;
 
 /// Largest deviation of an edge difference from its axis mean, relative to
@@ -70,31 +70,18 @@ pub(super) struct FlatKey {
     normal: [i32; 3],
 }
 
-/// The key and unit normal (from `x` towards `y`) of a flat cube, or
-/// `None` (see the module docs).
-pub(super) fn flat_key(voxel: DVec3, iface: Interface, cube: &Cube) -> Option<(FlatKey, DVec3)> {
+/// The key of a flat cube, or `None` (see the module docs).
+pub(super) fn flat_key(voxel: DVec3, iface: Interface, cube: &Cube) -> Option<FlatKey> {
     let l0 = cube.label[0];
     let other = *cube.label.iter().find(|l| **l != l0)?;
     if cube.label.iter().any(|l| *l != l0 && *l != other) {
         return None;
     }
-    let (x, y) = if l0 == 0 || (other != 0 && other < l0) {
-        (other, l0)
-    } else {
-        (l0, other)
-    };
-    let g: [f64; 8] = match (y, iface) {
-        (0, _) => cube.dist.map(f64::from),
-        (_, Interface::Ranges { n }) => {
-            let c = f64::from(x + y - 1) / (2 * n) as f64;
-            std::array::from_fn(|k| f64::from(cube.value[k][0]) - c)
-        }
-        (_, Interface::Dominant { .. }) => {
-            let (sx, sy) = (x as usize - 1, y as usize - 1);
-            std::array::from_fn(|k| f64::from(cube.value[k][sy]) - f64::from(cube.value[k][sx]))
-        }
-        (_, Interface::Midpoint) => return None,
-    };
+    let (x, y) = front_back(l0, other);
+    let mut g = [0.0; 8];
+    for (k, g) in g.iter_mut().enumerate() {
+        *g = cut_field(iface, x, y, cube.dist[k], cube.value[k])?;
+    }
     // Which side holds `g = 0` exactly, as the labels put it: inside for
     // distances (d ≤ 0), the upper range for ranges (⌊f·n⌋), the lower slot
     // for dominant ties.
@@ -132,14 +119,11 @@ pub(super) fn flat_key(voxel: DVec3, iface: Interface, cube: &Cube) -> Option<(F
     }
     let n = DVec3::new(mean[0] / voxel.x, mean[1] / voxel.y, mean[2] / voxel.z).normalize();
     let q = (n * NORMAL_BINS).round();
-    Some((
-        FlatKey {
-            x,
-            y,
-            normal: [q.x as i32, q.y as i32, q.z as i32],
-        },
-        n,
-    ))
+    Some(FlatKey {
+        x,
+        y,
+        normal: [q.x as i32, q.y as i32, q.z as i32],
+    })
 }
 
 /// A flat cube, kept for the fallback.
@@ -161,7 +145,6 @@ struct Edge {
 /// One region at triangulation time.
 struct Region {
     key: FlatKey,
-    normal: DVec3,
     /// Its cubes (ids) and outline edges (indices into `Regions::edges`).
     cubes: Vec<u32>,
     edges: Vec<u32>,
@@ -177,7 +160,6 @@ pub(super) type CubeContour<'a> = dyn Fn(&Cube, &mut Vec<Tri>) + 'a;
 pub(super) struct Regions {
     parent: Vec<u32>,
     keys: Vec<FlatKey>,
-    normals: Vec<DVec3>,
     cubes: Vec<Kept>,
     /// Interface values of the cubes, `8 · stride` each.
     values: Vec<f32>,
@@ -193,7 +175,6 @@ impl Regions {
         Self {
             parent: Vec::new(),
             keys: Vec::new(),
-            normals: Vec::new(),
             cubes: Vec::new(),
             values: Vec::new(),
             edges: Vec::new(),
@@ -203,11 +184,10 @@ impl Regions {
     }
 
     /// A new one-cube region; returns its id.
-    pub fn add(&mut self, key: FlatKey, normal: DVec3, cube: &Cube) -> u32 {
+    pub fn add(&mut self, key: FlatKey, cube: &Cube) -> u32 {
         let id = self.parent.len() as u32;
         self.parent.push(id);
         self.keys.push(key);
-        self.normals.push(normal);
         self.cubes.push(Kept {
             base: cube.base,
             label: cube.label,
@@ -262,7 +242,6 @@ impl Regions {
                 slot[r] = regions.len() as u32;
                 regions.push(Region {
                     key: self.keys[r],
-                    normal: self.normals[r],
                     cubes: Vec::new(),
                     edges: Vec::new(),
                 });
@@ -356,10 +335,11 @@ impl Regions {
 /// The region's triangles as indices in `x`'s mesh, oriented like its
 /// outline, or `None` when a check fails (see the module docs).
 fn triangulate(r: &Region, all: &[Edge], verts: &[[f32; 3]]) -> Option<Vec<[u32; 3]>> {
-    let n = r.normal.abs();
-    let drop = if n.x >= n.y && n.x >= n.z {
+    // Project along the normal's largest component (quantised is enough).
+    let n = r.key.normal.map(i32::abs);
+    let drop = if n[0] >= n[1] && n[0] >= n[2] {
         0
-    } else if n.y >= n.z {
+    } else if n[1] >= n[2] {
         1
     } else {
         2
