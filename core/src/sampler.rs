@@ -21,6 +21,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::bounds::Aabb;
+use crate::interval::Interval;
 use crate::model::{MAX_MATERIALS, Model};
 
 /// A regular voxel grid.
@@ -159,11 +160,44 @@ pub struct SampleStats {
     pub skipped: AtomicU64,
 }
 
+/// Voxels `[x0, x0 + w) × [y0, y0 + h)` of layer `z`.
+#[derive(Clone, Copy)]
+struct Rect {
+    z: usize,
+    x0: usize,
+    y0: usize,
+    w: usize,
+    h: usize,
+}
+
+/// A task's buffers: rows from `row0` of one layer, `k` fractions a voxel.
+struct Rows<'b> {
+    row0: usize,
+    dist: &'b mut [f32],
+    fracs: &'b mut [f32],
+    k: usize,
+}
+
+/// A consumer's test on fraction bounds: true when every fraction vector
+/// within them means the same to it (a mesh export's segment label).
+pub type UniformTest<'a> = &'a (dyn Fn(&[Interval]) -> bool + Sync);
+
+/// What fraction bounds say about a solid tile and its neighbours.
+enum Uniformity {
+    /// The consumer's answer is the same throughout.
+    Same,
+    /// It may change inside: smaller tiles may still be uniform.
+    Mixed,
+    /// No bound (or no test): sample every voxel.
+    Unknown,
+}
+
 /// Samples a model on a grid.
 pub struct Sampler<'a> {
     model: &'a Model,
     grid: Grid,
     with_fracs: bool,
+    uniform: Option<UniformTest<'a>>,
     /// Statistics since creation.
     pub stats: SampleStats,
 }
@@ -183,8 +217,22 @@ impl<'a> Sampler<'a> {
             model,
             grid,
             with_fracs,
+            uniform: None,
             stats: SampleStats::default(),
         }
+    }
+
+    /// For consumers that read only a function of the fractions (`test`
+    /// says where it is constant): a solid tile whose fraction bounds, over
+    /// the tile grown by one voxel on every side, pass `test` gets its
+    /// centre's fractions in every voxel (one evaluation instead of one per
+    /// voxel). Growing the box makes every neighbour of such a voxel agree
+    /// too, so a mesher never interpolates across it: the mesh is the same
+    /// as with every voxel sampled. Not for slice stacks, which dither the
+    /// fractions themselves.
+    pub fn with_uniform(mut self, test: UniformTest<'a>) -> Self {
+        self.uniform = Some(test);
+        self
     }
 
     /// The grid.
@@ -256,29 +304,32 @@ impl<'a> Sampler<'a> {
         k: usize,
     ) {
         let nx = self.grid.dims[0];
+        let mut out = Rows {
+            row0: y0,
+            dist,
+            fracs,
+            k,
+        };
         let mut x0 = 0;
         while x0 < nx {
             let w = TILE.min(nx - x0);
-            self.tile(z, x0, y0, w, rows, y0, dist, fracs, k);
+            let r = Rect {
+                z,
+                x0,
+                y0,
+                w,
+                h: rows,
+            };
+            self.tile(r, &mut out);
             x0 += w;
         }
     }
 
-    /// Refine tile `[x0, x0+w) × [y0, y0+h)` of layer `z`; `row0` is the first
-    /// row of the buffers.
-    #[allow(clippy::too_many_arguments)]
-    fn tile(
-        &self,
-        z: usize,
-        x0: usize,
-        y0: usize,
-        w: usize,
-        h: usize,
-        row0: usize,
-        dist: &mut [f32],
-        fracs: &mut [f32],
-        k: usize,
-    ) {
+    /// Refine tile `r` into `out`.
+    fn tile(&self, r: Rect, out: &mut Rows) {
+        let Rect { z, x0, y0, w, h } = r;
+        let k = out.k;
+        let row0 = out.row0;
         let nx = self.grid.dims[0];
         let b = self.grid.centres_box(x0, x0 + w - 1, y0, y0 + h - 1, z);
         let margin = self.grid.voxel.length();
@@ -292,28 +343,45 @@ impl<'a> Sampler<'a> {
         };
         if let Some((value, inside)) = filled {
             let mut f = [0.0f64; MAX_MATERIALS];
-            let constant = inside && k > 0 && self.model.constant_fractions(&b);
+            let mut constant = inside && k > 0 && self.model.constant_fractions(&b);
+            if inside && k > 0 && !constant {
+                match self.uniformity(&b, k) {
+                    Uniformity::Same => constant = true,
+                    Uniformity::Mixed if w > LEAF || h > LEAF => {
+                        return self.split(r, out);
+                    }
+                    _ => {}
+                }
+            }
             if constant {
                 self.model.eval_into(b.center(), &mut f[..k]);
             }
+            let one: [f32; MAX_MATERIALS] = std::array::from_fn(|i| f[i] as f32);
             for y in y0..y0 + h {
                 let row = (y - row0) * nx;
-                dist[row + x0..row + x0 + w].fill(value);
-                if k > 0 {
-                    for x in x0..x0 + w {
-                        let out = &mut fracs[(row + x) * k..(row + x + 1) * k];
-                        if !inside {
-                            out.fill(0.0);
-                        } else if constant {
-                            for (o, v) in out.iter_mut().zip(&f[..k]) {
-                                *o = *v as f32;
-                            }
-                        } else {
-                            let p = self.grid.center(x, y, z);
-                            self.model.fractions_inside(p, &mut f[..k]);
-                            for (o, v) in out.iter_mut().zip(&f[..k]) {
-                                *o = *v as f32;
-                            }
+                out.dist[row + x0..row + x0 + w].fill(value);
+                if k == 0 {
+                    continue;
+                }
+                // Whole runs at once where every voxel gets the same
+                // fractions (a per-voxel `fill` was a library call each).
+                let run = &mut out.fracs[(row + x0) * k..(row + x0 + w) * k];
+                if !inside {
+                    run.fill(0.0);
+                } else if constant && k == 1 {
+                    run.fill(one[0]);
+                } else if constant {
+                    for voxel in run.chunks_exact_mut(k) {
+                        for (o, v) in voxel.iter_mut().zip(&one) {
+                            *o = *v;
+                        }
+                    }
+                } else {
+                    for (x, voxel) in (x0..).zip(run.chunks_exact_mut(k)) {
+                        let p = self.grid.center(x, y, z);
+                        self.model.fractions_inside(p, &mut f[..k]);
+                        for (o, v) in voxel.iter_mut().zip(&f[..k]) {
+                            *o = *v as f32;
                         }
                     }
                 }
@@ -324,15 +392,7 @@ impl<'a> Sampler<'a> {
             return;
         }
         if w > LEAF || h > LEAF {
-            let (hw, hh) = (w.div_ceil(2), h.div_ceil(2));
-            for (sx, sw) in [(x0, hw), (x0 + hw, w - hw)] {
-                for (sy, sh) in [(y0, hh), (y0 + hh, h - hh)] {
-                    if sw > 0 && sh > 0 {
-                        self.tile(z, sx, sy, sw, sh, row0, dist, fracs, k);
-                    }
-                }
-            }
-            return;
+            return self.split(r, out);
         }
         let mut f = [0.0f64; MAX_MATERIALS];
         for y in y0..y0 + h {
@@ -341,17 +401,47 @@ impl<'a> Sampler<'a> {
                 let p = self.grid.center(x, y, z);
                 let v = row + x;
                 if k > 0 {
-                    dist[v] = self.model.eval_into(p, &mut f[..k]) as f32;
-                    for (o, val) in fracs[v * k..(v + 1) * k].iter_mut().zip(&f[..k]) {
+                    out.dist[v] = self.model.eval_into(p, &mut f[..k]) as f32;
+                    for (o, val) in out.fracs[v * k..(v + 1) * k].iter_mut().zip(&f[..k]) {
                         *o = *val as f32;
                     }
                 } else {
-                    dist[v] = self.model.distance(p) as f32;
+                    out.dist[v] = self.model.distance(p) as f32;
                 }
             }
         }
         self.stats
             .evaluated
             .fetch_add((w * h) as u64, Ordering::Relaxed);
+    }
+    /// Refine a tile as four quarters.
+    fn split(&self, r: Rect, out: &mut Rows) {
+        let (hw, hh) = (r.w.div_ceil(2), r.h.div_ceil(2));
+        for (x0, w) in [(r.x0, hw), (r.x0 + hw, r.w - hw)] {
+            for (y0, h) in [(r.y0, hh), (r.y0 + hh, r.h - hh)] {
+                if w > 0 && h > 0 {
+                    self.tile(Rect { x0, y0, w, h, ..r }, out);
+                }
+            }
+        }
+    }
+
+    /// Whether the consumer's test holds over the solid tile of voxel
+    /// centres `b` grown by one voxel (neighbours in x, y and z included;
+    /// they must be inside too).
+    fn uniformity(&self, b: &Aabb, k: usize) -> Uniformity {
+        let Some(test) = self.uniform else {
+            return Uniformity::Unknown;
+        };
+        let grown = Aabb::new(b.min - self.grid.voxel, b.max + self.grid.voxel);
+        let mut iv = [Interval::point(0.0); MAX_MATERIALS];
+        if !self.model.fraction_bounds(&grown, &mut iv[..k]) {
+            return Uniformity::Unknown;
+        }
+        if self.model.interval(&grown).hi < 0.0 && test(&iv[..k]) {
+            Uniformity::Same
+        } else {
+            Uniformity::Mixed
+        }
     }
 }

@@ -170,6 +170,9 @@ struct Plan {
     infill: Expr,
     slab_layers: usize,
     estimate: MeshEstimate,
+    /// Let the sampler fill label-uniform solid tiles with one evaluation
+    /// (off only in tests, to show it changes nothing).
+    uniform_tiles: bool,
 }
 
 fn plan(model: &Model, p: &MeshParams) -> Result<Plan, ExportError> {
@@ -223,7 +226,9 @@ fn plan(model: &Model, p: &MeshParams) -> Result<Plan, ExportError> {
     let triangles = (area / face * TRIANGLES_PER_FACE) as u64;
     // Meshes: 12 B per triangle, ~½ vertex per triangle at 12 B + map entry.
     let mesh_bytes = triangles * 12 + triangles / 2 * 40;
-    let planes = (2 * layer * (2 + 4 + 4 * stride)) as u64;
+    // Planes: one slab being contoured, the next being labelled, and the
+    // contourer's previous plane.
+    let planes = ((2 * slab_layers + 1) * layer * (2 + 4 + 4 * stride)) as u64;
     let memory_bytes = (slab_layers * per_layer) as u64 + planes + mesh_bytes;
     check_memory(
         memory_bytes,
@@ -247,6 +252,7 @@ fn plan(model: &Model, p: &MeshParams) -> Result<Plan, ExportError> {
         infill,
         slab_layers,
         estimate,
+        uniform_tiles: true,
     })
 }
 
@@ -294,24 +300,49 @@ fn build(
 ) -> Result<Vec<SegmentMesh>, ExportError> {
     let dims = pl.grid.dims;
     let nz = dims[2];
-    let sampler = Sampler::new(model, pl.grid, true);
+    let uniform = |b: &[volcad_core::interval::Interval]| pl.classifier.uniform(b);
+    let mut sampler = Sampler::new(model, pl.grid, true);
+    if pl.uniform_tiles {
+        sampler = sampler.with_uniform(&uniform);
+    }
     let mut contourer =
         Contourer::new(pl.grid, pl.classifier.segments(), pl.classifier.interface());
     let mut tally = Tally::new(pl.classifier.segments());
     let mut slab = Slab::default();
-    let mut z0 = 0;
-    while z0 < nz {
-        let z1 = (z0 + pl.slab_layers).min(nz);
+    // Sample and label one slab of planes.
+    let labelled = |slab: &mut Slab, z0: usize, z1: usize| {
         sampler
-            .sample_layers(z0, z1, &mut slab, cancel)
+            .sample_layers(z0, z1, slab, cancel)
             .map_err(|_| ExportError::Cancelled)?;
-        for z in z0..z1 {
-            let (plane, t) = pl.classifier.plane(&slab, z - z0, dims, z);
-            tally.add(&t);
-            contourer.push_plane(z, plane);
-        }
+        Ok::<_, ExportError>(
+            (z0..z1)
+                .map(|z| pl.classifier.plane(slab, z - z0, dims, z))
+                .collect::<Vec<_>>(),
+        )
+    };
+    let mut z0 = 0;
+    let mut z1 = pl.slab_layers.min(nz);
+    let mut ready = labelled(&mut slab, z0, z1)?;
+    while z0 < nz {
+        let next = (z1 < nz).then(|| (z1, (z1 + pl.slab_layers).min(nz)));
+        let planes = std::mem::take(&mut ready);
+        // Contour this slab while the next one is sampled: contouring has
+        // sequential parts (stitching rows, joining flat regions) that
+        // would otherwise leave a core idle. Planes still enter the
+        // contourer in order, so the output does not change.
+        let (sampled, ()) = rayon::join(
+            || next.map(|(a, b)| labelled(&mut slab, a, b)).transpose(),
+            || {
+                for (z, (plane, t)) in (z0..).zip(planes) {
+                    tally.add(&t);
+                    contourer.push_plane(z, plane);
+                }
+            },
+        );
         progress(z1, nz);
+        ready = sampled?.unwrap_or_default();
         z0 = z1;
+        z1 = next.map_or(nz, |n| n.1);
     }
     let names = segment_names(model, p, &pl.classifier);
     let n = pl.classifier.segments();
@@ -521,5 +552,98 @@ fn summary(
         }),
         notes,
         seconds: 0.0,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use volcad_core::script::{ScriptOptions, model_of};
+
+    use super::*;
+
+    fn model(src: &str) -> Model {
+        let src = format!("let m = default_materials();\n{src}");
+        model_of(&src, "t.rhai", &ScriptOptions::default()).expect("design")
+    }
+
+    /// Meshes and voxel counts with and without label-uniform tiles.
+    fn both(m: &Model, p: &MeshParams) -> [Vec<SegmentMesh>; 2] {
+        let cancel = AtomicBool::new(false);
+        [true, false].map(|uniform_tiles| {
+            let mut pl = plan(m, p).expect("plan");
+            pl.uniform_tiles = uniform_tiles;
+            build(m, p, &pl, &cancel, &|_, _| {}).expect("build")
+        })
+    }
+
+    #[test]
+    fn uniform_tiles_give_the_same_meshes() {
+        let bar = model(
+            r#"FGrade(["x/15+0.5", "-x/15+0.5"], [m.id("red"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(15,10,5), m.id("gray")))"#,
+        );
+        let tilted = model(
+            r#"Rotate(20, 35, 10, Vec3(0,0,0), FGrade(["x/8+0.5", "0.3", "-y/8+0.5"], [m.id("red"), m.id("green"), m.id("blue")], true, Sphere(Vec3(0,0,0), 4, m.id("gray"))))"#,
+        );
+        let red = bar.table().id("red").expect("red");
+        let cases = [
+            (&bar, SegmentBy::Material(red), 4, 0.1),
+            (&bar, SegmentBy::Dominant, 1, 0.1),
+            (&tilted, SegmentBy::Material(red), 5, 0.1),
+            (&tilted, SegmentBy::Dominant, 1, 0.1),
+        ];
+        for (m, by, segments, voxel) in cases {
+            let p = MeshParams {
+                voxel: DVec3::splat(voxel),
+                segments,
+                by,
+                ..MeshParams::default()
+            };
+            let [fast, plain] = both(m, &p);
+            assert_eq!(fast.len(), plain.len());
+            let nonempty = plain.iter().filter(|s| !s.mesh.triangles.is_empty());
+            assert!(nonempty.count() >= segments.min(2), "too few segments");
+            for (a, b) in fast.iter().zip(&plain) {
+                assert_eq!(a.mesh, b.mesh, "{}: meshes differ", a.name);
+                assert_eq!(a.voxels, b.voxels, "{}: voxel counts differ", a.name);
+            }
+        }
+    }
+
+    #[test]
+    fn uniform_tiles_are_used_and_agree_on_labels() {
+        let bar = model(
+            r#"FGrade(["x/15+0.5", "-x/15+0.5"], [m.id("red"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(15,10,5), m.id("gray")))"#,
+        );
+        let p = MeshParams {
+            voxel: DVec3::splat(0.1),
+            segments: 4,
+            by: SegmentBy::Material(bar.table().id("red").expect("red")),
+            ..MeshParams::default()
+        };
+        let pl = plan(&bar, &p).expect("plan");
+        let dims = pl.grid.dims;
+        let test = |b: &[volcad_core::interval::Interval]| pl.classifier.uniform(b);
+        let fast = Sampler::new(&bar, pl.grid, true).with_uniform(&test);
+        let plain = Sampler::new(&bar, pl.grid, true);
+        let cancel = AtomicBool::new(false);
+        let (mut a, mut b) = (Slab::default(), Slab::default());
+        let mut filled = 0;
+        for z in 0..dims[2] {
+            fast.sample_layers(z, z + 1, &mut a, &cancel)
+                .expect("sample");
+            plain
+                .sample_layers(z, z + 1, &mut b, &cancel)
+                .expect("sample");
+            let (la, ta) = pl.classifier.plane(&a, 0, dims, z);
+            let (lb, tb) = pl.classifier.plane(&b, 0, dims, z);
+            assert_eq!(la.label, lb.label, "labels of layer {z}");
+            assert_eq!(ta.voxels, tb.voxels);
+            filled += a.fracs.iter().zip(&b.fracs).filter(|(x, y)| x != y).count();
+        }
+        // Most of the bar's voxels got their tile's centre fractions.
+        assert!(
+            filled > dims[0] * dims[1] * dims[2] / 4,
+            "{filled} voxels filled"
+        );
     }
 }

@@ -14,6 +14,7 @@
 //! Labels are `segment + 1` (0 = void), as [`super::contour`] takes them.
 
 use rayon::prelude::*;
+use volcad_core::interval::Interval;
 use volcad_core::sampler::Slab;
 
 use super::contour::{Interface, Plane};
@@ -45,7 +46,9 @@ pub struct Tally {
     /// Voxels per segment.
     pub voxels: Vec<u64>,
     /// Sum per segment of the classifying fraction (the material's `f`, or
-    /// the dominant fraction), for means.
+    /// the dominant fraction), for means. A solid tile the sampler proved
+    /// uniform counts at its centre's value (the mean over the tile for
+    /// gradings affine across it).
     pub sum_f: Vec<f64>,
 }
 
@@ -75,6 +78,34 @@ impl Classifier {
         match *self {
             Classifier::Ranges { n, .. } => n,
             Classifier::Dominant { k } => k,
+        }
+    }
+
+    /// True when every fraction vector within `bounds` (one interval per
+    /// material) gets the same non-void label, with a margin of 10⁻⁵ for the
+    /// `f32` rounding of sampled fractions: the sampler may then fill a
+    /// solid tile with one evaluation (see `Sampler::with_uniform`).
+    pub fn uniform(&self, bounds: &[Interval]) -> bool {
+        const EPS: f64 = 1e-5;
+        let sum_lo: f64 = bounds.iter().map(|i| i.lo).sum();
+        let sum_hi: f64 = bounds.iter().map(|i| i.hi).sum();
+        if !(sum_lo > f64::from(MIN_TOTAL) + EPS && sum_hi.is_finite()) {
+            return false; // could be void
+        }
+        match *self {
+            Classifier::Ranges { slot: None, .. } => true,
+            Classifier::Ranges { slot: Some(s), n } => {
+                let segment = |x: f64| ((x.clamp(0.0, 1.0) * n as f64).floor() as usize).min(n - 1);
+                let lo = bounds[s].lo / sum_hi - EPS;
+                let hi = bounds[s].hi / sum_lo + EPS;
+                segment(lo) == segment(hi)
+            }
+            Classifier::Dominant { .. } => bounds.iter().enumerate().any(|(a, ba)| {
+                bounds
+                    .iter()
+                    .enumerate()
+                    .all(|(j, bj)| j == a || ba.lo > bj.hi + EPS)
+            }),
         }
     }
 
@@ -144,15 +175,29 @@ impl Classifier {
                 if edge_plane || y == 0 || y + 1 == ny {
                     return t;
                 }
+                // The last inside voxel classified in this row: solid
+                // regions with constant fractions repeat it voxel after
+                // voxel, and comparing k bit patterns is cheaper than
+                // normalising (the result is the same bit for bit).
+                let mut last: Option<(usize, u16, f32)> = None;
                 for x in 1..nx - 1 {
                     let v = y * nx + x;
                     if dist[v] > 0.0 {
                         continue;
                     }
-                    let (lab, f) = self.classify(
-                        &fracs[v * k..(v + 1) * k],
-                        &mut values[x * stride..(x + 1) * stride],
-                    );
+                    let fv = &fracs[v * k..(v + 1) * k];
+                    let (lab, f) = match last {
+                        Some((u, lab, f)) if same_bits(&fracs[(y * nx + u) * k..][..k], fv) => {
+                            if stride == 1 {
+                                values[x] = values[u];
+                            } else {
+                                values.copy_within(u * stride..(u + 1) * stride, x * stride);
+                            }
+                            (lab, f)
+                        }
+                        _ => self.classify(fv, &mut values[x * stride..(x + 1) * stride]),
+                    };
+                    last = Some((x, lab, f));
                     labels[x] = lab;
                     if lab > 0 {
                         t.voxels[lab as usize - 1] += 1;
@@ -168,6 +213,12 @@ impl Classifier {
         }
         (Plane { label, dist, value }, tally)
     }
+}
+
+/// Equal bit patterns (unlike `==`, tells `-0.0` from `0.0`).
+#[inline]
+fn same_bits(a: &[f32], b: &[f32]) -> bool {
+    a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
 }
 
 #[cfg(test)]

@@ -10,12 +10,11 @@ use std::sync::Arc;
 use volcad_compilers::job::{self, JobContext};
 use volcad_compilers::{ExportError, Summary};
 use volcad_core::Model;
-use volcad_core::script::{ScriptOptions, run_script};
+use volcad_core::script::{ScriptOptions, model_of};
 
 /// The prepared model of a Rhai design.
 pub fn model(src: &str) -> Arc<Model> {
-    let d = run_script(src, "t.rhai", &ScriptOptions::default()).expect("script runs");
-    Arc::new(Model::prepare(&d.root, d.materials.clone()).expect("model prepares"))
+    Arc::new(model_of(src, "t.rhai", &ScriptOptions::default()).expect("design prepares"))
 }
 
 /// Run `work` as a job writing to `dest`, and wait.

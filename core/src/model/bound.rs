@@ -42,7 +42,7 @@ fn mesh_interval(mesh: &crate::mesh::TriangleMesh, b: &Aabb) -> Interval {
 
 /// The part of a Tile child's domain that box `b` maps to: the mapped box if
 /// `b` lies in one cell, else the whole cell.
-fn tile_box(b: &Aabb, cell: DVec3) -> Aabb {
+pub(super) fn tile_box(b: &Aabb, cell: DVec3) -> Aabb {
     let lo = (b.min / cell).floor();
     let hi = (b.max / cell).floor();
     if lo == hi {
@@ -268,20 +268,21 @@ impl NAry {
         acc
     }
 
-    /// Constant when exactly one child can be inside in `b` and it is constant.
-    fn union_constant(&self, b: &Aabb) -> bool {
-        let mut inside: Option<usize> = None;
+    /// Up to `N` children that may contain a point of `b` (interval
+    /// `lo ≤ 0`), and how many; `None` when more than `N` may.
+    pub(super) fn maybe_inside<const N: usize>(&self, b: &Aabb) -> Option<([usize; N], usize)> {
+        let mut ids = [0usize; N];
+        let mut n = 0;
         let mut many = false;
         let mut check = |i: usize| {
-            if many {
+            if many || self.children[i].interval(b).lo > 0.0 {
                 return;
             }
-            if self.children[i].interval(b).lo <= 0.0 {
-                if inside.is_some() {
-                    many = true;
-                } else {
-                    inside = Some(i);
-                }
+            if n == N {
+                many = true;
+            } else {
+                ids[n] = i;
+                n += 1;
             }
         };
         match &self.index {
@@ -293,12 +294,16 @@ impl NAry {
             }
             None => (0..self.children.len()).for_each(&mut check),
         }
-        if many || self.smooth > 0.0 && inside.is_some() {
-            return false;
-        }
-        match inside {
-            Some(i) => self.children[i].constant_fractions(b),
-            None => true,
+        (!many).then_some((ids, n))
+    }
+
+    /// Constant when exactly one child can be inside in `b` and it is constant.
+    fn union_constant(&self, b: &Aabb) -> bool {
+        match self.maybe_inside::<1>(b) {
+            None => false,
+            Some((_, 0)) => true,
+            Some(_) if self.smooth > 0.0 => false,
+            Some(([i], _)) => self.children[i].constant_fractions(b),
         }
     }
 }

@@ -8,6 +8,7 @@
 //! are `k = materials().len()` numbers in that order.
 
 mod bound;
+mod frac_bound;
 mod fractions;
 mod pnode;
 mod prepare;
@@ -203,6 +204,15 @@ impl Model {
     /// `b` has a distance inside it. `lo > 0`: empty; `hi < 0`: full.
     pub fn interval(&self, b: &Aabb) -> Interval {
         self.root.interval(b)
+    }
+
+    /// Bounds of the fractions at every inside point of `b` into `out`
+    /// (one per material of [`Self::materials`]); false when the design has
+    /// a node without a cheap bound (`Blend`, `SimulationField`, a smooth
+    /// union, a union with many children overlapping `b`).
+    pub fn fraction_bounds(&self, b: &Aabb, out: &mut [Interval]) -> bool {
+        out.fill(frac_bound::ZERO);
+        self.root.frac_bounds(b, out)
     }
 
     /// True when the fractions are the same at every inside point of `b`

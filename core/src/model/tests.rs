@@ -6,12 +6,11 @@ use glam::DVec3;
 
 use crate::Model;
 use crate::bounds::Aabb;
-use crate::script::{ScriptOptions, run_script};
+use crate::script::{ScriptOptions, model_of, run_script};
 
 fn model(src: &str) -> Model {
     let src = format!("let m = default_materials();\n{src}");
-    let d = run_script(&src, "t.rhai", &ScriptOptions::default()).unwrap_or_else(|e| panic!("{e}"));
-    Model::prepare(&d.root, d.materials.clone()).unwrap_or_else(|e| panic!("{e}"))
+    model_of(&src, "t.rhai", &ScriptOptions::default()).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn d(m: &Model, x: f64, y: f64, z: f64) -> f64 {

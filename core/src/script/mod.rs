@@ -172,6 +172,14 @@ impl RunContext {
     }
 }
 
+/// Run a design script and prepare its model (what tests, benchmarks and
+/// one-shot tools do); the error is the script's or the preparation's
+/// message.
+pub fn model_of(source: &str, name: &str, opts: &ScriptOptions) -> Result<crate::Model, String> {
+    let d = run_script(source, name, opts).map_err(|e| e.to_string())?;
+    crate::Model::prepare(&d.root, d.materials.clone()).map_err(|e| e.to_string())
+}
+
 /// Run a design script.
 pub fn run_script(source: &str, name: &str, opts: &ScriptOptions) -> Result<Design, ScriptError> {
     let ctx = RunContext {

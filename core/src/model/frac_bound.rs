@@ -1,0 +1,228 @@
+//! Bounds of the material fractions over a box: every inside point of the
+//! box has fractions within them.
+//!
+//! Why: a consumer that needs only a function of the fractions (a mesh
+//! export's segment label: which range of one material's fraction, or
+//! which material dominates) can skip evaluating every voxel of a region
+//! where the bounds prove that function constant. The rules mirror
+//! [`PNode::frac`]; nodes without a cheap bound (a `Blend`, an FEA field, a
+//! smooth union) answer "unknown" and the caller samples as before.
+//!
+//! FGrade (clamped, normalised expressions `vᵢ = max(eᵢ, 0)`,
+//! `fᵢ = vᵢ / Σⱼ vⱼ`): with `vᵢ ∈ [aᵢ, bᵢ]`, `fᵢ` is increasing in `vᵢ` and
+//! decreasing in every other `vⱼ`, so
+//! `aᵢ / (aᵢ + Σ_{j≠i} bⱼ) ≤ fᵢ ≤ bᵢ / (bᵢ + Σ_{j≠i} aⱼ)` (0 when the
+//! numerator is 0: an all-zero sum gives zero fractions).
+
+use super::MAX_MATERIALS;
+use super::bound::{coord_intervals, tile_box};
+use super::pnode::{D_SLOT, Grade, NAry, PNode};
+use crate::bounds::Aabb;
+use crate::interval::Interval;
+
+/// Most children of a union that may overlap a box before the bound gives up.
+const MAX_OVERLAPPING: usize = 8;
+
+/// `[0, 0]`.
+pub(crate) const ZERO: Interval = Interval { lo: 0.0, hi: 0.0 };
+
+impl PNode {
+    /// Bounds of the fractions at the inside points of `b` into `out`
+    /// (`[0, 0]` on entry); false when this node cannot bound them.
+    pub fn frac_bounds(&self, b: &Aabb, out: &mut [Interval]) -> bool {
+        if let Some(m) = self.leaf_material() {
+            out[m as usize] = Interval::point(1.0);
+            return true;
+        }
+        match self {
+            PNode::Translate { t, child } => {
+                child.frac_bounds(&Aabb::new(b.min - *t, b.max - *t), out)
+            }
+            PNode::Rotate {
+                to_local,
+                around,
+                child,
+            } => child.frac_bounds(&b.transformed(to_local, *around), out),
+            PNode::Scale { inv, child, .. } => child.frac_bounds(&b.scaled(*inv), out),
+            PNode::Union(u) if !u.blend && u.smooth <= 0.0 => u.union_bounds(b, out),
+            PNode::Intersection(n) if !n.blend => n.children[0].frac_bounds(b, out),
+            PNode::Difference { a, .. } => a.frac_bounds(b, out),
+            PNode::Offset { child, .. } | PNode::Shell { child, .. } => child.frac_bounds(b, out),
+            PNode::Tile { cell, child } => child.frac_bounds(&tile_box(b, *cell), out),
+            PNode::FGrade(g) => g.bounds(b, out),
+            _ => false,
+        }
+    }
+}
+
+impl NAry {
+    /// A sharp union gives a point the fractions of the first child that
+    /// contains it: the hull over the children that may contain a point of
+    /// `b`.
+    fn union_bounds(&self, b: &Aabb, out: &mut [Interval]) -> bool {
+        let k = out.len();
+        let Some((ids, n)) = self.maybe_inside::<MAX_OVERLAPPING>(b) else {
+            return false;
+        };
+        let mut tmp = [ZERO; MAX_MATERIALS];
+        for (j, &i) in ids[..n].iter().enumerate() {
+            tmp[..k].fill(ZERO);
+            if !self.children[i].frac_bounds(b, &mut tmp[..k]) {
+                return false;
+            }
+            for (o, t) in out.iter_mut().zip(&tmp[..k]) {
+                *o = if j == 0 { *t } else { o.union(*t) };
+            }
+        }
+        true
+    }
+}
+
+impl Grade {
+    fn bounds(&self, b: &Aabb, out: &mut [Interval]) -> bool {
+        let d = self.child.interval(b);
+        if d.lo > 0.0 {
+            return true; // no inside point
+        }
+        let d = if self.used & (1 << D_SLOT) != 0 {
+            d
+        } else {
+            Interval::EVERYTHING
+        };
+        let slots = coord_intervals(b, d);
+        let mut v = [ZERO; MAX_MATERIALS];
+        let n = self.exprs.len();
+        for (vi, e) in v.iter_mut().zip(&self.exprs) {
+            let i = e.eval_interval(&slots);
+            if !(i.lo.is_finite() && i.hi.is_finite()) {
+                return false;
+            }
+            *vi = Interval::new(i.lo.max(0.0), i.hi.max(0.0));
+        }
+        let (sum_lo, sum_hi) = v[..n]
+            .iter()
+            .fold((0.0, 0.0), |(l, h), x| (l + x.lo, h + x.hi));
+        for (vi, &m) in v[..n].iter().zip(&self.mats) {
+            let (others_lo, others_hi) = (sum_lo - vi.lo, sum_hi - vi.hi);
+            let lo = if vi.lo > 0.0 {
+                vi.lo / (vi.lo + others_hi.max(0.0))
+            } else {
+                0.0
+            };
+            let hi = if vi.hi > 0.0 {
+                vi.hi / (vi.hi + others_lo.max(0.0))
+            } else {
+                0.0
+            };
+            // Rounding: widen by a few ulps' worth, the evaluator rounds too.
+            let slack = 1e-12;
+            let f = Interval::new((lo - slack).max(0.0), (hi + slack).min(1.0));
+            let o = &mut out[m as usize];
+            *o = Interval::new(o.lo + f.lo, o.hi + f.hi);
+        }
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::DVec3;
+
+    use super::*;
+    use crate::Model;
+    use crate::script::{ScriptOptions, model_of};
+
+    fn model(src: &str) -> Model {
+        let src = format!("let m = default_materials();\n{src}");
+        model_of(&src, "t.rhai", &ScriptOptions::default()).expect("design")
+    }
+
+    /// Every inside sample of random boxes has fractions within the
+    /// bounds; returns how many boxes were bounded.
+    fn check(m: &Model, size: f64) -> usize {
+        let k = m.materials().len();
+        let bb = m.bbox();
+        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut bounded = 0;
+        let mut iv = [ZERO; MAX_MATERIALS];
+        let mut f = [0.0; MAX_MATERIALS];
+        for _ in 0..400 {
+            let c = bb.min + (bb.max - bb.min) * DVec3::new(next(), next(), next());
+            let h = DVec3::new(next(), next(), next()) * size;
+            let b = Aabb::new(c - h, c + h);
+            if !m.fraction_bounds(&b, &mut iv[..k]) {
+                continue;
+            }
+            bounded += 1;
+            for _ in 0..50 {
+                let p = b.min + (b.max - b.min) * DVec3::new(next(), next(), next());
+                if m.eval_into(p, &mut f[..k]) > 0.0 {
+                    continue;
+                }
+                for (i, (b, v)) in iv[..k].iter().zip(&f[..k]).enumerate() {
+                    assert!(
+                        b.lo - 1e-9 <= *v && *v <= b.hi + 1e-9,
+                        "fraction {i} = {v} outside [{}, {}] at {p} in {b:?}",
+                        b.lo,
+                        b.hi
+                    );
+                }
+            }
+        }
+        bounded
+    }
+
+    #[test]
+    fn bounds_hold_inside_boxes() {
+        let designs = [
+            // The graded bar, and its grade turned and moved.
+            r#"FGrade(["x/15+0.5", "-x/15+0.5"], [m.id("red"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(15,10,5), m.id("gray")))"#,
+            r#"Translate(1, 2, 0, Rotate(0, 30, 45, Vec3(0,0,0), FGrade(["x*x/50", "1 - y/10", "0.2"], [m.id("red"), m.id("blue"), m.id("green")], true, Sphere(Vec3(0,0,0), 6, m.id("gray")))))"#,
+            // A union: the first containing child wins, one plain child.
+            r#"Union(false, [FGrade(["z/4+0.5", "0.5-z/4"], [m.id("red"), m.id("blue")], true, Sphere(Vec3(0,0,0), 4, m.id("gray"))), RectPrism(Vec3(3,0,0), Vec3(6,6,6), m.id("green"))])"#,
+            // A grade using the distance d.
+            r#"FGrade(["-d", "1"], [m.id("red"), m.id("blue")], true, Sphere(Vec3(0,0,0), 5, m.id("gray")))"#,
+        ];
+        for src in designs {
+            let m = model(src);
+            for size in [0.05, 0.5, 3.0] {
+                assert!(check(&m, size) > 100, "{src}: too few boxes bounded");
+            }
+        }
+    }
+
+    #[test]
+    fn bounds_are_tight_enough_to_decide_small_boxes() {
+        let m = model(
+            r#"FGrade(["x/15+0.5", "-x/15+0.5"], [m.id("red"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(15,10,5), m.id("gray")))"#,
+        );
+        let k = m.materials().len();
+        let mut iv = [ZERO; MAX_MATERIALS];
+        let b = Aabb::new(DVec3::new(1.0, -1.0, -1.0), DVec3::new(1.1, 1.0, 1.0));
+        assert!(m.fraction_bounds(&b, &mut iv[..k]));
+        let red = m
+            .materials()
+            .iter()
+            .position(|&i| i == m.table().id("red").unwrap())
+            .unwrap();
+        let exact = |x: f64| x / 15.0 + 0.5;
+        assert!((iv[red].lo - exact(1.0)).abs() < 1e-9, "{:?}", iv[red]);
+        assert!((iv[red].hi - exact(1.1)).abs() < 1e-9, "{:?}", iv[red]);
+    }
+
+    #[test]
+    fn unknown_where_no_cheap_bound() {
+        let m = model(
+            r#"Blend(0.5, FGrade(["x", "1"], [m.id("red"), m.id("blue")], true, Sphere(Vec3(0,0,0), 3, m.id("gray"))))"#,
+        );
+        let mut iv = [ZERO; MAX_MATERIALS];
+        let b = Aabb::new(DVec3::splat(-0.1), DVec3::splat(0.1));
+        assert!(!m.fraction_bounds(&b, &mut iv[..m.materials().len()]));
+    }
+}
