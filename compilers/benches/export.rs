@@ -26,7 +26,8 @@ Intersection(false, [Tile(GraphLattice(LatticeType::BodyCenteredCubic, Vec3(5,5,
 
 struct Case {
     name: &'static str,
-    model: Arc<Model>,
+    /// Prepared only when the case runs (the bunny takes a while).
+    model: fn() -> Arc<Model>,
     /// PNG stack voxel (mm).
     png_voxel: f64,
     /// Mesh voxel (mm) and segmentation.
@@ -145,7 +146,7 @@ fn main() {
     let cases = [
         Case {
             name: "cube",
-            model: load("hello_cube.rhai"),
+            model: || load("hello_cube.rhai"),
             png_voxel: 0.02,
             mesh_voxel: 0.05,
             by: SegmentBy::Dominant,
@@ -153,7 +154,7 @@ fn main() {
         },
         Case {
             name: "graded_bar",
-            model: load("graded_bar.rhai"),
+            model: || load("graded_bar.rhai"),
             png_voxel: 0.02,
             mesh_voxel: 0.05,
             by: SegmentBy::Material(1),
@@ -161,7 +162,7 @@ fn main() {
         },
         Case {
             name: "bcc_sphere",
-            model: inline(BCC_SPHERE),
+            model: || inline(BCC_SPHERE),
             png_voxel: 0.04,
             mesh_voxel: 0.05,
             by: SegmentBy::Dominant,
@@ -169,7 +170,7 @@ fn main() {
         },
         Case {
             name: "bunny_lattice",
-            model: load("bunny_lattice.rhai"),
+            model: || load("bunny_lattice.rhai"),
             png_voxel: 0.1,
             mesh_voxel: 0.2,
             by: SegmentBy::Dominant,
@@ -183,18 +184,19 @@ fn main() {
         {
             continue;
         }
+        let model = (c.model)();
         for dither in [Dither::Random, Dither::Diffusion] {
             if !only("png") {
                 break;
             }
-            let (voxels, sample, choose) = stage_times(&c.model, c.png_voxel, dither);
+            let (voxels, sample, choose) = stage_times(&model, c.png_voxel, dither);
             let p = PngParams {
                 voxel: DVec3::splat(c.png_voxel),
                 seed: 1,
                 dither,
                 ..PngParams::default()
             };
-            let m = c.model.clone();
+            let m = model.clone();
             let probe = tmp.path().join("size");
             let (secs, s) = run_job(tmp.path(), move |ctx| {
                 let s = export_png_stack(&m, &p, ctx)?;
@@ -229,7 +231,7 @@ fn main() {
             ..MeshParams::default()
         };
         let t = Instant::now();
-        segment_meshes(&c.model, &p, &AtomicBool::new(false), |_, _| {}).expect("meshes");
+        segment_meshes(&model, &p, &AtomicBool::new(false), |_, _| {}).expect("meshes");
         let contour = t.elapsed().as_secs_f64();
         // pyvcad's mesh compiler writes STL only: the like-for-like figure.
         let stl_only = MeshParams {
@@ -240,9 +242,9 @@ fn main() {
             },
             ..p.clone()
         };
-        let m = c.model.clone();
+        let m = model.clone();
         let (stl_secs, _) = run_job(tmp.path(), move |ctx| export_meshes(&m, &stl_only, ctx));
-        let m = c.model.clone();
+        let m = model.clone();
         let (secs, s) = run_job(tmp.path(), move |ctx| export_meshes(&m, &p, ctx));
         let tris: u64 = s
             .notes

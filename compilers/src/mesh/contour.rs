@@ -44,7 +44,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use volcad_core::sampler::Grid;
 
-use super::flat::{FlatKey, Regions, flat_key};
+use super::flat::{FlatKey, KeptCubes, Regions, flat_key};
 use super::indexed::IndexedMesh;
 
 /// How an edge between two inside samples of different labels is cut.
@@ -212,7 +212,18 @@ pub(super) struct Cube<'a> {
 }
 
 /// A flat cube of one row: its x index and region key.
-type RowFlat = (usize, FlatKey);
+/// A band's flat cubes: row, column, key and the corners of the key's `x`
+/// label (bit mask), with their samples kept for the fallback.
+#[derive(Default)]
+struct BandFlats {
+    at: Vec<([usize; 2], FlatKey, u8)>,
+    kept: KeptCubes,
+}
+
+/// Rows of cubes a contouring task takes: fewer, larger tasks cost less
+/// to schedule and allocate for than one per row (most rows of a solid
+/// part hold two surface cubes).
+const BAND: usize = 8;
 
 /// No flat cube here (layer tables of region ids).
 const NOT_FLAT: u32 = u32::MAX;
@@ -294,15 +305,17 @@ impl Contourer {
         // then one sequential pass gives each new vertex its index in its
         // label's mesh (one map lookup per row vertex instead of one per
         // triangle corner: the sequential part was a third of contouring).
-        let rows: Vec<(RowMesh, Vec<RowFlat>)> = (0..ny.saturating_sub(1))
+        let rows = ny.saturating_sub(1);
+        let bands: Vec<(RowMesh, BandFlats)> = (0..rows.div_ceil(BAND))
             .into_par_iter()
-            .map(|j| {
-                let (tris, flats) = self.row(pz, j, &lo, &plane);
+            .map(|b| {
+                let js = b * BAND..((b + 1) * BAND).min(rows);
+                let (tris, flats) = self.band(pz, js, &lo, &plane);
                 (RowMesh::new(tris), flats)
             })
             .collect();
         let mut global = Vec::new();
-        for (row, _) in &rows {
+        for (row, _) in &bands {
             global.clear();
             for &(label, key, pos) in &row.verts {
                 global.push(self.index_of(pz, label, VRef { key, pos }));
@@ -314,8 +327,8 @@ impl Contourer {
             }
         }
         if self.merge {
-            let flats: Vec<Vec<RowFlat>> = rows.into_iter().map(|r| r.1).collect();
-            self.flat_layer(pz, &lo, &plane, &flats);
+            let flats: Vec<BandFlats> = bands.into_iter().map(|r| r.1).collect();
+            self.flat_layer(pz, &lo, &plane, flats);
         }
         for m in &mut self.maps {
             m.swap(0, 1);
@@ -364,29 +377,38 @@ impl Contourer {
         }
     }
 
-    /// Triangles of the cubes in row `j` between planes `z` and `z + 1`,
-    /// and the row's flat cubes (left for [`Self::flat_layer`]).
-    fn row(&self, z: usize, j: usize, lo: &Plane, hi: &Plane) -> (Vec<Tri>, Vec<RowFlat>) {
+    /// Triangles of the cubes in rows `js` between planes `z` and `z + 1`,
+    /// and the band's flat cubes (left for [`Self::flat_layer`]).
+    fn band(
+        &self,
+        z: usize,
+        js: std::ops::Range<usize>,
+        lo: &Plane,
+        hi: &Plane,
+    ) -> (Vec<Tri>, BandFlats) {
         let nx = self.grid.dims[0];
         let mut out = Vec::new();
-        let mut flats = Vec::new();
+        let mut flats = BandFlats::default();
         let mut scratch = Scratch::default();
-        let rows = [
-            &lo.label[j * nx..(j + 1) * nx],
-            &lo.label[(j + 1) * nx..(j + 2) * nx],
-            &hi.label[j * nx..(j + 1) * nx],
-            &hi.label[(j + 1) * nx..(j + 2) * nx],
-        ];
-        for i in mixed_cubes(rows) {
-            let cube = self.cube([i, j, z], lo, hi);
-            if self.merge
-                && let Some(key) = flat_key(self.grid.voxel, self.iface, &cube)
-            {
-                flats.push((i, key));
-                continue;
-            }
-            for perm in 0..6 {
-                self.tet(&cube, perm, &mut scratch, &mut out);
+        for j in js {
+            let rows = [
+                &lo.label[j * nx..(j + 1) * nx],
+                &lo.label[(j + 1) * nx..(j + 2) * nx],
+                &hi.label[j * nx..(j + 1) * nx],
+                &hi.label[(j + 1) * nx..(j + 2) * nx],
+            ];
+            for i in mixed_cubes(rows) {
+                let cube = self.cube([i, j, z], lo, hi);
+                if self.merge
+                    && let Some(key) = flat_key(self.grid.voxel, self.iface, &cube)
+                {
+                    flats.at.push(([j, i], key, corner_mask(&cube, key.x)));
+                    flats.kept.push(&cube);
+                    continue;
+                }
+                for perm in 0..6 {
+                    self.tet(&cube, perm, &mut scratch, &mut out);
+                }
             }
         }
         (out, flats)
@@ -396,17 +418,19 @@ impl Contourer {
     /// the same key (left, front, below) and give each region the cut
     /// segments of its faces shared with anything else. Faces towards the
     /// next layer are settled when that layer comes.
-    fn flat_layer(&mut self, pz: usize, lo: &Plane, hi: &Plane, flats: &[Vec<RowFlat>]) {
+    fn flat_layer(&mut self, pz: usize, lo: &Plane, hi: &Plane, flats: Vec<BandFlats>) {
         let [nx, ny, _] = self.grid.dims;
         let (cw, ch) = (nx - 1, ny - 1);
         let mut cur = vec![NOT_FLAT; cw * ch];
         // (cube, corners labelled x as a bit mask)
         let mut list = Vec::new();
-        for (j, row) in flats.iter().enumerate() {
-            for &(i, key) in row {
-                let cube = self.cube([i, j, pz], lo, hi);
-                cur[j * cw + i] = self.regions.add(key, &cube);
-                list.push((j * cw + i, corner_mask(&cube, key.x)));
+        for band in flats {
+            let first = self
+                .regions
+                .add_band(band.at.iter().map(|a| a.1), band.kept);
+            for (id, &([j, i], _, mask)) in (first..).zip(&band.at) {
+                cur[j * cw + i] = id;
+                list.push((j * cw + i, mask));
             }
         }
         if self.prev_flat.len() != cur.len() {

@@ -127,10 +127,48 @@ pub(super) fn flat_key(voxel: DVec3, iface: Interface, cube: &Cube) -> Option<Fl
 }
 
 /// A flat cube, kept for the fallback.
+#[derive(Clone, Copy)]
 struct Kept {
     base: [usize; 3],
     label: [u16; 8],
     dist: [f32; 8],
+}
+
+/// Flat cubes' samples, kept for the fallback: gathered per band of rows
+/// in parallel and handed to [`Regions`] whole. Regions keep the bands as
+/// they come: one growing array of every flat cube's samples (tens of MB) was
+/// copied by `realloc` each time it grew, in the sequential joining pass.
+#[derive(Default)]
+pub(super) struct KeptCubes {
+    cubes: Vec<Kept>,
+    /// Interface values, `8 · stride` a cube.
+    values: Vec<f32>,
+}
+
+impl KeptCubes {
+    /// Keep `cube`'s samples.
+    pub fn push(&mut self, cube: &Cube) {
+        self.cubes.push(Kept {
+            base: cube.base,
+            label: cube.label,
+            dist: cube.dist,
+        });
+        for v in &cube.value {
+            self.values.extend_from_slice(v);
+        }
+    }
+
+    /// The cube at `i` (from 0 in this band) as a [`Cube`].
+    fn cube(&self, i: usize, stride: usize) -> Cube<'_> {
+        let kept = &self.cubes[i];
+        let vals = &self.values[i * 8 * stride..(i + 1) * 8 * stride];
+        Cube {
+            base: kept.base,
+            label: kept.label,
+            dist: kept.dist,
+            value: std::array::from_fn(|k| &vals[k * stride..(k + 1) * stride]),
+        }
+    }
 }
 
 /// An outline edge: the flat cube that added it, its vertex keys and
@@ -160,9 +198,8 @@ pub(super) type CubeContour<'a> = dyn Fn(&Cube, &mut Vec<Tri>) + 'a;
 pub(super) struct Regions {
     parent: Vec<u32>,
     keys: Vec<FlatKey>,
-    cubes: Vec<Kept>,
-    /// Interface values of the cubes, `8 · stride` each.
-    values: Vec<f32>,
+    /// Kept cubes by band, with the id of each band's first cube.
+    kept: Vec<(u32, KeptCubes)>,
     edges: Vec<Edge>,
     stride: usize,
     /// False: every region takes the fallback (tests compare the paths).
@@ -175,28 +212,37 @@ impl Regions {
         Self {
             parent: Vec::new(),
             keys: Vec::new(),
-            cubes: Vec::new(),
-            values: Vec::new(),
+            kept: Vec::new(),
             edges: Vec::new(),
             stride,
             triangulate: true,
         }
     }
 
-    /// A new one-cube region; returns its id.
-    pub fn add(&mut self, key: FlatKey, cube: &Cube) -> u32 {
-        let id = self.parent.len() as u32;
-        self.parent.push(id);
-        self.keys.push(key);
-        self.cubes.push(Kept {
-            base: cube.base,
-            label: cube.label,
-            dist: cube.dist,
-        });
-        for v in &cube.value {
-            self.values.extend_from_slice(v);
+    /// New one-cube regions, one per key, with the cubes `kept` (in the
+    /// same order); returns the first id (the others follow).
+    pub fn add_band(&mut self, keys: impl Iterator<Item = FlatKey>, kept: KeptCubes) -> u32 {
+        let first = self.parent.len() as u32;
+        for key in keys {
+            self.parent.push(self.parent.len() as u32);
+            self.keys.push(key);
         }
-        id
+        debug_assert_eq!(
+            self.parent.len() - first as usize,
+            kept.cubes.len(),
+            "one kept cube a key"
+        );
+        if !kept.cubes.is_empty() {
+            self.kept.push((first, kept));
+        }
+        first
+    }
+
+    /// The kept samples of cube `id`.
+    fn kept_cube(&self, id: u32) -> Cube<'_> {
+        let band = self.kept.partition_point(|(first, _)| *first <= id) - 1;
+        let (first, kept) = &self.kept[band];
+        kept.cube((id - first) as usize, self.stride)
     }
 
     fn find(&mut self, mut a: u32) -> u32 {
@@ -297,7 +343,6 @@ impl Regions {
         tris: &mut Vec<Tri>,
     ) {
         let (x, y) = (r.key.x, r.key.y);
-        let stride = self.stride;
         let mut map: HashMap<(u16, u64), u32> = HashMap::new();
         for e in r.edges.iter().map(|e| &self.edges[*e as usize]) {
             for k in 0..2 {
@@ -308,14 +353,7 @@ impl Regions {
             }
         }
         for &c in &r.cubes {
-            let (c, kept) = (c as usize, &self.cubes[c as usize]);
-            let vals = &self.values[c * 8 * stride..(c + 1) * 8 * stride];
-            let cube = Cube {
-                base: kept.base,
-                label: kept.label,
-                dist: kept.dist,
-                value: std::array::from_fn(|k| &vals[k * stride..(k + 1) * stride]),
-            };
+            let cube = self.kept_cube(c);
             tris.clear();
             contour(&cube, tris);
             for t in tris.iter() {
