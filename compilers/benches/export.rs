@@ -13,8 +13,9 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use glam::DVec3;
-use volcad_compilers::dither::{Diffuser, choose_random};
+use volcad_compilers::dither::Diffuser;
 use volcad_compilers::job;
+use volcad_compilers::lazy_random::choose_random_row;
 use volcad_compilers::mesh::{MeshFormats, MeshParams, SegmentBy, export_meshes, segment_meshes};
 use volcad_compilers::png_stack::{Dither, PngParams, export_png_stack};
 use volcad_core::Model;
@@ -57,7 +58,11 @@ fn stage_times(model: &Model, voxel: f64, dither: Dither) -> (u64, f64, f64) {
     let [nx, ny, nz] = grid.dims;
     let k = model.materials().len();
     let cancel = AtomicBool::new(false);
-    let sampler = Sampler::new(model, grid, true);
+    // As the export: random picks leave graded fractions to the chooser.
+    let sampler = match dither {
+        Dither::Random => Sampler::new(model, grid, true).with_lazy_fractions(),
+        Dither::Diffusion => Sampler::new(model, grid, true),
+    };
     let mut slab = Slab::default();
     let layers = 16;
     let t = Instant::now();
@@ -90,9 +95,11 @@ fn stage_times(model: &Model, voxel: f64, dither: Dither) -> (u64, f64, f64) {
                     use rayon::prelude::*;
                     codes.par_chunks_mut(nx).enumerate().for_each(|(y, c)| {
                         let v = y * nx;
-                        choose_random(
+                        choose_random_row(
+                            model,
+                            &grid,
                             1,
-                            ((z + l) * layer + v) as u64,
+                            [y, z + l],
                             &d[v..v + nx],
                             &f[v * k..(v + nx) * k],
                             k,

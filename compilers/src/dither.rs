@@ -50,7 +50,7 @@ const W_NEXT_BEHIND: f32 = 0.75 * 3.0 / 16.0;
 const W_NEXT_BELOW: f32 = 0.75 * 5.0 / 16.0;
 const W_NEXT_AHEAD: f32 = 0.75 * 1.0 / 16.0;
 /// Fraction totals at or below this are void.
-const MIN_TOTAL: f32 = 1e-6;
+pub(crate) const MIN_TOTAL: f32 = 1e-6;
 /// SplitMix64's increment (2⁶⁴ / φ).
 const GAMMA: u64 = 0x9E37_79B9_7F4A_7C15;
 
@@ -66,7 +66,7 @@ pub fn splitmix64(seed: u64, index: u64) -> u64 {
 
 /// A uniform number in `[0, 1)` from the top 24 bits of a hash (exact in f32).
 #[inline]
-fn unit_f32(h: u64) -> f32 {
+pub(crate) fn unit_f32(h: u64) -> f32 {
     (h >> 40) as f32 * (1.0 / 16_777_216.0)
 }
 
@@ -82,35 +82,43 @@ pub fn choose_random(
     out: &mut [u8],
 ) {
     for (v, o) in out.iter_mut().enumerate() {
-        *o = 0;
-        if dist[v] > 0.0 {
-            continue;
-        }
-        let f = &fracs[v * k..(v + 1) * k];
-        if k == 1 {
-            *o = u8::from(f[0] > MIN_TOTAL);
-            continue;
-        }
-        let total: f32 = f.iter().sum();
-        if total.is_nan() || total <= MIN_TOTAL {
-            continue;
-        }
-        let u = unit_f32(splitmix64(seed, first_index + v as u64)) * total;
-        // The first i with u < Σ_{j≤i} f_j is the number of running sums
-        // ≤ u (they never decrease); counted without branches, since the
-        // pick is unpredictable in a mix. A zero fraction is never picked.
-        let mut acc = 0.0f32;
-        let mut pick = 0usize;
-        for fi in f {
-            acc += fi;
-            pick += usize::from(acc <= u);
-        }
-        if pick >= k {
-            // Rounding left u at or above the total: the last material then.
-            pick = f.iter().rposition(|fi| *fi > 0.0).unwrap_or(0);
-        }
-        *o = pick as u8 + 1;
+        *o = if dist[v] > 0.0 {
+            0
+        } else {
+            let r = unit_f32(splitmix64(seed, first_index + v as u64));
+            pick_random(&fracs[v * k..(v + 1) * k], r)
+        };
     }
+}
+
+/// The code of an inside voxel with fractions `f` for the uniform number
+/// `r ∈ [0, 1)`: the first `i` with `r·T < Σ_{j≤i} f_j`, 0 when `T` is
+/// (almost) nothing.
+#[inline]
+pub(crate) fn pick_random(f: &[f32], r: f32) -> u8 {
+    let k = f.len();
+    if k == 1 {
+        return u8::from(f[0] > MIN_TOTAL);
+    }
+    let total: f32 = f.iter().sum();
+    if total.is_nan() || total <= MIN_TOTAL {
+        return 0;
+    }
+    let u = r * total;
+    // The first i with u < Σ_{j≤i} f_j is the number of running sums
+    // ≤ u (they never decrease); counted without branches, since the
+    // pick is unpredictable in a mix. A zero fraction is never picked.
+    let mut acc = 0.0f32;
+    let mut pick = 0usize;
+    for fi in f {
+        acc += fi;
+        pick += usize::from(acc <= u);
+    }
+    if pick >= k {
+        // Rounding left u at or above the total: the last material then.
+        pick = f.iter().rposition(|fi| *fi > 0.0).unwrap_or(0);
+    }
+    pick as u8 + 1
 }
 
 /// 3D error diffusion over consecutive layers of an `nx × ny` grid with `k`

@@ -12,6 +12,7 @@
 
 pub mod fea;
 pub mod job;
+pub mod lazy_random;
 
 pub mod design;
 pub mod dither;

@@ -46,6 +46,7 @@ use volcad_core::sampler::{Grid, Sampler, Slab};
 use crate::design::{grid_for, palette};
 use crate::dither::{self, Diffuser};
 use crate::job::{ExportError, JobContext, Summary};
+use crate::lazy_random;
 use crate::png_io::{self, bit_row_bytes};
 pub use crate::presets::{Preset, preset, presets};
 use crate::probe::probe;
@@ -256,8 +257,13 @@ fn write_stack(
         let dir = ctx.staging().join(&f.dir);
         std::fs::create_dir_all(&dir).map_err(|e| ExportError::io(&dir, e))?;
     }
-    let sampler = Sampler::new(model, grid, true);
     let mut diffuser = (p.dither == Dither::Diffusion).then(|| Diffuser::new(nx, ny, k));
+    // Random picks need a voxel's fractions only where bounds leave the
+    // pick open (see lazy_random.rs); diffusion needs every one.
+    let sampler = match diffuser {
+        Some(_) => Sampler::new(model, grid, true),
+        None => Sampler::new(model, grid, true).with_lazy_fractions(),
+    };
     let first = if diffuser.is_some() {
         Diffuser::warmup_start(est.layers.start)
     } else {
@@ -290,10 +296,11 @@ fn write_stack(
             }
             None => codes.par_chunks_mut(nx).enumerate().for_each(|(row, c)| {
                 let v = row * nx;
-                let global = ((z0 * ny) * nx + v) as u64;
-                dither::choose_random(
+                lazy_random::choose_random_row(
+                    model,
+                    &grid,
                     p.seed,
-                    global,
+                    [row % ny, z0 + row / ny],
                     &slab.dist[v..v + nx],
                     &slab.fracs[v * k..(v + nx) * k],
                     k,

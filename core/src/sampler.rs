@@ -137,7 +137,9 @@ pub struct Slab {
     /// Signed distance per voxel, index `(z − z0)·nx·ny + y·nx + x`.
     pub dist: Vec<f32>,
     /// Fractions per voxel, `k` consecutive values in model material order
-    /// (empty when fractions were not asked for). Zero outside.
+    /// (empty when fractions were not asked for). Zero outside. `NaN` in a
+    /// solid tile whose fractions vary, when the sampler was made
+    /// [`Sampler::with_lazy_fractions`]: the consumer evaluates them.
     pub fracs: Vec<f32>,
     /// Fractions per voxel (`Model::materials().len()`).
     pub k: usize,
@@ -198,6 +200,7 @@ pub struct Sampler<'a> {
     grid: Grid,
     with_fracs: bool,
     uniform: Option<UniformTest<'a>>,
+    lazy: bool,
     /// Statistics since creation.
     pub stats: SampleStats,
 }
@@ -208,6 +211,9 @@ pub struct Sampler<'a> {
 pub struct Cancelled;
 
 const TILE: usize = 32;
+/// Widest fraction bounds (summed over materials) of a tile left to a lazy
+/// consumer: beyond it most of its voxels would be evaluated anyway.
+const LAZY_WIDTH: f64 = 0.5;
 const LEAF: usize = 4;
 
 impl<'a> Sampler<'a> {
@@ -218,6 +224,7 @@ impl<'a> Sampler<'a> {
             grid,
             with_fracs,
             uniform: None,
+            lazy: false,
             stats: SampleStats::default(),
         }
     }
@@ -325,6 +332,16 @@ impl<'a> Sampler<'a> {
         }
     }
 
+    /// For consumers that bound the fractions and evaluate them only where
+    /// the bounds do not settle what they need (random dithering): a solid
+    /// tile whose fractions vary, and which `Model::fraction_bounds` can
+    /// bound, gets `NaN` fractions instead of one evaluation per voxel (see
+    /// `Slab::fracs`).
+    pub fn with_lazy_fractions(mut self) -> Self {
+        self.lazy = true;
+        self
+    }
+
     /// Refine tile `r` into `out`.
     fn tile(&self, r: Rect, out: &mut Rows) {
         let Rect { z, x0, y0, w, h } = r;
@@ -356,6 +373,12 @@ impl<'a> Sampler<'a> {
             if constant {
                 self.model.eval_into(b.center(), &mut f[..k]);
             }
+            // Lazy only where the consumer will be able to bound them.
+            let lazy = inside
+                && !constant
+                && self.lazy
+                && self.model.varying_fractions()
+                && self.bounded(&b, k);
             let one: [f32; MAX_MATERIALS] = std::array::from_fn(|i| f[i] as f32);
             for y in y0..y0 + h {
                 let row = (y - row0) * nx;
@@ -368,6 +391,8 @@ impl<'a> Sampler<'a> {
                 let run = &mut out.fracs[(row + x0) * k..(row + x0 + w) * k];
                 if !inside {
                     run.fill(0.0);
+                } else if lazy {
+                    run.fill(f32::NAN);
                 } else if constant && k == 1 {
                     run.fill(one[0]);
                 } else if constant {
@@ -424,6 +449,16 @@ impl<'a> Sampler<'a> {
                 }
             }
         }
+    }
+
+    /// Whether the model bounds the fractions over `b` narrowly enough for
+    /// bounds to settle most random picks (a gentle grading, not a tile
+    /// where several parts with different materials meet): the widths sum
+    /// to at most [`LAZY_WIDTH`].
+    fn bounded(&self, b: &Aabb, k: usize) -> bool {
+        let mut iv = [Interval::point(0.0); MAX_MATERIALS];
+        self.model.fraction_bounds(b, &mut iv[..k])
+            && iv[..k].iter().map(|i| i.hi - i.lo).sum::<f64>() <= LAZY_WIDTH
     }
 
     /// Whether the consumer's test holds over the solid tile of voxel

@@ -55,6 +55,29 @@ impl PNode {
     }
 }
 
+impl PNode {
+    /// True when some part's fractions depend on the point (see
+    /// `Model::varying_fractions`).
+    pub fn varying_fractions(&self) -> bool {
+        if self.leaf_material().is_some() {
+            return false;
+        }
+        if let Some(child) = self.fraction_child() {
+            return child.varying_fractions();
+        }
+        match self {
+            PNode::Union(n) | PNode::Intersection(n) => {
+                n.blend || n.children.iter().any(|c| c.varying_fractions())
+            }
+            PNode::Difference { a, .. } => a.varying_fractions(),
+            PNode::FGrade(g) => {
+                g.exprs.iter().any(|e| e.constant().is_none()) || g.child.varying_fractions()
+            }
+            _ => true, // Blend, FEA fields
+        }
+    }
+}
+
 impl NAry {
     /// A sharp union gives a point the fractions of the first child that
     /// contains it: the hull over the children that may contain a point of
@@ -214,6 +237,18 @@ mod tests {
         let exact = |x: f64| x / 15.0 + 0.5;
         assert!((iv[red].lo - exact(1.0)).abs() < 1e-9, "{:?}", iv[red]);
         assert!((iv[red].hi - exact(1.1)).abs() < 1e-9, "{:?}", iv[red]);
+    }
+
+    #[test]
+    fn varying_fractions_only_where_a_grade_has_a_variable() {
+        let fixed = model(
+            r#"Union(false, [FGrade(["0.3", "0.7"], [m.id("red"), m.id("blue")], true, Sphere(Vec3(0,0,0), 2, m.id("gray"))), Translate(3, 0, 0, RectPrism(Vec3(0,0,0), Vec3(2,2,2), m.id("green")))])"#,
+        );
+        assert!(!fixed.varying_fractions());
+        let graded = model(
+            r#"Union(false, [FGrade(["0.3", "z"], [m.id("red"), m.id("blue")], true, Sphere(Vec3(0,0,0), 2, m.id("gray"))), RectPrism(Vec3(3,0,0), Vec3(2,2,2), m.id("green"))])"#,
+        );
+        assert!(graded.varying_fractions());
     }
 
     #[test]

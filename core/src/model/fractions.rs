@@ -71,6 +71,21 @@ impl PNode {
         }
     }
 
+    /// The child of a node whose fractions are its child's at a moved
+    /// point (a move, rotation, scale, offset, shell or tile).
+    #[inline]
+    pub(super) fn fraction_child(&self) -> Option<&PNode> {
+        match self {
+            PNode::Translate { child, .. }
+            | PNode::Rotate { child, .. }
+            | PNode::Scale { child, .. }
+            | PNode::Offset { child, .. }
+            | PNode::Shell { child, .. }
+            | PNode::Tile { child, .. } => Some(child),
+            _ => None,
+        }
+    }
+
     /// The material of a leaf that assigns one material everywhere.
     #[inline]
     pub(super) fn leaf_material(&self) -> Option<Slot> {
@@ -126,13 +141,10 @@ impl PNode {
         if let Some(m) = self.leaf_material() {
             return Some(FixedFractions::one(m));
         }
+        if let Some(child) = self.fraction_child() {
+            return child.fixed_fractions();
+        }
         match self {
-            PNode::Translate { child, .. }
-            | PNode::Rotate { child, .. }
-            | PNode::Scale { child, .. }
-            | PNode::Offset { child, .. }
-            | PNode::Shell { child, .. }
-            | PNode::Tile { child, .. } => child.fixed_fractions(),
             PNode::Difference { a, .. } => a.fixed_fractions(),
             PNode::Intersection(n) if !n.blend => n.children[0].fixed_fractions(),
             PNode::FGrade(g) if g.exprs.len() <= 4 => {

@@ -54,6 +54,7 @@ pub struct Model {
     table: Arc<MaterialTable>,
     node_count: usize,
     prepare_time: Duration,
+    varying: bool,
 }
 
 /// Points as structure of arrays (mm).
@@ -101,6 +102,7 @@ impl Model {
             });
         }
         Ok(Model {
+            varying: root_p.varying_fractions(),
             root: root_p,
             bbox,
             materials,
@@ -204,6 +206,14 @@ impl Model {
     /// `b` has a distance inside it. `lo > 0`: empty; `hi < 0`: full.
     pub fn interval(&self, b: &Aabb) -> Interval {
         self.root.interval(b)
+    }
+
+    /// False when every part has fractions that do not depend on the point
+    /// (no grading with a variable, no FEA field, no `Blend`): the design's
+    /// fractions are then piecewise constant, and bounding them over a box
+    /// helps no one (the bunny lattice: 3,286 struts of fixed mixes).
+    pub fn varying_fractions(&self) -> bool {
+        self.varying
     }
 
     /// Bounds of the fractions at every inside point of `b` into `out`

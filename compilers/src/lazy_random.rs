@@ -1,0 +1,217 @@
+//! Random dithering that evaluates fractions only where it must.
+//!
+//! A voxel's random pick depends on its fractions only through which
+//! running sum its number `u = r·T` falls under (see [`crate::dither`]). In
+//! a solid region whose fractions vary smoothly (a grading), bounds of the
+//! fractions over a short run of voxels (`Model::fraction_bounds`) leave
+//! each running sum `S_j = Σ_{i≤j} f_i` within a narrow band; every voxel
+//! whose `u` falls outside the bands gets its pick from the bounds alone,
+//! and only the others (a few percent for a gentle grading) are evaluated.
+//! The sampler marks such regions with `NaN` fractions
+//! (`Sampler::with_lazy_fractions`).
+//!
+//! Exactness: the bounds are widened by [`EPS`], which covers rounding the
+//! `f64` fractions to `f32` and the `f32` running sums and product that
+//! [`crate::dither::pick_random`] computes, so a decided pick equals the one
+//! computed from the evaluated fractions, and the slices are byte for byte
+//! those of evaluating every voxel (tested).
+
+use volcad_core::Model;
+use volcad_core::interval::Interval;
+use volcad_core::model::MAX_MATERIALS;
+use volcad_core::sampler::Grid;
+
+use crate::dither::{MIN_TOTAL, pick_random, splitmix64, unit_f32};
+
+/// Widening of every bound: far above `f32` rounding of sums of at most
+/// [`MAX_MATERIALS`] fractions (`64 · 2⁻²⁴ ≈ 4·10⁻⁶`), far below the
+/// fraction steps that matter.
+const EPS: f64 = 1e-5;
+/// Longest run of voxels bounded together (a sampler tile's width).
+const RUN: usize = 32;
+
+/// Bounds of the running sums of one run of voxels.
+struct RunningSums {
+    k: usize,
+    lo: [f64; MAX_MATERIALS],
+    hi: [f64; MAX_MATERIALS],
+}
+
+impl RunningSums {
+    /// From fraction bounds; `None` when the total may be void.
+    fn new(bounds: &[Interval]) -> Option<RunningSums> {
+        let k = bounds.len();
+        let mut s = RunningSums {
+            k,
+            lo: [0.0; MAX_MATERIALS],
+            hi: [0.0; MAX_MATERIALS],
+        };
+        let (mut lo, mut hi) = (0.0, 0.0);
+        for (j, b) in bounds.iter().enumerate() {
+            lo += b.lo;
+            hi += b.hi;
+            s.lo[j] = lo - EPS;
+            s.hi[j] = hi + EPS;
+        }
+        (s.lo[k - 1] > f64::from(MIN_TOTAL) + EPS && hi.is_finite()).then_some(s)
+    }
+
+    /// The pick for uniform number `r`, when the bounds settle it.
+    #[inline]
+    fn pick(&self, r: f32) -> Option<u8> {
+        let k = self.k;
+        if k == 1 {
+            return Some(1); // the total is certainly above MIN_TOTAL
+        }
+        let r = f64::from(r);
+        let (u_lo, u_hi) = (r * self.lo[k - 1] - EPS, r * self.hi[k - 1] + EPS);
+        // Without branches (the pick is unpredictable in a mix): count the
+        // sums certainly below u, note any that may be on either side.
+        let mut pick = 0usize;
+        let mut open = false;
+        for j in 0..k {
+            let below = self.hi[j] < u_lo;
+            let above = self.lo[j] > u_hi;
+            pick += usize::from(below);
+            open |= !(below | above);
+        }
+        (!open && pick < k).then_some(pick as u8 + 1)
+    }
+}
+
+/// Random picks for row `y` of layer `z` (`out` and `dist` one per voxel of
+/// the row, `fracs` `k` per voxel): as [`crate::dither::choose_random`],
+/// with `NaN`-marked fractions bounded per run and evaluated only where
+/// the bounds leave the pick open.
+#[allow(clippy::too_many_arguments)]
+pub fn choose_random_row(
+    model: &Model,
+    grid: &Grid,
+    seed: u64,
+    [y, z]: [usize; 2],
+    dist: &[f32],
+    fracs: &[f32],
+    k: usize,
+    out: &mut [u8],
+) {
+    let [nx, ny, _] = grid.dims;
+    let first = ((z * ny + y) * nx) as u64;
+    let lazy = |x: usize| dist[x] <= 0.0 && fracs[x * k].is_nan();
+    let mut iv = [Interval::point(0.0); MAX_MATERIALS];
+    let mut f = [0.0f64; MAX_MATERIALS];
+    let mut f32s = [0.0f32; MAX_MATERIALS];
+    let mut x = 0;
+    while x < nx {
+        if !lazy(x) {
+            let end = (x + 1..nx).find(|&e| lazy(e)).unwrap_or(nx);
+            crate::dither::choose_random(
+                seed,
+                first + x as u64,
+                &dist[x..end],
+                &fracs[x * k..end * k],
+                k,
+                &mut out[x..end],
+            );
+            x = end;
+            continue;
+        }
+        let end = (x + 1..(x + RUN).min(nx))
+            .find(|&e| !lazy(e))
+            .unwrap_or((x + RUN).min(nx));
+        let b = volcad_core::Aabb::new(grid.center(x, y, z), grid.center(end - 1, y, z));
+        let sums = model
+            .fraction_bounds(&b, &mut iv[..k])
+            .then(|| RunningSums::new(&iv[..k]))
+            .flatten();
+        for (v, o) in (x..end).zip(&mut out[x..end]) {
+            let r = unit_f32(splitmix64(seed, first + v as u64));
+            *o = match sums.as_ref().and_then(|s| s.pick(r)) {
+                Some(code) => code,
+                None => {
+                    model.fractions_inside(grid.center(v, y, z), &mut f[..k]);
+                    for (a, b) in f32s.iter_mut().zip(&f[..k]) {
+                        *a = *b as f32;
+                    }
+                    pick_random(&f32s[..k], r)
+                }
+            };
+        }
+        x = end;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::atomic::AtomicBool;
+
+    use glam::DVec3;
+    use volcad_core::sampler::{Sampler, Slab};
+    use volcad_core::script::{ScriptOptions, model_of};
+
+    use super::*;
+
+    /// Codes of every layer of `src` at `voxel`, sampling every voxel and
+    /// lazily: they must be equal.
+    fn compare(src: &str, voxel: f64, seed: u64) -> (usize, usize) {
+        let src = format!("let m = default_materials();\n{src}");
+        let m = model_of(&src, "t.rhai", &ScriptOptions::default()).expect("design");
+        let grid = Grid::covering(&m.bbox(), DVec3::splat(voxel), 1 << 40).expect("grid");
+        let [nx, ny, nz] = grid.dims;
+        let k = m.materials().len();
+        let cancel = AtomicBool::new(false);
+        let eager = Sampler::new(&m, grid, true);
+        let lazy = Sampler::new(&m, grid, true).with_lazy_fractions();
+        let (mut a, mut b) = (Slab::default(), Slab::default());
+        let (mut ca, mut cb) = (vec![0u8; nx], vec![0u8; nx]);
+        let mut marked = 0;
+        let mut inside = 0;
+        for z in 0..nz {
+            eager
+                .sample_layers(z, z + 1, &mut a, &cancel)
+                .expect("sample");
+            lazy.sample_layers(z, z + 1, &mut b, &cancel)
+                .expect("sample");
+            for y in 0..ny {
+                let (d, f) = (&a.dist[y * nx..][..nx], &a.fracs[y * nx * k..][..nx * k]);
+                crate::dither::choose_random(seed, ((z * ny + y) * nx) as u64, d, f, k, &mut ca);
+                let (d, f) = (&b.dist[y * nx..][..nx], &b.fracs[y * nx * k..][..nx * k]);
+                choose_random_row(&m, &grid, seed, [y, z], d, f, k, &mut cb);
+                assert_eq!(ca, cb, "row {y} of layer {z}");
+                marked += (0..nx).filter(|&x| f[x * k].is_nan()).count();
+                inside += ca.iter().filter(|&&c| c > 0).count();
+            }
+        }
+        (marked, inside)
+    }
+
+    #[test]
+    fn lazy_picks_equal_evaluated_ones() {
+        let designs = [
+            r#"FGrade(["x/15+0.5", "-x/15+0.5"], [m.id("red"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(15,10,5), m.id("gray")))"#,
+            r#"Rotate(10, 20, 30, Vec3(0,0,0), FGrade(["x*x/20", "0.3", "1 - y/8", "z/4 + 0.5"], [m.id("red"), m.id("green"), m.id("blue"), m.id("yellow")], true, Sphere(Vec3(0,0,0), 4, m.id("gray"))))"#,
+            // A grade that reaches zero total: void inside the shape.
+            r#"FGrade(["x", "0"], [m.id("red"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(6,4,4), m.id("gray")))"#,
+        ];
+        for src in designs {
+            for seed in [1, 99] {
+                let (marked, inside) = compare(src, 0.1, seed);
+                assert!(marked > inside / 4, "{src}: {marked} of {inside} lazy");
+            }
+        }
+    }
+
+    #[test]
+    fn bounds_settle_most_picks_of_a_gentle_grade() {
+        let mut iv = [Interval::point(0.0); 2];
+        iv[0] = Interval::new(0.40, 0.41);
+        iv[1] = Interval::new(0.59, 0.60);
+        let s = RunningSums::new(&iv).expect("not void");
+        let settled = (0..1000)
+            .filter(|i| s.pick(*i as f32 / 1000.0).is_some())
+            .count();
+        assert!(settled > 950, "{settled}");
+        assert_eq!(s.pick(0.1), Some(1));
+        assert_eq!(s.pick(0.9), Some(2));
+        assert_eq!(s.pick(0.405), None);
+    }
+}
