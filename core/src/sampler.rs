@@ -396,10 +396,14 @@ impl<'a> Sampler<'a> {
                 } else if constant && k == 1 {
                     run.fill(one[0]);
                 } else if constant {
-                    for voxel in run.chunks_exact_mut(k) {
-                        for (o, v) in voxel.iter_mut().zip(&one) {
-                            *o = *v;
-                        }
+                    // One voxel, then doubling copies (a copy per voxel was a
+                    // library call each).
+                    run[..k].copy_from_slice(&one[..k]);
+                    let mut filled = k;
+                    while filled < run.len() {
+                        let n = filled.min(run.len() - filled);
+                        run.copy_within(..n, filled);
+                        filled += n;
                     }
                 } else {
                     for (x, voxel) in (x0..).zip(run.chunks_exact_mut(k)) {

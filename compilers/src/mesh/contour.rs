@@ -279,11 +279,12 @@ impl Contourer {
     }
 
     /// Add plane `z` (planes come in order from 0); contours the cube layer
-    /// between it and the previous plane.
+    /// between it and the previous plane, and hands that previous plane
+    /// back for its buffers to be reused.
     ///
     /// # Panics
     /// If a plane is skipped or has the wrong size.
-    pub fn push_plane(&mut self, z: usize, plane: Plane) {
+    pub fn push_plane(&mut self, z: usize, plane: Plane) -> Option<Plane> {
         let layer = self.grid.dims[0] * self.grid.dims[1];
         assert!(
             plane.label.len() == layer && plane.dist.len() == layer,
@@ -297,7 +298,7 @@ impl Contourer {
         let Some((pz, lo)) = self.prev.take() else {
             assert_eq!(z, 0, "planes must start at 0");
             self.prev = Some((z, plane));
-            return;
+            return None;
         };
         assert_eq!(pz + 1, z, "planes must come in order");
         let ny = self.grid.dims[1];
@@ -335,6 +336,7 @@ impl Contourer {
             m[1].clear();
         }
         self.prev = Some((z, plane));
+        Some(lo)
     }
 
     /// Index in `label`'s mesh of vertex `v` (added when new), for the

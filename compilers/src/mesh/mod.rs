@@ -55,7 +55,7 @@ use crate::job::{ExportError, JobContext, Summary};
 use crate::png_io::folder_name;
 use crate::probe::probe;
 use crate::resources::{check_disk, check_memory, human_bytes, run_with_threads};
-use contour::Contourer;
+use contour::{Contourer, Plane};
 use segment::{Classifier, Tally};
 
 /// Infill percent from `f` when no expression is given.
@@ -309,38 +309,49 @@ fn build(
         Contourer::new(pl.grid, pl.classifier.segments(), pl.classifier.interface());
     let mut tally = Tally::new(pl.classifier.segments());
     let mut slab = Slab::default();
-    // Sample and label one slab of planes.
-    let labelled = |slab: &mut Slab, z0: usize, z1: usize| {
+    // Sample and label one slab of planes, into retired planes' buffers.
+    let labelled = |slab: &mut Slab, z0: usize, z1: usize, mut spare: Vec<Plane>| {
         sampler
             .sample_layers(z0, z1, slab, cancel)
             .map_err(|_| ExportError::Cancelled)?;
         Ok::<_, ExportError>(
             (z0..z1)
-                .map(|z| pl.classifier.plane(slab, z - z0, dims, z))
+                .map(|z| {
+                    let reuse = spare.pop().unwrap_or_default();
+                    pl.classifier.plane_into(slab, z - z0, dims, z, reuse)
+                })
                 .collect::<Vec<_>>(),
         )
     };
     let mut z0 = 0;
     let mut z1 = pl.slab_layers.min(nz);
-    let mut ready = labelled(&mut slab, z0, z1)?;
+    let mut ready = labelled(&mut slab, z0, z1, Vec::new())?;
+    let mut spare = Vec::new();
     while z0 < nz {
         let next = (z1 < nz).then(|| (z1, (z1 + pl.slab_layers).min(nz)));
         let planes = std::mem::take(&mut ready);
+        let reuse = std::mem::take(&mut spare);
         // Contour this slab while the next one is sampled: contouring has
         // sequential parts (stitching rows, joining flat regions) that
         // would otherwise leave a core idle. Planes still enter the
         // contourer in order, so the output does not change.
-        let (sampled, ()) = rayon::join(
-            || next.map(|(a, b)| labelled(&mut slab, a, b)).transpose(),
+        let (sampled, retired) = rayon::join(
             || {
+                next.map(|(a, b)| labelled(&mut slab, a, b, reuse))
+                    .transpose()
+            },
+            || {
+                let mut retired = Vec::new();
                 for (z, (plane, t)) in (z0..).zip(planes) {
                     tally.add(&t);
-                    contourer.push_plane(z, plane);
+                    retired.extend(contourer.push_plane(z, plane));
                 }
+                retired
             },
         );
         progress(z1, nz);
         ready = sampled?.unwrap_or_default();
+        spare = retired;
         z0 = z1;
         z1 = next.map_or(nz, |n| n.1);
     }

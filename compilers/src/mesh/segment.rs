@@ -150,20 +150,36 @@ impl Classifier {
 
     /// The plane of labels for layer `l` of `slab` (grid `[nx, ny, nz]`,
     /// global layer `z`), with its tallies.
-    pub fn plane(
+    pub fn plane(&self, slab: &Slab, l: usize, dims: [usize; 3], z: usize) -> (Plane, Tally) {
+        self.plane_into(slab, l, dims, z, Plane::default())
+    }
+
+    /// [`Self::plane`] into the buffers of a plane the caller no longer
+    /// needs (fresh buffers each layer cost page faults and zeroing by the
+    /// kernel: a tenth of a cube export).
+    pub fn plane_into(
         &self,
         slab: &Slab,
         l: usize,
         [nx, ny, nz]: [usize; 3],
         z: usize,
+        reuse: Plane,
     ) -> (Plane, Tally) {
         let layer = nx * ny;
         let k = slab.k;
         let stride = self.interface().stride();
-        let dist = slab.dist[l * layer..(l + 1) * layer].to_vec();
+        let Plane {
+            mut label,
+            mut dist,
+            mut value,
+        } = reuse;
+        dist.clear();
+        dist.extend_from_slice(&slab.dist[l * layer..(l + 1) * layer]);
         let fracs = &slab.fracs[l * layer * k..(l + 1) * layer * k];
-        let mut label = vec![0u16; layer];
-        let mut value = vec![0f32; layer * stride];
+        label.clear();
+        label.resize(layer, 0);
+        value.clear();
+        value.resize(layer * stride, 0.0);
         let segments = self.segments();
         let edge_plane = z == 0 || z + 1 == nz;
         let tallies: Vec<Tally> = label
