@@ -596,7 +596,22 @@ mod tests {
             r#"Rotate(20, 35, 10, Vec3(0,0,0), FGrade(["x/8+0.5", "0.3", "-y/8+0.5"], [m.id("red"), m.id("green"), m.id("blue")], true, Sphere(Vec3(0,0,0), 4, m.id("gray"))))"#,
         );
         let red = bar.table().id("red").expect("red");
+        let seat_src = std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../assets/examples/bicycle_seat.rhai"),
+        )
+        .expect("seat example");
+        let seat_path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../assets/examples/bicycle_seat.rhai");
+        let seat = model_of(
+            &seat_src,
+            "bicycle_seat.rhai",
+            &ScriptOptions::for_file(&seat_path),
+        )
+        .expect("seat");
+        let cyan = seat.table().id("VeroCyan").expect("VeroCyan");
         let cases = [
+            (&seat, SegmentBy::Material(cyan), 4, 2.0),
             (&bar, SegmentBy::Material(red), 4, 0.1),
             (&bar, SegmentBy::Dominant, 1, 0.1),
             (&tilted, SegmentBy::Material(red), 5, 0.1),

@@ -17,6 +17,8 @@
 
 use glam::{DVec3, Vec4};
 
+use crate::bounds::Aabb;
+
 use super::bvh::Bvh;
 
 /// Marks a child slot that holds a primitive (its slot number in the low bits).
@@ -197,6 +199,41 @@ impl WideBvh {
             break;
         }
         (best_slot != EMPTY).then_some((best_slot, best))
+    }
+
+    /// Calls `f` with every primitive whose box may meet `b` (boxes and `b`
+    /// rounded outwards); stops and returns false as soon as `f` does.
+    pub fn overlapping<F: FnMut(u32) -> bool>(&self, b: &Aabb, mut f: F) -> bool {
+        let lo = [b.min.x, b.min.y, b.min.z].map(|v| Vec4::splat(down(v)));
+        let hi = [b.max.x, b.max.y, b.max.z].map(|v| Vec4::splat(up(v)));
+        let mut stack = Stack::<u32>::new();
+        let mut ni = 0usize;
+        loop {
+            let n = &self.nodes[ni];
+            let meet = n.lo[0].cmple(hi[0])
+                & n.hi[0].cmpge(lo[0])
+                & n.lo[1].cmple(hi[1])
+                & n.hi[1].cmpge(lo[1])
+                & n.lo[2].cmple(hi[2])
+                & n.hi[2].cmpge(lo[2]);
+            let mut mask = meet.bitmask();
+            while mask != 0 {
+                let lane = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let c = n.child[lane];
+                if c & PRIM != 0 {
+                    if !f(c & !PRIM) {
+                        return false;
+                    }
+                } else {
+                    stack.push(c);
+                }
+            }
+            match stack.pop() {
+                Some(next) => ni = next as usize,
+                None => return true,
+            }
+        }
     }
 
     /// First primitive whose box contains `p` and for which `test(slot)` is

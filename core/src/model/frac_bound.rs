@@ -5,8 +5,10 @@
 //! export's segment label: which range of one material's fraction, or
 //! which material dominates) can skip evaluating every voxel of a region
 //! where the bounds prove that function constant. The rules mirror
-//! [`PNode::frac`]; nodes without a cheap bound (a `Blend`, an FEA field, a
-//! smooth union) answer "unknown" and the caller samples as before.
+//! [`PNode::frac`]; nodes without a cheap bound (a `Blend`, a smooth
+//! union) answer "unknown" and the caller samples as before. An FEA field
+//! (`SimulationField`) is bounded through the nodal ranges of the
+//! tetrahedra that meet the box (`SimField::bounds`).
 //!
 //! FGrade (clamped, normalised expressions `vᵢ = max(eᵢ, 0)`,
 //! `fᵢ = vᵢ / Σⱼ vⱼ`): with `vᵢ ∈ [aᵢ, bᵢ]`, `fᵢ` is increasing in `vᵢ` and
@@ -14,10 +16,13 @@
 //! `aᵢ / (aᵢ + Σ_{j≠i} bⱼ) ≤ fᵢ ≤ bᵢ / (bᵢ + Σ_{j≠i} aⱼ)` (0 when the
 //! numerator is 0: an all-zero sum gives zero fractions).
 
+use std::sync::Arc;
+
 use super::MAX_MATERIALS;
 use super::bound::{coord_intervals, tile_box};
-use super::pnode::{D_SLOT, Grade, NAry, PNode};
+use super::pnode::{COORD_SLOTS, D_SLOT, Grade, NAry, PNode, SimGrade, Slot};
 use crate::bounds::Aabb;
+use crate::expr::Expr;
 use crate::interval::Interval;
 
 /// Most children of a union that may overlap a box before the bound gives up.
@@ -50,6 +55,7 @@ impl PNode {
             PNode::Offset { child, .. } | PNode::Shell { child, .. } => child.frac_bounds(b, out),
             PNode::Tile { cell, child } => child.frac_bounds(&tile_box(b, *cell), out),
             PNode::FGrade(g) => g.bounds(b, out),
+            PNode::SimField(g) => g.bounds(b, out),
             _ => false,
         }
     }
@@ -112,39 +118,65 @@ impl Grade {
         } else {
             Interval::EVERYTHING
         };
-        let slots = coord_intervals(b, d);
-        let mut v = [ZERO; MAX_MATERIALS];
-        let n = self.exprs.len();
-        for (vi, e) in v.iter_mut().zip(&self.exprs) {
-            let i = e.eval_interval(&slots);
-            if !(i.lo.is_finite() && i.hi.is_finite()) {
-                return false;
-            }
-            *vi = Interval::new(i.lo.max(0.0), i.hi.max(0.0));
-        }
-        let (sum_lo, sum_hi) = v[..n]
-            .iter()
-            .fold((0.0, 0.0), |(l, h), x| (l + x.lo, h + x.hi));
-        for (vi, &m) in v[..n].iter().zip(&self.mats) {
-            let (others_lo, others_hi) = (sum_lo - vi.lo, sum_hi - vi.hi);
-            let lo = if vi.lo > 0.0 {
-                vi.lo / (vi.lo + others_hi.max(0.0))
-            } else {
-                0.0
-            };
-            let hi = if vi.hi > 0.0 {
-                vi.hi / (vi.hi + others_lo.max(0.0))
-            } else {
-                0.0
-            };
-            // Rounding: widen by a few ulps' worth, the evaluator rounds too.
-            let slack = 1e-12;
-            let f = Interval::new((lo - slack).max(0.0), (hi + slack).min(1.0));
-            let o = &mut out[m as usize];
-            *o = Interval::new(o.lo + f.lo, o.hi + f.hi);
-        }
-        true
+        normalised_bounds(&self.exprs, &self.mats, &coord_intervals(b, d), out)
     }
+}
+
+impl SimGrade {
+    /// As `Grade`, with the field's variables bounded over `b`
+    /// (`SimField::bounds`); `d` is 0, as `SimGrade::frac` leaves it.
+    fn bounds(&self, b: &Aabb, out: &mut [Interval]) -> bool {
+        let n = COORD_SLOTS + self.field.variable_count();
+        if n > 64 {
+            return false;
+        }
+        let mut slots = [ZERO; 64];
+        slots[..COORD_SLOTS].copy_from_slice(&coord_intervals(b, ZERO));
+        self.field.bounds(b, &mut slots[COORD_SLOTS..n])
+            && normalised_bounds(&self.exprs, &self.mats, &slots[..n], out)
+    }
+}
+
+/// Bounds of clamped, normalised expressions (see the module docs) added
+/// to their materials' entries of `out`; false when an expression has no
+/// finite bound.
+fn normalised_bounds(
+    exprs: &[Arc<Expr>],
+    mats: &[Slot],
+    slots: &[Interval],
+    out: &mut [Interval],
+) -> bool {
+    let mut v = [ZERO; MAX_MATERIALS];
+    let n = exprs.len();
+    for (vi, e) in v.iter_mut().zip(exprs) {
+        let i = e.eval_interval(slots);
+        if !(i.lo.is_finite() && i.hi.is_finite()) {
+            return false;
+        }
+        *vi = Interval::new(i.lo.max(0.0), i.hi.max(0.0));
+    }
+    let (sum_lo, sum_hi) = v[..n]
+        .iter()
+        .fold((0.0, 0.0), |(l, h), x| (l + x.lo, h + x.hi));
+    for (vi, &m) in v[..n].iter().zip(mats) {
+        let (others_lo, others_hi) = (sum_lo - vi.lo, sum_hi - vi.hi);
+        let lo = if vi.lo > 0.0 {
+            vi.lo / (vi.lo + others_hi.max(0.0))
+        } else {
+            0.0
+        };
+        let hi = if vi.hi > 0.0 {
+            vi.hi / (vi.hi + others_lo.max(0.0))
+        } else {
+            0.0
+        };
+        // Rounding: widen by a few ulps' worth, the evaluator rounds too.
+        let slack = 1e-12;
+        let f = Interval::new((lo - slack).max(0.0), (hi + slack).min(1.0));
+        let o = &mut out[m as usize];
+        *o = Interval::new(o.lo + f.lo, o.hi + f.hi);
+    }
+    true
 }
 
 #[cfg(test)]

@@ -180,6 +180,10 @@ pub enum SimFieldError {
     },
 }
 
+/// Most tetrahedra [`SimField::bounds`] gathers before giving up (a box
+/// that large is too coarse for its bounds to decide anything).
+pub const MAX_BOUND_TETS: usize = 512;
+
 /// A tetrahedral mesh with nodal values, sampled by barycentric
 /// interpolation. Immutable and `Sync`.
 #[derive(Clone, Debug)]
@@ -307,6 +311,40 @@ impl SimField {
         }
         if let (Some([x, y, z]), Some(o)) = (self.len_from, out.get_mut(s)) {
             *o = DVec3::new(interp(x), interp(y), interp(z)).length();
+        }
+        true
+    }
+
+    /// Bounds of every variable (as [`SimField::sample`] orders them) at
+    /// the points of `b` inside the mesh, into `out`: the nodal ranges over
+    /// the tetrahedra whose boxes meet `b` (linear interpolation stays
+    /// within them), and for `len` the magnitude of the component ranges.
+    /// False when no tetrahedron or more than [`MAX_BOUND_TETS`] meet `b`.
+    pub fn bounds(&self, b: &Aabb, out: &mut [Interval]) -> bool {
+        let s = self.stride;
+        let mut lo = [f64::INFINITY; 64];
+        let mut hi = [f64::NEG_INFINITY; 64];
+        let mut count = 0;
+        let complete = self.locator.overlapping(b, |nodes| {
+            count += 1;
+            for n in nodes {
+                let row = &self.values[n as usize * s..(n as usize + 1) * s];
+                for (c, v) in row.iter().enumerate().take(64) {
+                    lo[c] = lo[c].min(*v);
+                    hi[c] = hi[c].max(*v);
+                }
+            }
+            count <= MAX_BOUND_TETS
+        });
+        if !complete || count == 0 || s > 64 {
+            return false;
+        }
+        let column = |c: usize| Interval::new(lo[c], hi[c]);
+        for (c, o) in out.iter_mut().take(s).enumerate() {
+            *o = column(c);
+        }
+        if let (Some([x, y, z]), Some(o)) = (self.len_from, out.get_mut(s)) {
+            *o = (column(x).square() + column(y).square() + column(z).square()).sqrt();
         }
         true
     }

@@ -59,6 +59,38 @@ fn check_seat(f: &SimField) {
 }
 
 #[test]
+fn seat_bounds_hold_at_every_sample_of_random_boxes() {
+    let f = SimField::load(&seat("seat.inp"), &seat("seat_displacement_table.csv")).unwrap();
+    let bb = f.bbox();
+    let mut rng = Rng::new(11);
+    let mut bounded = 0;
+    let mut iv = [crate::interval::Interval::point(0.0); 4];
+    let mut out = [0.0; 4];
+    for i in 0..300 {
+        let size = [0.5, 2.0, 6.0][i % 3];
+        let c = rng.in_box(&bb);
+        let b = crate::bounds::Aabb::new(c - DVec3::splat(size), c + DVec3::splat(size));
+        if !f.bounds(&b, &mut iv) {
+            continue;
+        }
+        bounded += 1;
+        for _ in 0..40 {
+            let p = rng.in_box(&b);
+            if !f.sample(p, &mut out) {
+                continue;
+            }
+            for (v, (x, i)) in out.iter().zip(&iv).enumerate() {
+                assert!(
+                    i.lo - 1e-9 <= *x && *x <= i.hi + 1e-9,
+                    "variable {v} = {x} outside {i:?} at {p}"
+                );
+            }
+        }
+    }
+    assert!(bounded > 150, "{bounded} boxes bounded");
+}
+
+#[test]
 fn seat_headerless_and_table_agree() {
     let a = SimField::load(&seat("seat.inp"), &seat("seat_displacement.csv")).unwrap();
     check_seat(&a);

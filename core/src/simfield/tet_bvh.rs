@@ -148,6 +148,13 @@ impl TetLocator {
         loc
     }
 
+    /// Calls `f` with the nodes of every tetrahedron whose box meets `b`;
+    /// stops and returns false as soon as `f` does.
+    pub fn overlapping(&self, b: &Aabb, mut f: impl FnMut([u32; 4]) -> bool) -> bool {
+        self.wide
+            .overlapping(b, |slot| f(self.data[slot as usize].nodes))
+    }
+
     /// About one cell per tetrahedron over the mesh box; each cell remembers
     /// the tetrahedron at its centre, or that it is wholly outside.
     fn start_grid(&self, boundary: &TriangleMesh) -> StartGrid {
