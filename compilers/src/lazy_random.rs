@@ -150,17 +150,20 @@ mod tests {
 
     use super::*;
 
-    /// Codes of every layer of `src` at `voxel`, sampling every voxel and
-    /// lazily: they must be equal.
-    fn compare(src: &str, voxel: f64, seed: u64) -> (usize, usize) {
+    fn inline(src: &str) -> Model {
         let src = format!("let m = default_materials();\n{src}");
-        let m = model_of(&src, "t.rhai", &ScriptOptions::default()).expect("design");
+        model_of(&src, "t.rhai", &ScriptOptions::default()).expect("design")
+    }
+
+    /// Codes of every layer of `m` at `voxel`, sampling every voxel and
+    /// lazily: they must be equal.
+    fn compare(m: &Model, voxel: f64, seed: u64) -> (usize, usize) {
         let grid = Grid::covering(&m.bbox(), DVec3::splat(voxel), 1 << 40).expect("grid");
         let [nx, ny, nz] = grid.dims;
         let k = m.materials().len();
         let cancel = AtomicBool::new(false);
-        let eager = Sampler::new(&m, grid, true);
-        let lazy = Sampler::new(&m, grid, true).with_lazy_fractions();
+        let eager = Sampler::new(m, grid, true);
+        let lazy = Sampler::new(m, grid, true).with_lazy_fractions();
         let (mut a, mut b) = (Slab::default(), Slab::default());
         let (mut ca, mut cb) = (vec![0u8; nx], vec![0u8; nx]);
         let mut marked = 0;
@@ -175,7 +178,7 @@ mod tests {
                 let (d, f) = (&a.dist[y * nx..][..nx], &a.fracs[y * nx * k..][..nx * k]);
                 crate::dither::choose_random(seed, ((z * ny + y) * nx) as u64, d, f, k, &mut ca);
                 let (d, f) = (&b.dist[y * nx..][..nx], &b.fracs[y * nx * k..][..nx * k]);
-                choose_random_row(&m, &grid, seed, [y, z], d, f, k, &mut cb);
+                choose_random_row(m, &grid, seed, [y, z], d, f, k, &mut cb);
                 assert_eq!(ca, cb, "row {y} of layer {z}");
                 marked += (0..nx).filter(|&x| f[x * k].is_nan()).count();
                 inside += ca.iter().filter(|&&c| c > 0).count();
@@ -193,11 +196,22 @@ mod tests {
             r#"FGrade(["x", "0"], [m.id("red"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(6,4,4), m.id("gray")))"#,
         ];
         for src in designs {
+            let m = inline(src);
             for seed in [1, 99] {
-                let (marked, inside) = compare(src, 0.1, seed);
+                let (marked, inside) = compare(&m, 0.1, seed);
                 assert!(marked > inside / 4, "{src}: {marked} of {inside} lazy");
             }
         }
+    }
+
+    #[test]
+    fn lazy_picks_of_the_seat_field_equal_evaluated_ones() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../assets/examples/bicycle_seat.rhai");
+        let src = std::fs::read_to_string(&path).expect("seat example");
+        let m = model_of(&src, "bicycle_seat.rhai", &ScriptOptions::for_file(&path)).expect("seat");
+        let (marked, inside) = compare(&m, 1.0, 3);
+        assert!(marked > inside / 10, "{marked} of {inside} lazy");
     }
 
     #[test]
