@@ -162,6 +162,31 @@ pub struct SampleStats {
     pub skipped: AtomicU64,
 }
 
+/// Repeat `one` (a voxel's fractions) over `run`. The usual few materials
+/// get a fixed-size copy the compiler turns into plain stores; a copy of
+/// run-time length was a library call per voxel (a tenth of a graded mesh
+/// export).
+fn fill_pattern(run: &mut [f32], one: &[f32]) {
+    fn fixed<const K: usize>(run: &mut [f32], one: &[f32]) {
+        let mut p = [0.0; K];
+        p.copy_from_slice(one);
+        for v in run.chunks_exact_mut(K) {
+            v.copy_from_slice(&p);
+        }
+    }
+    match one.len() {
+        1 => run.fill(one[0]),
+        2 => fixed::<2>(run, one),
+        3 => fixed::<3>(run, one),
+        4 => fixed::<4>(run, one),
+        k => {
+            for v in run.chunks_exact_mut(k) {
+                v.copy_from_slice(one);
+            }
+        }
+    }
+}
+
 /// Voxels `[x0, x0 + w) × [y0, y0 + h)` of layer `z`.
 #[derive(Clone, Copy)]
 struct Rect {
@@ -393,18 +418,8 @@ impl<'a> Sampler<'a> {
                     run.fill(0.0);
                 } else if lazy {
                     run.fill(f32::NAN);
-                } else if constant && k == 1 {
-                    run.fill(one[0]);
                 } else if constant {
-                    // One voxel, then doubling copies (a copy per voxel was a
-                    // library call each).
-                    run[..k].copy_from_slice(&one[..k]);
-                    let mut filled = k;
-                    while filled < run.len() {
-                        let n = filled.min(run.len() - filled);
-                        run.copy_within(..n, filled);
-                        filled += n;
-                    }
+                    fill_pattern(run, &one[..k]);
                 } else {
                     for (x, voxel) in (x0..).zip(run.chunks_exact_mut(k)) {
                         let p = self.grid.center(x, y, z);
