@@ -37,15 +37,14 @@
 //! label's mesh has every vertex once. Only the keys of two sample planes are
 //! kept: memory is proportional to a plane plus the output.
 
-use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
-
 use glam::DVec3;
 use rayon::prelude::*;
 use volcad_core::sampler::Grid;
 
 use super::flat::{FlatKey, KeptCubes, Regions, flat_key};
 use super::indexed::IndexedMesh;
+use super::vertex_keys::{BandMesh, KeyMap};
+use super::vertex_keys::{Tri, VRef};
 
 /// How an edge between two inside samples of different labels is cut.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -109,29 +108,6 @@ const FACE_KEY: u64 = 8;
 const TET_KEY: u64 = 72;
 const KEY_TYPES: u64 = 128;
 
-/// Hasher for the vertex keys (already well spread u64s): one multiply
-/// (Fibonacci hashing) instead of SipHash, which dominated the merge.
-#[derive(Default)]
-struct KeyHasher(u64);
-
-impl Hasher for KeyHasher {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-
-    fn write(&mut self, bytes: &[u8]) {
-        for b in bytes {
-            self.0 = (self.0 ^ u64::from(*b)).wrapping_mul(0x0100_0000_01b3);
-        }
-    }
-
-    fn write_u64(&mut self, k: u64) {
-        self.0 = k.wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(26);
-    }
-}
-
-type KeyMap = HashMap<u64, u32, BuildHasherDefault<KeyHasher>>;
-
 /// A point of the contour inside one cube, by the cube corners (bit masks
 /// x = 1, y = 2, z = 4) it is built from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -142,51 +118,6 @@ enum Pt {
     Face(u8, u8, u8),
     /// Centroid of the tet's edge points.
     Tet,
-}
-
-/// A vertex: its key (shared across cubes) and position.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct VRef {
-    pub key: u64,
-    pub pos: [f32; 3],
-}
-
-/// A triangle for one label, before vertex sharing.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Tri {
-    pub label: u16,
-    pub v: [VRef; 3],
-}
-
-/// One row's triangles over its own vertex list, deduplicated per label
-/// (first appearance order, so the merged meshes list vertices in the same
-/// order as a triangle-by-triangle merge would).
-struct RowMesh {
-    /// Label, key and position of each distinct (label, key).
-    verts: Vec<(u16, u64, [f32; 3])>,
-    /// Label and row-local vertex indices.
-    tris: Vec<(u16, [u32; 3])>,
-}
-
-impl RowMesh {
-    fn new(tris: Vec<Tri>) -> RowMesh {
-        let mut local: HashMap<(u16, u64), u32, BuildHasherDefault<KeyHasher>> =
-            HashMap::with_capacity_and_hasher(tris.len(), Default::default());
-        let mut verts = Vec::with_capacity(tris.len());
-        let tris = tris
-            .iter()
-            .map(|t| {
-                let idx = t.v.map(|v| {
-                    *local.entry((t.label, v.key)).or_insert_with(|| {
-                        verts.push((t.label, v.key, v.pos));
-                        (verts.len() - 1) as u32
-                    })
-                });
-                (t.label, idx)
-            })
-            .collect();
-        RowMesh { verts, tris }
-    }
 }
 
 /// Order corner masks by inclusion (Kuhn corners are nested sets).
@@ -307,12 +238,12 @@ impl Contourer {
         // label's mesh (one map lookup per row vertex instead of one per
         // triangle corner: the sequential part was a third of contouring).
         let rows = ny.saturating_sub(1);
-        let bands: Vec<(RowMesh, BandFlats)> = (0..rows.div_ceil(BAND))
+        let bands: Vec<(BandMesh, BandFlats)> = (0..rows.div_ceil(BAND))
             .into_par_iter()
             .map(|b| {
                 let js = b * BAND..((b + 1) * BAND).min(rows);
                 let (tris, flats) = self.band(pz, js, &lo, &plane);
-                (RowMesh::new(tris), flats)
+                (BandMesh::new(tris), flats)
             })
             .collect();
         let mut global = Vec::new();

@@ -48,8 +48,9 @@ use glam::DVec3;
 use rayon::prelude::*;
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 
-use super::contour::{Cube, Interface, Tri, cut_field, front_back};
+use super::contour::{Cube, Interface, cut_field, front_back};
 use super::indexed::IndexedMesh;
+use super::vertex_keys::Tri;
 
 /// Largest deviation of an edge difference from its axis mean, relative to
 /// `|Δx| + |Δy| + |Δz|`: a sphere of radius `R` sampled at `h` deviates by

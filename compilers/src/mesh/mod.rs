@@ -35,6 +35,7 @@ pub mod obj;
 pub mod segment;
 pub mod stl;
 pub mod threemf;
+mod vertex_keys;
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
