@@ -7,8 +7,13 @@
 //! tiles, and each tile is refined quadtree-style with the model's interval
 //! bound. A tile whose interval is beyond ± one voxel diagonal is filled
 //! without evaluating its voxels (empty space, or solid interior); a solid
-//! tile with constant fractions gets one fraction evaluation. Memory is
-//! proportional to the slab, never to the volume.
+//! tile with constant fractions gets one fraction evaluation. Two consumer
+//! options use fraction bounds (`Model::fraction_bounds`) on solid tiles:
+//! [`Sampler::with_uniform`] (meshes: one evaluation where the segment label
+//! is proved constant) and [`Sampler::with_lazy_fractions`] (random
+//! dithering: `NaN` fractions that the consumer evaluates only where its
+//! bounds leave a pick open). Memory is proportional to the slab, never to
+//! the volume.
 //!
 //! Skipped voxels store the interval end (`lo` outside, `hi` inside): the
 //! sign is exact and the magnitude is a valid bound. Because a skipped voxel
