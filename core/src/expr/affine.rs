@@ -5,6 +5,7 @@
 
 use super::ast::Node;
 use super::ops::Op;
+use crate::interval::Interval;
 
 /// `c + Σ k·slots[i]` for `(i, k)` in `terms`.
 #[derive(Clone, Debug, PartialEq)]
@@ -22,6 +23,25 @@ impl Affine {
             v += k * slots[*i as usize];
         }
         v
+    }
+
+    /// Bounds over `slots`, with the same operations in the same order as
+    /// [`Affine::eval`] on the corner that makes each term smallest or
+    /// largest: rounding is monotone, so every point value lies within.
+    #[inline]
+    pub(crate) fn eval_interval(&self, slots: &[Interval]) -> Interval {
+        let (mut lo, mut hi) = (self.c, self.c);
+        for (i, k) in self.terms.iter() {
+            let s = slots[*i as usize];
+            let (a, b) = if *k >= 0.0 {
+                (s.lo, s.hi)
+            } else {
+                (s.hi, s.lo)
+            };
+            lo += k * a;
+            hi += k * b;
+        }
+        Interval::new(lo, hi)
     }
 }
 

@@ -202,6 +202,9 @@ impl Expr {
     /// # Panics
     /// If a variable the expression uses has no slot (`slots` too short).
     pub fn eval_interval(&self, slots: &[Interval]) -> Interval {
+        if let Some(a) = &self.affine {
+            return a.eval_interval(slots);
+        }
         match &self.tape {
             Some(t) => t.eval_interval(slots),
             None => Interval::point(self.constant.unwrap_or(f64::NAN)),

@@ -618,3 +618,38 @@ fn large_register_files() {
         assert!(b.contains(got), "{got} not in {b:?}");
     }
 }
+
+/// Affine gradings take their interval from the affine form: it must hold
+/// every point value (including the box corners, where it is attained).
+#[test]
+fn affine_intervals_contain_points_and_reach_the_corners() {
+    let vars = ["x", "y", "z"];
+    for src in ["x/15+0.5", "-x/15+0.5", "0.3 - 2*y + z/7", "(x - y)/3 - z"] {
+        let e = Expr::compile(src, &vars).unwrap();
+        assert!(e.is_affine(), "{src}");
+        let mut rng = crate::mesh::tests::Rng::new(5);
+        let mut unit = || rng.f64();
+        for _ in 0..200 {
+            let lo: Vec<f64> = (0..3).map(|_| unit() * 20.0 - 10.0).collect();
+            let hi: Vec<f64> = lo.iter().map(|l| l + unit() * 3.0).collect();
+            let iv: Vec<Interval> = (0..3).map(|i| Interval::new(lo[i], hi[i])).collect();
+            let b = e.eval_interval(&iv);
+            let mut reached = (false, false);
+            for c in 0..8 {
+                let p: Vec<f64> = (0..3)
+                    .map(|i| if c >> i & 1 == 0 { lo[i] } else { hi[i] })
+                    .collect();
+                let v = e.eval(&p);
+                assert!(b.lo <= v && v <= b.hi, "{src}: {v} outside {b:?}");
+                reached.0 |= v == b.lo;
+                reached.1 |= v == b.hi;
+            }
+            assert!(reached.0 && reached.1, "{src}: {b:?} not attained");
+            for _ in 0..20 {
+                let p: Vec<f64> = (0..3).map(|i| lo[i] + unit() * (hi[i] - lo[i])).collect();
+                let v = e.eval(&p);
+                assert!(b.lo <= v && v <= b.hi, "{src}: {v} outside {b:?}");
+            }
+        }
+    }
+}

@@ -197,13 +197,8 @@ mod tests {
     fn check(m: &Model, size: f64) -> usize {
         let k = m.materials().len();
         let bb = m.bbox();
-        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
-            (rng >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::mesh::tests::Rng::new(3);
+        let mut next = || rng.f64();
         let mut bounded = 0;
         let mut iv = [ZERO; MAX_MATERIALS];
         let mut f = [0.0; MAX_MATERIALS];
