@@ -307,3 +307,49 @@ fn export_png_mesh_and_fea() {
     );
     assert!(inp.to_uppercase().contains("NSET=NBOTTOM"));
 }
+
+#[test]
+fn bench_reports_evaluation_and_export_rates() {
+    let out = ok(&volcad(&[
+        "bench",
+        &example("graded_bar.rhai"),
+        "--points",
+        "2000",
+        "--voxels",
+        "200000",
+    ]));
+    assert!(
+        out.contains("png voxels/s") && out.contains("mesh voxels/s"),
+        "{out}"
+    );
+    let row = out
+        .lines()
+        .find(|l| l.starts_with("graded_bar.rhai"))
+        .unwrap_or_else(|| panic!("no row: {out}"));
+    // nodes, prepare, random, Z-order, voxel, png, mesh: all numbers > 0.
+    let numbers: Vec<f64> = row
+        .split_whitespace()
+        .skip(1)
+        .map(|w| {
+            w.parse()
+                .unwrap_or_else(|_| panic!("not a number: {w} in {row}"))
+        })
+        .collect();
+    assert_eq!(numbers.len(), 7, "{row}");
+    assert!(numbers[2..].iter().all(|v| *v > 0.0), "{row}");
+    // The voxel gives about the asked grid: (15·10·5 / 2e5)^(1/3) mm.
+    assert!((numbers[4] - (750.0f64 / 2e5).cbrt()).abs() < 1e-3, "{row}");
+    // Evaluation alone: no export columns.
+    let out = ok(&volcad(&[
+        "bench",
+        &example("graded_bar.rhai"),
+        "--points",
+        "2000",
+        "--no-exports",
+    ]));
+    let row = out
+        .lines()
+        .find(|l| l.starts_with("graded_bar.rhai"))
+        .unwrap();
+    assert_eq!(row.split_whitespace().count(), 5, "{row}");
+}

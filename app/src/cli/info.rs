@@ -60,9 +60,19 @@ pub struct BenchArgs {
     /// Points per measurement.
     #[arg(long, default_value_t = 2_000_000)]
     pub points: usize,
+    /// Voxels of each export grid: the voxel size per design is
+    /// `cbrt(box volume / N)`.
+    #[arg(long, default_value_t = 10_000_000)]
+    pub voxels: u64,
+    /// Measure evaluation only (no slice-stack and mesh exports).
+    #[arg(long)]
+    pub no_exports: bool,
 }
 
-/// `volcad bench`: points per second near the surface for each design.
+/// `volcad bench`: points per second near the surface for each design,
+/// then voxels per second of its slice stack (random dither) and of its
+/// segmented meshes (dominant material, STL + OBJ + 3MF), each written to
+/// a temporary folder that is removed.
 pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
     let designs = if args.designs.is_empty() {
         let dir = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/examples"));
@@ -76,8 +86,15 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
         args.designs.clone()
     };
     println!(
-        "{:<28} {:>8} {:>14} {:>16} {:>16}",
-        "design", "nodes", "prepare (ms)", "random order", "Z-order"
+        "{:<28} {:>8} {:>14} {:>16} {:>16} {:>11} {:>14} {:>14}",
+        "design",
+        "nodes",
+        "prepare (ms)",
+        "random order",
+        "Z-order",
+        "voxel (mm)",
+        "png voxels/s",
+        "mesh voxels/s"
     );
     for path in designs {
         let d = super::DesignArgs {
@@ -95,8 +112,13 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
         let pps = volcad_core::bench::points_per_second(&l.model, &pts);
         let sorted = volcad_core::bench::z_order(&l.model, &pts);
         let pps_z = volcad_core::bench::points_per_second(&l.model, &sorted);
+        let exports = if args.no_exports {
+            String::new()
+        } else {
+            export_rates(&l.model, args.voxels)
+        };
         println!(
-            "{:<28} {:>8} {:>14.1} {:>16.3e} {:>16.3e}",
+            "{:<28} {:>8} {:>14.1} {:>16.3e} {:>16.3e}{exports}",
             path.file_name()
                 .map(|f| f.to_string_lossy().to_string())
                 .unwrap_or_default(),
@@ -107,4 +129,53 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// The voxel size and the slice-stack and mesh export rates of `model` on
+/// a grid of about `voxels` voxels, as table columns (or why not).
+fn export_rates(model: &std::sync::Arc<volcad_core::Model>, voxels: u64) -> String {
+    use volcad_compilers::job;
+    use volcad_compilers::mesh::{MeshParams, export_meshes};
+    use volcad_compilers::png_stack::{PngParams, export_png_stack};
+
+    let size = model.bbox().size();
+    let volume = size.x * size.y * size.z;
+    if !(volume.is_finite() && volume > 0.0) {
+        return format!(" {:>11}", "unbounded");
+    }
+    let voxel = (volume / voxels.max(1) as f64).cbrt();
+    let run = |kind: &str, work: Box<dyn FnOnce(&job::JobContext) -> _ + Send>| {
+        let dest = std::env::temp_dir().join(format!(
+            "volcad-bench-{}-{kind}-{}",
+            std::process::id(),
+            next_id()
+        ));
+        let t = std::time::Instant::now();
+        let r = job::spawn(dest.clone(), "bench".into(), work).join();
+        let secs = t.elapsed().as_secs_f64();
+        let _ = std::fs::remove_dir_all(&dest);
+        match r {
+            Ok(s) => format!("{:>14.3e}", s.units as f64 / secs),
+            Err(e) => format!(" {kind}: {e}"),
+        }
+    };
+    let png = PngParams {
+        voxel: DVec3::splat(voxel),
+        ..PngParams::default()
+    };
+    let mesh = MeshParams {
+        voxel: DVec3::splat(voxel),
+        ..MeshParams::default()
+    };
+    let (m1, m2) = (model.clone(), model.clone());
+    let png = run("png", Box::new(move |ctx| export_png_stack(&m1, &png, ctx)));
+    let mesh = run("mesh", Box::new(move |ctx| export_meshes(&m2, &mesh, ctx)));
+    format!(" {voxel:>11.4} {png} {mesh}")
+}
+
+/// A number that differs between calls (temporary folder names).
+fn next_id() -> u64 {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static N: AtomicU64 = AtomicU64::new(0);
+    N.fetch_add(1, Ordering::Relaxed)
 }
