@@ -20,7 +20,7 @@ use volcad_compilers::mesh::{MeshFormats, MeshParams, SegmentBy, export_meshes, 
 use volcad_compilers::png_stack::{Dither, PngParams, export_png_stack};
 use volcad_core::Model;
 use volcad_core::sampler::{Grid, Sampler, Slab};
-use volcad_core::script::{ScriptOptions, run_script};
+use volcad_core::script::{ScriptOptions, model_of, model_of_file};
 
 const BCC_SPHERE: &str = r#"let m = default_materials();
 Intersection(false, [Tile(GraphLattice(LatticeType::BodyCenteredCubic, Vec3(5,5,5), 0.175, m.id("red"))), Sphere(Vec3(0,0,0), 10, m.id("blue"))])"#;
@@ -41,14 +41,11 @@ fn load(file: &str) -> Arc<Model> {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../assets/examples")
         .join(file);
-    let src = std::fs::read_to_string(&path).expect("example");
-    let d = run_script(&src, file, &ScriptOptions::for_file(&path)).expect("script");
-    Arc::new(Model::prepare(&d.root, d.materials.clone()).expect("prepare"))
+    Arc::new(model_of_file(&path).expect("example"))
 }
 
 fn inline(src: &str) -> Arc<Model> {
-    let d = run_script(src, "bench.rhai", &ScriptOptions::default()).expect("script");
-    Arc::new(Model::prepare(&d.root, d.materials.clone()).expect("prepare"))
+    Arc::new(model_of(src, "bench.rhai", &ScriptOptions::default()).expect("design"))
 }
 
 /// Seconds to sample every layer (no fractions / with fractions), and to

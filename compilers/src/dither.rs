@@ -49,8 +49,14 @@ const W_AHEAD: f32 = 0.75 * 7.0 / 16.0;
 const W_NEXT_BEHIND: f32 = 0.75 * 3.0 / 16.0;
 const W_NEXT_BELOW: f32 = 0.75 * 5.0 / 16.0;
 const W_NEXT_AHEAD: f32 = 0.75 * 1.0 / 16.0;
-/// Fraction totals at or below this are void.
+/// Fraction totals at or below this are void (slice stacks and segment
+/// labels alike).
 pub(crate) const MIN_TOTAL: f32 = 1e-6;
+/// Widening of fraction bounds before a decision is taken from them (a
+/// random pick, a segment label): far above the `f32` rounding of sampled
+/// fractions and of sums of at most 64 of them (`64 · 2⁻²⁴ ≈ 4·10⁻⁶`), far
+/// below the fraction steps that matter.
+pub(crate) const BOUND_MARGIN: f64 = 1e-5;
 /// SplitMix64's increment (2⁶⁴ / φ).
 const GAMMA: u64 = 0x9E37_79B9_7F4A_7C15;
 

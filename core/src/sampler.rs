@@ -366,9 +366,11 @@ impl<'a> Sampler<'a> {
     /// the bounds do not settle what they need (random dithering): a solid
     /// tile whose fractions vary, and which `Model::fraction_bounds` can
     /// bound, gets `NaN` fractions instead of one evaluation per voxel (see
-    /// `Slab::fracs`).
+    /// `Slab::fracs`). Nothing changes for a design whose fractions never
+    /// vary (`Model::varying_fractions`).
     pub fn with_lazy_fractions(mut self) -> Self {
-        self.lazy = true;
+        // Piecewise-constant designs have nothing to leave lazy.
+        self.lazy = self.model.varying_fractions();
         self
     }
 
@@ -400,16 +402,15 @@ impl<'a> Sampler<'a> {
                     _ => {}
                 }
             }
+            let mut one = [0.0f32; MAX_MATERIALS];
             if constant {
                 self.model.eval_into(b.center(), &mut f[..k]);
+                for (o, v) in one.iter_mut().zip(&f[..k]) {
+                    *o = *v as f32;
+                }
             }
             // Lazy only where the consumer will be able to bound them.
-            let lazy = inside
-                && !constant
-                && self.lazy
-                && self.model.varying_fractions()
-                && self.bounded(&b, k);
-            let one: [f32; MAX_MATERIALS] = std::array::from_fn(|i| f[i] as f32);
+            let lazy = inside && !constant && self.lazy && self.bounded(&b, k);
             for y in y0..y0 + h {
                 let row = (y - row0) * nx;
                 out.dist[row + x0..row + x0 + w].fill(value);

@@ -142,7 +142,6 @@ pub(super) struct Cube<'a> {
     pub value: [&'a [f32]; 8],
 }
 
-/// A flat cube of one row: its x index and region key.
 /// A band's flat cubes: row, column, key and the corners of the key's `x`
 /// label (bit mask), with their samples kept for the fallback.
 #[derive(Default)]

@@ -569,7 +569,7 @@ fn summary(
 
 #[cfg(test)]
 mod tests {
-    use volcad_core::script::{ScriptOptions, model_of};
+    use volcad_core::script::{ScriptOptions, model_of, model_of_file};
 
     use super::*;
 
@@ -597,17 +597,9 @@ mod tests {
             r#"Rotate(20, 35, 10, Vec3(0,0,0), FGrade(["x/8+0.5", "0.3", "-y/8+0.5"], [m.id("red"), m.id("green"), m.id("blue")], true, Sphere(Vec3(0,0,0), 4, m.id("gray"))))"#,
         );
         let red = bar.table().id("red").expect("red");
-        let seat_src = std::fs::read_to_string(
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        let seat = model_of_file(
+            &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
                 .join("../assets/examples/bicycle_seat.rhai"),
-        )
-        .expect("seat example");
-        let seat_path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../assets/examples/bicycle_seat.rhai");
-        let seat = model_of(
-            &seat_src,
-            "bicycle_seat.rhai",
-            &ScriptOptions::for_file(&seat_path),
         )
         .expect("seat");
         let cyan = seat.table().id("VeroCyan").expect("VeroCyan");
@@ -665,8 +657,15 @@ mod tests {
             let (lb, tb) = pl.classifier.plane(&b, 0, dims, z);
             assert_eq!(la.label, lb.label, "labels of layer {z}");
             assert_eq!(ta.voxels, tb.voxels);
-            filled += a.fracs.iter().zip(&b.fracs).filter(|(x, y)| x != y).count();
+            let k = a.k;
+            filled += (0..a.dist.len())
+                .filter(|v| a.fracs[v * k..(v + 1) * k] != b.fracs[v * k..(v + 1) * k])
+                .count();
         }
+        eprintln!(
+            "graded bar at 0.1 mm: {filled} of {} voxels filled",
+            dims[0] * dims[1] * dims[2]
+        );
         // Most of the bar's voxels got their tile's centre fractions.
         assert!(
             filled > dims[0] * dims[1] * dims[2] / 4,

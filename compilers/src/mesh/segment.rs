@@ -18,9 +18,7 @@ use volcad_core::interval::Interval;
 use volcad_core::sampler::Slab;
 
 use super::contour::{Interface, Plane};
-
-/// Fraction totals at or below this are void.
-const MIN_TOTAL: f32 = 1e-6;
+use crate::dither::{BOUND_MARGIN as EPS, MIN_TOTAL};
 
 /// How voxels are put into segments.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -86,7 +84,6 @@ impl Classifier {
     /// `f32` rounding of sampled fractions: the sampler may then fill a
     /// solid tile with one evaluation (see `Sampler::with_uniform`).
     pub fn uniform(&self, bounds: &[Interval]) -> bool {
-        const EPS: f64 = 1e-5;
         let sum_lo: f64 = bounds.iter().map(|i| i.lo).sum();
         let sum_hi: f64 = bounds.iter().map(|i| i.hi).sum();
         if !(sum_lo > f64::from(MIN_TOTAL) + EPS && sum_hi.is_finite()) {

@@ -203,26 +203,68 @@ impl WideBvh {
 
     /// Calls `f` with every primitive whose box may meet `b` (boxes and `b`
     /// rounded outwards); stops and returns false as soon as `f` does.
-    pub fn overlapping<F: FnMut(u32) -> bool>(&self, b: &Aabb, mut f: F) -> bool {
+    pub fn overlapping<F: FnMut(u32) -> bool>(&self, b: &Aabb, f: F) -> bool {
         let lo = [b.min.x, b.min.y, b.min.z].map(|v| Vec4::splat(down(v)));
         let hi = [b.max.x, b.max.y, b.max.z].map(|v| Vec4::splat(up(v)));
+        self.walk(
+            |n| {
+                (n.lo[0].cmple(hi[0])
+                    & n.hi[0].cmpge(lo[0])
+                    & n.lo[1].cmple(hi[1])
+                    & n.hi[1].cmpge(lo[1])
+                    & n.lo[2].cmple(hi[2])
+                    & n.hi[2].cmpge(lo[2]))
+                .bitmask()
+            },
+            f,
+        )
+    }
+
+    /// First primitive whose box contains `p` and for which `test(slot)` is
+    /// true.
+    #[inline(always)]
+    pub fn find<F: FnMut(u32) -> bool>(&self, p: DVec3, mut test: F) -> Option<u32> {
+        let px = Vec4::splat(p.x as f32);
+        let py = Vec4::splat(p.y as f32);
+        let pz = Vec4::splat(p.z as f32);
+        let mut found = None;
+        self.walk(
+            |n| {
+                (px.cmpge(n.lo[0])
+                    & px.cmple(n.hi[0])
+                    & py.cmpge(n.lo[1])
+                    & py.cmple(n.hi[1])
+                    & pz.cmpge(n.lo[2])
+                    & pz.cmple(n.hi[2]))
+                .bitmask()
+            },
+            |slot| {
+                let hit = test(slot);
+                if hit {
+                    found = Some(slot);
+                }
+                !hit
+            },
+        );
+        found
+    }
+
+    /// Depth-first walk into the children that `lanes` selects (a bit mask
+    /// of a node's four lanes), calling `leaf` with each primitive reached;
+    /// stops and returns false as soon as `leaf` does.
+    #[inline(always)]
+    fn walk(&self, lanes: impl Fn(&Node4) -> u32, mut leaf: impl FnMut(u32) -> bool) -> bool {
         let mut stack = Stack::<u32>::new();
         let mut ni = 0usize;
         loop {
             let n = &self.nodes[ni];
-            let meet = n.lo[0].cmple(hi[0])
-                & n.hi[0].cmpge(lo[0])
-                & n.lo[1].cmple(hi[1])
-                & n.hi[1].cmpge(lo[1])
-                & n.lo[2].cmple(hi[2])
-                & n.hi[2].cmpge(lo[2]);
-            let mut mask = meet.bitmask();
+            let mut mask = lanes(n);
             while mask != 0 {
                 let lane = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
                 let c = n.child[lane];
                 if c & PRIM != 0 {
-                    if !f(c & !PRIM) {
+                    if !leaf(c & !PRIM) {
                         return false;
                     }
                 } else {
@@ -233,40 +275,6 @@ impl WideBvh {
                 Some(next) => ni = next as usize,
                 None => return true,
             }
-        }
-    }
-
-    /// First primitive whose box contains `p` and for which `test(slot)` is
-    /// true.
-    #[inline(always)]
-    pub fn find<F: FnMut(u32) -> bool>(&self, p: DVec3, mut test: F) -> Option<u32> {
-        let px = Vec4::splat(p.x as f32);
-        let py = Vec4::splat(p.y as f32);
-        let pz = Vec4::splat(p.z as f32);
-        let mut stack = Stack::<u32>::new();
-        let mut ni = 0usize;
-        loop {
-            let n = &self.nodes[ni];
-            let inside = px.cmpge(n.lo[0])
-                & px.cmple(n.hi[0])
-                & py.cmpge(n.lo[1])
-                & py.cmple(n.hi[1])
-                & pz.cmpge(n.lo[2])
-                & pz.cmple(n.hi[2]);
-            let mut mask = inside.bitmask();
-            while mask != 0 {
-                let lane = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                let c = n.child[lane];
-                if c & PRIM != 0 {
-                    if test(c & !PRIM) {
-                        return Some(c & !PRIM);
-                    }
-                } else {
-                    stack.push(c);
-                }
-            }
-            ni = stack.pop()? as usize;
         }
     }
 }

@@ -42,7 +42,7 @@ fn mesh_interval(mesh: &crate::mesh::TriangleMesh, b: &Aabb) -> Interval {
 
 /// The part of a Tile child's domain that box `b` maps to: the mapped box if
 /// `b` lies in one cell, else the whole cell.
-pub(super) fn tile_box(b: &Aabb, cell: DVec3) -> Aabb {
+fn tile_box(b: &Aabb, cell: DVec3) -> Aabb {
     let lo = (b.min / cell).floor();
     let hi = (b.max / cell).floor();
     if lo == hi {
@@ -174,17 +174,11 @@ impl PNode {
         if self.leaf_material().is_some() {
             return true;
         }
+        if let Some((child, cb)) = self.fraction_child_box(b) {
+            return child.constant_fractions(&cb);
+        }
         match self {
             PNode::SimField(_) => false,
-            PNode::Translate { t, child } => {
-                child.constant_fractions(&Aabb::new(b.min - *t, b.max - *t))
-            }
-            PNode::Rotate {
-                to_local,
-                around,
-                child,
-            } => child.constant_fractions(&b.transformed(to_local, *around)),
-            PNode::Scale { inv, child, .. } => child.constant_fractions(&b.scaled(*inv)),
             PNode::Union(u) => u.union_constant(b),
             PNode::Intersection(n) => {
                 if n.blend {
@@ -194,33 +188,52 @@ impl PNode {
                 }
             }
             PNode::Difference { a, .. } => a.constant_fractions(b),
-            PNode::Offset { child, .. } | PNode::Shell { child, .. } => child.constant_fractions(b),
-            PNode::Tile { cell, child } => child.constant_fractions(&tile_box(b, *cell)),
-            PNode::FGrade(g) => {
-                if !g.child.is_inside_somewhere(b) {
-                    return true;
-                }
-                let d = if g.used & (1 << D_SLOT) != 0 {
-                    g.child.interval(b)
-                } else {
-                    Interval::EVERYTHING
-                };
-                let slots = coord_intervals(b, d);
-                g.exprs.iter().all(|e| {
+            PNode::FGrade(g) => match g.slot_intervals(b) {
+                None => true,
+                Some(slots) => g.exprs.iter().all(|e| {
                     e.constant().is_some() || {
                         let i = e.eval_interval(&slots);
                         i.lo == i.hi
                     }
-                })
-            }
+                }),
+            },
             PNode::Blend { .. } => false,
             _ => true, // leaves: above
         }
     }
 
-    /// False when the node is certainly outside everywhere in `b`.
-    fn is_inside_somewhere(&self, b: &Aabb) -> bool {
-        self.interval(b).lo <= 0.0
+    /// The child whose fractions this node passes on
+    /// ([`PNode::fraction_child`]), with `b` in the child's frame.
+    pub(super) fn fraction_child_box(&self, b: &Aabb) -> Option<(&PNode, Aabb)> {
+        let child = self.fraction_child()?;
+        let cb = match self {
+            PNode::Translate { t, .. } => Aabb::new(b.min - *t, b.max - *t),
+            PNode::Rotate {
+                to_local, around, ..
+            } => b.transformed(to_local, *around),
+            PNode::Scale { inv, .. } => b.scaled(*inv),
+            PNode::Tile { cell, .. } => tile_box(b, *cell),
+            _ => *b, // offset, shell: the same points
+        };
+        Some((child, cb))
+    }
+}
+
+impl super::pnode::Grade {
+    /// Intervals of the coordinate slots over `b` (`d` from the child when
+    /// an expression reads it); `None` when the child has no inside point
+    /// in `b`.
+    pub(super) fn slot_intervals(&self, b: &Aabb) -> Option<[Interval; COORD_SLOTS]> {
+        let d = self.child.interval(b);
+        if d.lo > 0.0 {
+            return None;
+        }
+        let d = if self.used & (1 << D_SLOT) != 0 {
+            d
+        } else {
+            Interval::EVERYTHING
+        };
+        Some(coord_intervals(b, d))
     }
 }
 

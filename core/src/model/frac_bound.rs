@@ -19,8 +19,8 @@
 use std::sync::Arc;
 
 use super::MAX_MATERIALS;
-use super::bound::{coord_intervals, tile_box};
-use super::pnode::{COORD_SLOTS, D_SLOT, Grade, NAry, PNode, SimGrade, Slot};
+use super::bound::coord_intervals;
+use super::pnode::{COORD_SLOTS, Grade, NAry, PNode, SimGrade, Slot};
 use crate::bounds::Aabb;
 use crate::expr::Expr;
 use crate::interval::Interval;
@@ -39,21 +39,13 @@ impl PNode {
             out[m as usize] = Interval::point(1.0);
             return true;
         }
+        if let Some((child, cb)) = self.fraction_child_box(b) {
+            return child.frac_bounds(&cb, out);
+        }
         match self {
-            PNode::Translate { t, child } => {
-                child.frac_bounds(&Aabb::new(b.min - *t, b.max - *t), out)
-            }
-            PNode::Rotate {
-                to_local,
-                around,
-                child,
-            } => child.frac_bounds(&b.transformed(to_local, *around), out),
-            PNode::Scale { inv, child, .. } => child.frac_bounds(&b.scaled(*inv), out),
             PNode::Union(u) if !u.blend && u.smooth <= 0.0 => u.union_bounds(b, out),
             PNode::Intersection(n) if !n.blend => n.children[0].frac_bounds(b, out),
             PNode::Difference { a, .. } => a.frac_bounds(b, out),
-            PNode::Offset { child, .. } | PNode::Shell { child, .. } => child.frac_bounds(b, out),
-            PNode::Tile { cell, child } => child.frac_bounds(&tile_box(b, *cell), out),
             PNode::FGrade(g) => g.bounds(b, out),
             PNode::SimField(g) => g.bounds(b, out),
             _ => false,
@@ -109,16 +101,10 @@ impl NAry {
 
 impl Grade {
     fn bounds(&self, b: &Aabb, out: &mut [Interval]) -> bool {
-        let d = self.child.interval(b);
-        if d.lo > 0.0 {
-            return true; // no inside point
+        match self.slot_intervals(b) {
+            None => true, // no inside point
+            Some(slots) => normalised_bounds(&self.exprs, &self.mats, &slots, out),
         }
-        let d = if self.used & (1 << D_SLOT) != 0 {
-            d
-        } else {
-            Interval::EVERYTHING
-        };
-        normalised_bounds(&self.exprs, &self.mats, &coord_intervals(b, d), out)
     }
 }
 
@@ -193,13 +179,13 @@ mod tests {
     }
 
     /// Every inside sample of random boxes has fractions within the
-    /// bounds; returns how many boxes were bounded.
+    /// bounds; returns how many inside samples were checked.
     fn check(m: &Model, size: f64) -> usize {
         let k = m.materials().len();
         let bb = m.bbox();
         let mut rng = crate::mesh::tests::Rng::new(3);
         let mut next = || rng.f64();
-        let mut bounded = 0;
+        let mut checked = 0;
         let mut iv = [ZERO; MAX_MATERIALS];
         let mut f = [0.0; MAX_MATERIALS];
         for _ in 0..400 {
@@ -209,12 +195,12 @@ mod tests {
             if !m.fraction_bounds(&b, &mut iv[..k]) {
                 continue;
             }
-            bounded += 1;
             for _ in 0..50 {
                 let p = b.min + (b.max - b.min) * DVec3::new(next(), next(), next());
                 if m.eval_into(p, &mut f[..k]) > 0.0 {
                     continue;
                 }
+                checked += 1;
                 for (i, (b, v)) in iv[..k].iter().zip(&f[..k]).enumerate() {
                     assert!(
                         b.lo - 1e-9 <= *v && *v <= b.hi + 1e-9,
@@ -225,7 +211,7 @@ mod tests {
                 }
             }
         }
-        bounded
+        checked
     }
 
     #[test]
@@ -242,7 +228,8 @@ mod tests {
         for src in designs {
             let m = model(src);
             for size in [0.05, 0.5, 3.0] {
-                assert!(check(&m, size) > 100, "{src}: too few boxes bounded");
+                let checked = check(&m, size);
+                assert!(checked > 2000, "{src}: {checked} inside samples checked");
             }
         }
     }

@@ -180,6 +180,17 @@ pub fn model_of(source: &str, name: &str, opts: &ScriptOptions) -> Result<crate:
     crate::Model::prepare(&d.root, d.materials.clone()).map_err(|e| e.to_string())
 }
 
+/// [`model_of`] for a script file: its text, named by its file name, with
+/// relative data paths resolved beside it.
+pub fn model_of_file(path: &Path) -> Result<crate::Model, String> {
+    let src = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let name = path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into(),
+    );
+    model_of(&src, &name, &ScriptOptions::for_file(path))
+}
+
 /// Run a design script.
 pub fn run_script(source: &str, name: &str, opts: &ScriptOptions) -> Result<Design, ScriptError> {
     let ctx = RunContext {

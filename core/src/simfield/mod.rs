@@ -322,6 +322,9 @@ impl SimField {
     /// False when no tetrahedron or more than [`MAX_BOUND_TETS`] meet `b`.
     pub fn bounds(&self, b: &Aabb, out: &mut [Interval]) -> bool {
         let s = self.stride;
+        if s > 64 {
+            return false;
+        }
         let mut lo = [f64::INFINITY; 64];
         let mut hi = [f64::NEG_INFINITY; 64];
         let mut count = 0;
@@ -329,14 +332,14 @@ impl SimField {
             count += 1;
             for n in nodes {
                 let row = &self.values[n as usize * s..(n as usize + 1) * s];
-                for (c, v) in row.iter().enumerate().take(64) {
+                for (c, v) in row.iter().enumerate() {
                     lo[c] = lo[c].min(*v);
                     hi[c] = hi[c].max(*v);
                 }
             }
             count <= MAX_BOUND_TETS
         });
-        if !complete || count == 0 || s > 64 {
+        if !complete || count == 0 {
             return false;
         }
         let column = |c: usize| Interval::new(lo[c], hi[c]);
