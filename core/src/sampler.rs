@@ -148,6 +148,31 @@ pub struct Slab {
     pub fracs: Vec<f32>,
     /// Fractions per voxel (`Model::materials().len()`).
     pub k: usize,
+    /// With [`Sampler::with_solid_rects`]: rectangles of solid voxels that
+    /// share one fraction vector, by layer then row block. Their voxels'
+    /// entries in `fracs` are not written (they hold whatever the buffer
+    /// held); their fractions are `rect_fracs[at..at + k]`.
+    pub rects: Vec<SolidRect>,
+    /// Fraction vectors of `rects`, `k` values each.
+    pub rect_fracs: Vec<f32>,
+}
+
+/// Voxels `[x0, x0 + w) × [y0, y0 + h)` of layer `z`, all inside the part
+/// and all with the fractions at `Slab::rect_fracs[at..at + k]`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SolidRect {
+    /// Global layer.
+    pub z: usize,
+    /// First column.
+    pub x0: usize,
+    /// First row.
+    pub y0: usize,
+    /// Columns.
+    pub w: usize,
+    /// Rows.
+    pub h: usize,
+    /// Offset of its fractions in `Slab::rect_fracs`.
+    pub at: usize,
 }
 
 impl Slab {
@@ -165,6 +190,9 @@ pub struct SampleStats {
     pub evaluated: AtomicU64,
     /// Voxels filled from an interval bound without evaluation.
     pub skipped: AtomicU64,
+    /// Of those, solid voxels filled by a block through several layers
+    /// ([`Sampler::with_blocks`]).
+    pub solid_blocks: AtomicU64,
 }
 
 /// Repeat `one` (a voxel's fractions) over `run`. The usual few materials
@@ -202,17 +230,88 @@ struct Rect {
     h: usize,
 }
 
+/// Column ranges `(x0, w)` of the tiles across a row of `nx` voxels.
+fn x_tiles(nx: usize) -> impl Iterator<Item = (usize, usize)> {
+    (0..nx).step_by(TILE).map(move |x0| (x0, TILE.min(nx - x0)))
+}
+
+/// Each layer's rows of `dist` and `fracs` (`nx × ny` a layer, `k`
+/// fractions a voxel) cut into blocks of TILE rows, layer by layer: the
+/// sampler's tasks, with the layer's index in the slab.
+fn row_blocks<'b>(
+    dist: &'b mut [f32],
+    fracs: &'b mut [f32],
+    nx: usize,
+    ny: usize,
+    k: usize,
+) -> Vec<(usize, Rows<'b>)> {
+    let (layer, block) = (nx * ny, nx * TILE);
+    let mut out = Vec::new();
+    let mut frac_layers = fracs.chunks_mut((layer * k).max(1));
+    for (l, dl) in dist.chunks_mut(layer).enumerate() {
+        // No fractions (k = 0): every task gets an empty slice.
+        let next = |it: &mut std::slice::ChunksMut<'b, f32>| it.next().filter(|_| k > 0);
+        let fl = next(&mut frac_layers).unwrap_or_default();
+        let mut frac_blocks = fl.chunks_mut((block * k).max(1));
+        for (bi, d) in dl.chunks_mut(block).enumerate() {
+            let f = next(&mut frac_blocks).unwrap_or_default();
+            let rows = Rows {
+                row0: bi * TILE,
+                dist: d,
+                fracs: f,
+                k,
+                rects: Vec::new(),
+                rect_fracs: Vec::new(),
+            };
+            out.push((l, rows));
+        }
+    }
+    out
+}
+
+/// The tasks' rectangles into `rects` and `fracs`, in task order (layer, then row
+/// block: the same on any thread count), with offsets into one array.
+fn merge_rects(done: Vec<Rows>, rects: &mut Vec<SolidRect>, fracs: &mut Vec<f32>) {
+    rects.clear();
+    fracs.clear();
+    for out in done {
+        let base = fracs.len();
+        rects.extend(out.rects.into_iter().map(|r| SolidRect {
+            at: r.at + base,
+            ..r
+        }));
+        fracs.extend_from_slice(&out.rect_fracs);
+    }
+}
+
 /// A task's buffers: rows from `row0` of one layer, `k` fractions a voxel.
 struct Rows<'b> {
     row0: usize,
     dist: &'b mut [f32],
     fracs: &'b mut [f32],
     k: usize,
+    /// Solid rectangles found (with [`Sampler::with_solid_rects`]), with
+    /// their fractions `k` apiece (`at` counts from this task's first).
+    rects: Vec<SolidRect>,
+    rect_fracs: Vec<f32>,
 }
 
 /// A consumer's test on fraction bounds: true when every fraction vector
 /// within them means the same to it (a mesh export's segment label).
 pub type UniformTest<'a> = &'a (dyn Fn(&[Interval]) -> bool + Sync);
+
+/// How a tile whose distances are not evaluated gets its fractions.
+#[derive(Clone, Copy)]
+enum Fill<'f> {
+    /// Outside: all zero.
+    Outside,
+    /// Inside, one vector for every voxel.
+    Constant(&'f [f32]),
+    /// Inside, left `NaN` for a lazy consumer.
+    Lazy,
+    /// Inside, evaluated voxel by voxel.
+    Evaluate,
+}
 
 /// What fraction bounds say about a solid tile and its neighbours.
 enum Uniformity {
@@ -231,6 +330,8 @@ pub struct Sampler<'a> {
     with_fracs: bool,
     uniform: Option<UniformTest<'a>>,
     lazy: bool,
+    solid_rects: bool,
+    blocks: bool,
     /// Statistics since creation.
     pub stats: SampleStats,
 }
@@ -255,6 +356,8 @@ impl<'a> Sampler<'a> {
             with_fracs,
             uniform: None,
             lazy: false,
+            solid_rects: false,
+            blocks: false,
             stats: SampleStats::default(),
         }
     }
@@ -269,6 +372,27 @@ impl<'a> Sampler<'a> {
     /// fractions themselves.
     pub fn with_uniform(mut self, test: UniformTest<'a>) -> Self {
         self.uniform = Some(test);
+        self
+    }
+
+    /// Solid tiles whose voxels all get one fraction vector (fixed mixes,
+    /// and tiles [`Sampler::with_uniform`] proves uniform) are reported as
+    /// [`SolidRect`]s in `Slab::rects` instead of being written voxel by
+    /// voxel into `Slab::fracs`: a consumer that reads rectangles can treat
+    /// each with one classification. Distances are still written.
+    pub fn with_solid_rects(mut self) -> Self {
+        self.solid_rects = true;
+        self
+    }
+
+    /// Tiles are first tried as blocks through every layer of the slab: a
+    /// block that is empty, or solid with one fraction vector (fixed, or
+    /// uniform for [`Sampler::with_uniform`]), is filled in every layer from
+    /// one analysis instead of one per layer. Its skipped voxels store the
+    /// block's (looser) interval end, so this is for consumers that read
+    /// skipped voxels' signs only (meshes), not for distance bakes.
+    pub fn with_blocks(mut self) -> Self {
+        self.blocks = true;
         self
     }
 
@@ -298,67 +422,119 @@ impl<'a> Sampler<'a> {
         slab.k = k;
         slab.dist.resize(nx * ny * layers, 0.0);
         slab.fracs.resize(nx * ny * layers * k, 0.0);
+        if self.blocks && layers > 1 {
+            return self.sample_blocks(z0, slab, cancel);
+        }
         // Tasks: one per block of TILE rows of one layer, so no task
         // straddles a layer.
-        let layer = nx * ny;
-        let block = nx * TILE;
-        let mut tasks: Vec<(usize, usize, &mut [f32], &mut [f32])> = Vec::new();
-        let mut frac_layers = slab.fracs.chunks_mut((layer * k).max(1));
-        for (l, dl) in slab.dist.chunks_mut(layer).enumerate() {
-            let fl: &mut [f32] = if k > 0 {
-                frac_layers.next().unwrap_or_default()
-            } else {
-                &mut []
-            };
-            let mut frac_blocks = fl.chunks_mut((block * k).max(1));
-            for (bi, d) in dl.chunks_mut(block).enumerate() {
-                let f: &mut [f32] = if k > 0 {
-                    frac_blocks.next().unwrap_or_default()
-                } else {
-                    &mut []
-                };
-                tasks.push((z0 + l, bi * TILE, d, f));
-            }
-        }
-        tasks.into_par_iter().try_for_each(|(z, y0, dist, fr)| {
-            if cancel.load(Ordering::Relaxed) {
-                return Err(Cancelled);
-            }
-            let rows = dist.len() / nx;
-            self.fill_rows(z, y0, rows, dist, fr, k);
-            Ok(())
-        })
+        let done: Vec<Rows> = row_blocks(&mut slab.dist, &mut slab.fracs, nx, ny, k)
+            .into_par_iter()
+            .map(|(l, mut out)| {
+                if cancel.load(Ordering::Relaxed) {
+                    return Err(Cancelled);
+                }
+                self.fill_rows(z0 + l, &mut out);
+                Ok(out)
+            })
+            .collect::<Result<_, _>>()?;
+        merge_rects(done, &mut slab.rects, &mut slab.rect_fracs);
+        Ok(())
     }
 
-    /// Fill rows `y0..y0+rows` of layer `z`.
-    fn fill_rows(
+    /// [`Self::sample_layers`] with tasks of TILE rows through every layer
+    /// (see [`Sampler::with_blocks`]); `slab` is sized.
+    fn sample_blocks(
         &self,
-        z: usize,
+        z0: usize,
+        slab: &mut Slab,
+        cancel: &AtomicBool,
+    ) -> Result<(), Cancelled> {
+        let [nx, ny, _] = self.grid.dims;
+        let mut tasks: Vec<Vec<Rows>> = (0..ny.div_ceil(TILE)).map(|_| Vec::new()).collect();
+        for (_, out) in row_blocks(&mut slab.dist, &mut slab.fracs, nx, ny, slab.k) {
+            tasks[out.row0 / TILE].push(out);
+        }
+        let done: Vec<Vec<Rows>> = tasks
+            .into_par_iter()
+            .map(|mut outs| {
+                if cancel.load(Ordering::Relaxed) {
+                    return Err(Cancelled);
+                }
+                let (y0, h) = (outs[0].row0, outs[0].dist.len() / nx);
+                for (x0, w) in x_tiles(nx) {
+                    if !self.block(z0, x0, y0, w, h, &mut outs) {
+                        for (z, out) in (z0..).zip(outs.iter_mut()) {
+                            self.tile(Rect { z, x0, y0, w, h }, out);
+                        }
+                    }
+                }
+                Ok(outs)
+            })
+            .collect::<Result<_, _>>()?;
+        // Back to layer-major order, the order `sample_layers` gives.
+        let mut done: Vec<_> = done.into_iter().map(|d| d.into_iter()).collect();
+        let by_layer = (0..slab.layers)
+            .flat_map(|_| done.iter_mut().filter_map(|t| t.next()).collect::<Vec<_>>());
+        merge_rects(by_layer.collect(), &mut slab.rects, &mut slab.rect_fracs);
+        Ok(())
+    }
+
+    /// Columns `x0..x0 + w` of rows `y0..y0 + h` through every layer of
+    /// `outs` (from `z0`) at once, when one bound settles all of them:
+    /// empty, or solid with one fraction vector. False when it does not.
+    fn block(
+        &self,
+        z0: usize,
+        x0: usize,
         y0: usize,
-        rows: usize,
-        dist: &mut [f32],
-        fracs: &mut [f32],
-        k: usize,
-    ) {
-        let nx = self.grid.dims[0];
-        let mut out = Rows {
-            row0: y0,
-            dist,
-            fracs,
-            k,
-        };
-        let mut x0 = 0;
-        while x0 < nx {
-            let w = TILE.min(nx - x0);
-            let r = Rect {
-                z,
-                x0,
-                y0,
-                w,
-                h: rows,
+        w: usize,
+        h: usize,
+        outs: &mut [Rows],
+    ) -> bool {
+        let z1 = z0 + outs.len() - 1;
+        let k = outs[0].k;
+        let b = Aabb::new(
+            self.grid.center(x0, y0, z0),
+            self.grid.center(x0 + w - 1, y0 + h - 1, z1),
+        );
+        let margin = self.grid.voxel.length();
+        let iv = self.model.interval(&b);
+        let (value, one) = if iv.lo > margin {
+            (iv.lo as f32, None)
+        } else if iv.hi < -margin
+            && (k == 0
+                || self.model.constant_fractions(&b)
+                || matches!(self.uniformity(&b, k), Uniformity::Same))
+        {
+            let one = if k > 0 {
+                self.centre_fractions(&b, k)
+            } else {
+                [0.0; MAX_MATERIALS]
             };
-            self.tile(r, &mut out);
-            x0 += w;
+            (iv.hi as f32, Some(one))
+        } else {
+            return false;
+        };
+        if one.is_some() {
+            let n = (w * h * outs.len()) as u64;
+            self.stats.solid_blocks.fetch_add(n, Ordering::Relaxed);
+        }
+        for (z, out) in (z0..).zip(outs.iter_mut()) {
+            let how = match &one {
+                None => Fill::Outside,
+                Some(one) => Fill::Constant(&one[..k]),
+            };
+            self.fill(Rect { z, x0, y0, w, h }, out, value, how);
+        }
+        true
+    }
+
+    /// Fill `out`'s rows of layer `z`, tile by tile.
+    fn fill_rows(&self, z: usize, out: &mut Rows) {
+        let nx = self.grid.dims[0];
+        let (y0, h) = (out.row0, out.dist.len() / nx);
+        for (x0, w) in x_tiles(nx) {
+            self.tile(Rect { z, x0, y0, w, h }, out);
         }
     }
 
@@ -391,7 +567,6 @@ impl<'a> Sampler<'a> {
             None
         };
         if let Some((value, inside)) = filled {
-            let mut f = [0.0f64; MAX_MATERIALS];
             let mut constant = inside && k > 0 && self.model.constant_fractions(&b);
             if inside && k > 0 && !constant {
                 match self.uniformity(&b, k) {
@@ -402,43 +577,22 @@ impl<'a> Sampler<'a> {
                     _ => {}
                 }
             }
-            let mut one = [0.0f32; MAX_MATERIALS];
-            if constant {
-                self.model.eval_into(b.center(), &mut f[..k]);
-                for (o, v) in one.iter_mut().zip(&f[..k]) {
-                    *o = *v as f32;
-                }
-            }
-            // Lazy only where the consumer will be able to bound them.
-            let lazy = inside && !constant && self.lazy && self.bounded(&b, k);
-            for y in y0..y0 + h {
-                let row = (y - row0) * nx;
-                out.dist[row + x0..row + x0 + w].fill(value);
-                if k == 0 {
-                    continue;
-                }
-                // Whole runs at once where every voxel gets the same
-                // fractions (a per-voxel `fill` was a library call each).
-                let run = &mut out.fracs[(row + x0) * k..(row + x0 + w) * k];
-                if !inside {
-                    run.fill(0.0);
-                } else if lazy {
-                    run.fill(f32::NAN);
-                } else if constant {
-                    fill_pattern(run, &one[..k]);
-                } else {
-                    for (x, voxel) in (x0..).zip(run.chunks_exact_mut(k)) {
-                        let p = self.grid.center(x, y, z);
-                        self.model.fractions_inside(p, &mut f[..k]);
-                        for (o, v) in voxel.iter_mut().zip(&f[..k]) {
-                            *o = *v as f32;
-                        }
-                    }
-                }
-            }
-            self.stats
-                .skipped
-                .fetch_add((w * h) as u64, Ordering::Relaxed);
+            let one = if constant {
+                self.centre_fractions(&b, k)
+            } else {
+                [0.0; MAX_MATERIALS]
+            };
+            let how = if !inside {
+                Fill::Outside
+            } else if constant {
+                Fill::Constant(&one[..k])
+            } else if self.lazy && self.bounded(&b, k) {
+                // Lazy only where the consumer will be able to bound them.
+                Fill::Lazy
+            } else {
+                Fill::Evaluate
+            };
+            self.fill(r, out, value, how);
             return;
         }
         if w > LEAF || h > LEAF {
@@ -464,6 +618,64 @@ impl<'a> Sampler<'a> {
             .evaluated
             .fetch_add((w * h) as u64, Ordering::Relaxed);
     }
+    /// Fractions at the centre of `b`, as stored.
+    fn centre_fractions(&self, b: &Aabb, k: usize) -> [f32; MAX_MATERIALS] {
+        let mut f = [0.0f64; MAX_MATERIALS];
+        self.model.eval_into(b.center(), &mut f[..k]);
+        let mut one = [0.0f32; MAX_MATERIALS];
+        for (o, v) in one.iter_mut().zip(&f[..k]) {
+            *o = *v as f32;
+        }
+        one
+    }
+
+    /// Write tile `r` without evaluating distances: `value` everywhere,
+    /// fractions as `how` says.
+    fn fill(&self, r: Rect, out: &mut Rows, value: f32, how: Fill<'_>) {
+        let Rect { z, x0, y0, w, h } = r;
+        let (k, row0, nx) = (out.k, out.row0, self.grid.dims[0]);
+        let as_rect = k > 0 && self.solid_rects && matches!(how, Fill::Constant(_));
+        if let (true, Fill::Constant(one)) = (as_rect, how) {
+            out.rects.push(SolidRect {
+                z,
+                x0,
+                y0,
+                w,
+                h,
+                at: out.rect_fracs.len(),
+            });
+            out.rect_fracs.extend_from_slice(one);
+        }
+        let mut f = [0.0f64; MAX_MATERIALS];
+        for y in y0..y0 + h {
+            let row = (y - row0) * nx;
+            out.dist[row + x0..row + x0 + w].fill(value);
+            if k == 0 || as_rect {
+                continue;
+            }
+            // Whole runs at once where every voxel gets the same
+            // fractions (a per-voxel `fill` was a library call each).
+            let run = &mut out.fracs[(row + x0) * k..(row + x0 + w) * k];
+            match how {
+                Fill::Outside => run.fill(0.0),
+                Fill::Lazy => run.fill(f32::NAN),
+                Fill::Constant(one) => fill_pattern(run, one),
+                Fill::Evaluate => {
+                    for (x, voxel) in (x0..).zip(run.chunks_exact_mut(k)) {
+                        let p = self.grid.center(x, y, z);
+                        self.model.fractions_inside(p, &mut f[..k]);
+                        for (o, v) in voxel.iter_mut().zip(&f[..k]) {
+                            *o = *v as f32;
+                        }
+                    }
+                }
+            }
+        }
+        self.stats
+            .skipped
+            .fetch_add((w * h) as u64, Ordering::Relaxed);
+    }
+
     /// Refine a tile as four quarters.
     fn split(&self, r: Rect, out: &mut Rows) {
         let (hw, hh) = (r.w.div_ceil(2), r.h.div_ceil(2));

@@ -15,7 +15,7 @@
 
 use rayon::prelude::*;
 use volcad_core::interval::Interval;
-use volcad_core::sampler::Slab;
+use volcad_core::sampler::{Slab, SolidRect};
 
 use super::contour::{Interface, Plane};
 use crate::dither::{BOUND_MARGIN as EPS, MIN_TOTAL};
@@ -145,6 +145,51 @@ impl Classifier {
         }
     }
 
+    /// Labels, values and tallies of the voxels `xs` of one row, one by one
+    /// (`dist` and `fracs` of the row, `k` fractions a voxel).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn voxels(
+        &self,
+        dist: &[f32],
+        fracs: &[f32],
+        k: usize,
+        xs: std::ops::Range<usize>,
+        labels: &mut [u16],
+        values: &mut [f32],
+        t: &mut Tally,
+    ) {
+        let stride = values.len() / labels.len();
+        // The last inside voxel classified in this run: solid regions with
+        // constant fractions repeat it voxel after voxel, and comparing k
+        // bit patterns is cheaper than normalising (the result is the same
+        // bit for bit).
+        let mut last: Option<(usize, u16, f32)> = None;
+        for x in xs {
+            if dist[x] > 0.0 {
+                continue;
+            }
+            let fv = &fracs[x * k..(x + 1) * k];
+            let (lab, f) = match last {
+                Some((u, lab, f)) if same_bits(&fracs[u * k..][..k], fv) => {
+                    if stride == 1 {
+                        values[x] = values[u];
+                    } else {
+                        values.copy_within(u * stride..(u + 1) * stride, x * stride);
+                    }
+                    (lab, f)
+                }
+                _ => self.classify(fv, &mut values[x * stride..(x + 1) * stride]),
+            };
+            last = Some((x, lab, f));
+            labels[x] = lab;
+            if lab > 0 {
+                t.voxels[lab as usize - 1] += 1;
+                t.sum_f[lab as usize - 1] += f64::from(f);
+            }
+        }
+    }
+
     /// The plane of labels for layer `l` of `slab` (grid `[nx, ny, nz]`,
     /// global layer `z`), with its tallies.
     pub fn plane(&self, slab: &Slab, l: usize, dims: [usize; 3], z: usize) -> (Plane, Tally) {
@@ -179,6 +224,7 @@ impl Classifier {
         value.resize(layer * stride, 0.0);
         let segments = self.segments();
         let edge_plane = z == 0 || z + 1 == nz;
+        let runs = self.solid_runs(slab, z, nx, ny);
         let tallies: Vec<Tally> = label
             .par_chunks_mut(nx)
             .zip(value.par_chunks_mut(nx * stride))
@@ -188,35 +234,35 @@ impl Classifier {
                 if edge_plane || y == 0 || y + 1 == ny {
                     return t;
                 }
-                // The last inside voxel classified in this row: solid
-                // regions with constant fractions repeat it voxel after
-                // voxel, and comparing k bit patterns is cheaper than
-                // normalising (the result is the same bit for bit).
-                let mut last: Option<(usize, u16, f32)> = None;
-                for x in 1..nx - 1 {
-                    let v = y * nx + x;
-                    if dist[v] > 0.0 {
+                let row = &dist[y * nx..(y + 1) * nx];
+                let fracs = &fracs[y * nx * k..(y + 1) * nx * k];
+                let mut x = 1;
+                for sp in runs.row(y) {
+                    let (a, b) = (sp.x0.max(x), sp.x1.min(nx - 1));
+                    if a >= b {
                         continue;
                     }
-                    let fv = &fracs[v * k..(v + 1) * k];
-                    let (lab, f) = match last {
-                        Some((u, lab, f)) if same_bits(&fracs[(y * nx + u) * k..][..k], fv) => {
-                            if stride == 1 {
-                                values[x] = values[u];
-                            } else {
-                                values.copy_within(u * stride..(u + 1) * stride, x * stride);
-                            }
-                            (lab, f)
+                    self.voxels(row, fracs, k, x..a, labels, values, &mut t);
+                    // The run's voxels are inside and share its rectangle's
+                    // fractions, classified once.
+                    let (lab, fv) = runs.classes[sp.rect];
+                    let v = &runs.values[sp.rect * stride..(sp.rect + 1) * stride];
+                    labels[a..b].fill(lab);
+                    if stride == 1 {
+                        values[a..b].fill(v[0]);
+                    } else {
+                        for out in values[a * stride..b * stride].chunks_exact_mut(stride) {
+                            out.copy_from_slice(v);
                         }
-                        _ => self.classify(fv, &mut values[x * stride..(x + 1) * stride]),
-                    };
-                    last = Some((x, lab, f));
-                    labels[x] = lab;
-                    if lab > 0 {
-                        t.voxels[lab as usize - 1] += 1;
-                        t.sum_f[lab as usize - 1] += f64::from(f);
                     }
+                    if lab > 0 {
+                        let n = (b - a) as u64;
+                        t.voxels[lab as usize - 1] += n;
+                        t.sum_f[lab as usize - 1] += f64::from(fv) * n as f64;
+                    }
+                    x = b;
                 }
+                self.voxels(row, fracs, k, x..nx - 1, labels, values, &mut t);
                 t
             })
             .collect();
@@ -225,6 +271,85 @@ impl Classifier {
             tally.add(t);
         }
         (Plane { label, dist, value }, tally)
+    }
+}
+
+/// One row's run of a [`SolidRect`]: columns `x0..x1`, rectangle `rect`.
+#[derive(Clone, Copy, Debug, Default)]
+struct Span {
+    x0: usize,
+    x1: usize,
+    rect: usize,
+}
+
+/// The runs of one layer's solid rectangles, row by row, and each
+/// rectangle's classification (label, classifying fraction, values).
+struct SolidRuns {
+    /// Row `y`'s runs are `spans[first[y]..first[y + 1]]`, by column.
+    first: Vec<usize>,
+    spans: Vec<Span>,
+    classes: Vec<(u16, f32)>,
+    values: Vec<f32>,
+}
+
+impl SolidRuns {
+    fn row(&self, y: usize) -> &[Span] {
+        &self.spans[self.first[y]..self.first[y + 1]]
+    }
+}
+
+impl Classifier {
+    /// [`SolidRuns`] of layer `z` of `slab` (`nx × ny`).
+    fn solid_runs(&self, slab: &Slab, z: usize, nx: usize, ny: usize) -> SolidRuns {
+        let (k, stride) = (slab.k, self.interface().stride());
+        // The sampler lists rectangles by layer.
+        let lo = slab.rects.partition_point(|r| r.z < z);
+        let hi = slab.rects.partition_point(|r| r.z <= z);
+        let rects = &slab.rects[lo..hi];
+        let mut values = vec![0.0; rects.len() * stride];
+        let classes = (rects.iter().enumerate())
+            .map(|(i, r)| {
+                let f = &slab.rect_fracs[r.at..r.at + k];
+                self.classify(f, &mut values[i * stride..(i + 1) * stride])
+            })
+            .collect();
+        // Counting sort by row. Within a row the sampler's order (tiles left
+        // to right, quadrants left before right) is already by column; the
+        // check below keeps that an optimisation, not an assumption.
+        let rows = |r: &SolidRect| r.y0.min(ny)..(r.y0 + r.h).min(ny);
+        let mut first = vec![0usize; ny + 1];
+        for r in rects {
+            for y in rows(r) {
+                first[y + 1] += 1;
+            }
+        }
+        for y in 0..ny {
+            first[y + 1] += first[y];
+        }
+        let mut fill = first.clone();
+        let mut spans = vec![Span::default(); first[ny]];
+        for (i, r) in rects.iter().enumerate() {
+            for y in rows(r) {
+                spans[fill[y]] = Span {
+                    x0: r.x0,
+                    x1: (r.x0 + r.w).min(nx),
+                    rect: i,
+                };
+                fill[y] += 1;
+            }
+        }
+        for y in 0..ny {
+            let row = &mut spans[first[y]..first[y + 1]];
+            if !row.is_sorted_by_key(|s| s.x0) {
+                row.sort_unstable_by_key(|s| s.x0);
+            }
+        }
+        SolidRuns {
+            first,
+            spans,
+            classes,
+            values,
+        }
     }
 }
 
