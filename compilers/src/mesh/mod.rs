@@ -735,8 +735,12 @@ mod tests {
             let mut z0 = 0;
             while z0 < dims[2] {
                 let z1 = (z0 + 7).min(dims[2]);
-                plain.sample_layers(z0, z1, &mut a, &cancel).expect("sample");
-                blocks.sample_layers(z0, z1, &mut b, &cancel).expect("sample");
+                plain
+                    .sample_layers(z0, z1, &mut a, &cancel)
+                    .expect("sample");
+                blocks
+                    .sample_layers(z0, z1, &mut b, &cancel)
+                    .expect("sample");
                 for z in z0..z1 {
                     let (la, ta) = pl.classifier.plane(&a, z - z0, dims, z);
                     let (lb, tb) = pl.classifier.plane(&b, z - z0, dims, z);
@@ -748,7 +752,10 @@ mod tests {
             // Solid blocks were used (so the comparison tested them).
             let solid = blocks.stats.solid_blocks.load(Ordering::Relaxed) as usize;
             let all = dims[0] * dims[1] * dims[2];
-            assert!(solid > all / n, "{src}: {solid} of {all} voxels in solid blocks");
+            assert!(
+                solid > all / n,
+                "{src}: {solid} of {all} voxels in solid blocks"
+            );
         }
     }
 }
