@@ -158,14 +158,10 @@ mod tests {
 
     use glam::DVec3;
     use volcad_core::sampler::{Sampler, Slab};
-    use volcad_core::script::{ScriptOptions, model_of, model_of_file};
+    use volcad_core::script::model_of_file;
 
     use super::*;
-
-    fn inline(src: &str) -> Model {
-        let src = format!("let m = default_materials();\n{src}");
-        model_of(&src, "t.rhai", &ScriptOptions::default()).expect("design")
-    }
+    use crate::mesh::tests::model;
 
     /// Codes of every layer of `m` at `voxel`, sampling every voxel and
     /// lazily: they must be equal.
@@ -209,7 +205,7 @@ mod tests {
             r#"FGrade(["x", "0"], [m.id("red"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(6,4,4), m.id("gray")))"#,
         ];
         for src in designs {
-            let m = inline(src);
+            let m = model(src);
             for seed in [1, 99] {
                 let (marked, evaluated, inside) = compare(&m, 0.1, seed);
                 assert!(marked > inside / 4, "{src}: {marked} of {inside} lazy");
@@ -219,7 +215,7 @@ mod tests {
         // The graded bar at 0.05 mm (a run is 1.6 mm, a tenth of the
         // grading): bounds settle about nine lazy voxels in ten. Bounding
         // running sums and the total apart left a third open.
-        let bar = inline(designs[0]);
+        let bar = model(designs[0]);
         let (marked, evaluated, _) = compare(&bar, 0.05, 1);
         eprintln!("graded bar at 0.05 mm: {evaluated} of {marked} lazy voxels evaluated");
         assert!(evaluated * 8 < marked, "{evaluated} of {marked} evaluated");

@@ -247,10 +247,10 @@ fn row_blocks<'b>(
 ) -> Vec<(usize, Rows<'b>)> {
     let (layer, block) = (nx * ny, nx * TILE);
     let mut out = Vec::new();
+    // No fractions (k = 0): every task gets an empty slice.
+    let next = |it: &mut std::slice::ChunksMut<'b, f32>| it.next().filter(|_| k > 0);
     let mut frac_layers = fracs.chunks_mut((layer * k).max(1));
     for (l, dl) in dist.chunks_mut(layer).enumerate() {
-        // No fractions (k = 0): every task gets an empty slice.
-        let next = |it: &mut std::slice::ChunksMut<'b, f32>| it.next().filter(|_| k > 0);
         let fl = next(&mut frac_layers).unwrap_or_default();
         let mut frac_blocks = fl.chunks_mut((block * k).max(1));
         for (bi, d) in dl.chunks_mut(block).enumerate() {
@@ -299,6 +299,23 @@ struct Rows<'b> {
 /// A consumer's test on fraction bounds: true when every fraction vector
 /// within them means the same to it (a mesh export's segment label).
 pub type UniformTest<'a> = &'a (dyn Fn(&[Interval]) -> bool + Sync);
+
+/// What bounds settle about a box of voxel centres ([`Sampler::settle`]).
+enum Settled {
+    /// The surface may be near: evaluate (or split).
+    Open,
+    /// Every voxel is outside; the value to store.
+    Outside(f32),
+    /// Every voxel is inside; the value to store, whether they may all
+    /// take the centre's fractions (fixed, or uniform for the consumer),
+    /// and whether the consumer's test found them mixed (smaller boxes may
+    /// settle).
+    Solid {
+        value: f32,
+        constant: bool,
+        mixed: bool,
+    },
+}
 
 /// How a tile whose distances are not evaluated gets its fractions.
 #[derive(Clone, Copy)]
@@ -497,23 +514,14 @@ impl<'a> Sampler<'a> {
             self.grid.center(x0, y0, z0),
             self.grid.center(x0 + w - 1, y0 + h - 1, z1),
         );
-        let margin = self.grid.voxel.length();
-        let iv = self.model.interval(&b);
-        let (value, one) = if iv.lo > margin {
-            (iv.lo as f32, None)
-        } else if iv.hi < -margin
-            && (k == 0
-                || self.model.constant_fractions(&b)
-                || matches!(self.uniformity(&b, k), Uniformity::Same))
-        {
-            let one = if k > 0 {
-                self.centre_fractions(&b, k)
-            } else {
-                [0.0; MAX_MATERIALS]
-            };
-            (iv.hi as f32, Some(one))
-        } else {
-            return false;
+        // Only what one vector settles for every layer: no lazy or
+        // per-voxel fractions, no quadtree split across layers.
+        let (value, one) = match self.settle(&b, k) {
+            Settled::Outside(value) => (value, None),
+            Settled::Solid {
+                value, constant, ..
+            } if constant || k == 0 => (value, Some(self.centre_fractions(&b, k))),
+            _ => return false,
         };
         if one.is_some() {
             let n = (w * h * outs.len()) as u64;
@@ -557,43 +565,30 @@ impl<'a> Sampler<'a> {
         let row0 = out.row0;
         let nx = self.grid.dims[0];
         let b = self.grid.centres_box(x0, x0 + w - 1, y0, y0 + h - 1, z);
-        let margin = self.grid.voxel.length();
-        let iv = self.model.interval(&b);
-        let filled = if iv.lo > margin {
-            Some((iv.lo as f32, false))
-        } else if iv.hi < -margin {
-            Some((iv.hi as f32, true))
-        } else {
-            None
-        };
-        if let Some((value, inside)) = filled {
-            let mut constant = inside && k > 0 && self.model.constant_fractions(&b);
-            if inside && k > 0 && !constant {
-                match self.uniformity(&b, k) {
-                    Uniformity::Same => constant = true,
-                    Uniformity::Mixed if w > LEAF || h > LEAF => {
-                        return self.split(r, out);
-                    }
-                    _ => {}
-                }
+        match self.settle(&b, k) {
+            Settled::Open => {}
+            Settled::Outside(value) => return self.fill(r, out, value, Fill::Outside),
+            Settled::Solid { mixed: true, .. } if w > LEAF || h > LEAF => {
+                return self.split(r, out);
             }
-            let one = if constant {
-                self.centre_fractions(&b, k)
-            } else {
-                [0.0; MAX_MATERIALS]
-            };
-            let how = if !inside {
-                Fill::Outside
-            } else if constant {
-                Fill::Constant(&one[..k])
-            } else if self.lazy && self.bounded(&b, k) {
-                // Lazy only where the consumer will be able to bound them.
-                Fill::Lazy
-            } else {
-                Fill::Evaluate
-            };
-            self.fill(r, out, value, how);
-            return;
+            Settled::Solid {
+                value, constant, ..
+            } => {
+                let one = if constant {
+                    self.centre_fractions(&b, k)
+                } else {
+                    [0.0; MAX_MATERIALS]
+                };
+                let how = if constant {
+                    Fill::Constant(&one[..k])
+                } else if self.lazy && self.bounded(&b, k) {
+                    // Lazy only where the consumer will be able to bound them.
+                    Fill::Lazy
+                } else {
+                    Fill::Evaluate
+                };
+                return self.fill(r, out, value, how);
+            }
         }
         if w > LEAF || h > LEAF {
             return self.split(r, out);
@@ -618,10 +613,43 @@ impl<'a> Sampler<'a> {
             .evaluated
             .fetch_add((w * h) as u64, Ordering::Relaxed);
     }
+    /// What the bounds say about the voxel centres in `b` (`k` fractions).
+    /// Beyond one voxel diagonal from the surface no grid edge that touches
+    /// a voxel is crossed, so its distance need not be evaluated.
+    fn settle(&self, b: &Aabb, k: usize) -> Settled {
+        let margin = self.grid.voxel.length();
+        let iv = self.model.interval(b);
+        if iv.lo > margin {
+            return Settled::Outside(iv.lo as f32);
+        }
+        if iv.hi.is_nan() || iv.hi >= -margin {
+            return Settled::Open;
+        }
+        let mut mixed = false;
+        let constant = k > 0
+            && (self.model.constant_fractions(b)
+                || match self.uniformity(b, k) {
+                    Uniformity::Same => true,
+                    Uniformity::Mixed => {
+                        mixed = true;
+                        false
+                    }
+                    Uniformity::Unknown => false,
+                });
+        Settled::Solid {
+            value: iv.hi as f32,
+            constant,
+            mixed,
+        }
+    }
+
     /// Fractions at the centre of `b`, as stored.
+    /// Nothing is evaluated for `k = 0`.
     fn centre_fractions(&self, b: &Aabb, k: usize) -> [f32; MAX_MATERIALS] {
         let mut f = [0.0f64; MAX_MATERIALS];
-        self.model.eval_into(b.center(), &mut f[..k]);
+        if k > 0 {
+            self.model.eval_into(b.center(), &mut f[..k]);
+        }
         let mut one = [0.0f32; MAX_MATERIALS];
         for (o, v) in one.iter_mut().zip(&f[..k]) {
             *o = *v as f32;

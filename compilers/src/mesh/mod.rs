@@ -571,13 +571,15 @@ fn summary(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use volcad_core::script::{ScriptOptions, model_of, model_of_file};
 
     use super::*;
     use std::sync::atomic::Ordering;
 
-    fn model(src: &str) -> Model {
+    /// `src` after `let m = default_materials();`, run and prepared (shared
+    /// by the crate's test modules).
+    pub(crate) fn model(src: &str) -> Model {
         let src = format!("let m = default_materials();\n{src}");
         model_of(&src, "t.rhai", &ScriptOptions::default()).expect("design")
     }

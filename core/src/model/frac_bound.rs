@@ -171,12 +171,7 @@ mod tests {
 
     use super::*;
     use crate::Model;
-    use crate::script::{ScriptOptions, model_of};
-
-    fn model(src: &str) -> Model {
-        let src = format!("let m = default_materials();\n{src}");
-        model_of(&src, "t.rhai", &ScriptOptions::default()).expect("design")
-    }
+    use crate::model::tests::model;
 
     /// Every inside sample of random boxes has fractions within the
     /// bounds; returns how many inside samples were checked.

@@ -17,7 +17,7 @@ mod tpms;
 mod union_index;
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};

@@ -8,7 +8,9 @@ use crate::Model;
 use crate::bounds::Aabb;
 use crate::script::{ScriptOptions, model_of, run_script};
 
-fn model(src: &str) -> Model {
+/// `src` after `let m = default_materials();`, run and prepared (shared by
+/// the model's test modules).
+pub(crate) fn model(src: &str) -> Model {
     let src = format!("let m = default_materials();\n{src}");
     model_of(&src, "t.rhai", &ScriptOptions::default()).unwrap_or_else(|e| panic!("{e}"))
 }
