@@ -273,20 +273,25 @@ fn export_png_mesh_and_fea() {
             .any(|f| f.ends_with(".stl") || f.ends_with(".obj")),
         "{files:?}"
     );
-    let bad = volcad(&[
-        "export",
-        "mesh",
-        &example("graded_bar.rhai"),
-        "--out",
-        d.join("bad").to_str().unwrap(),
-        "--voxel",
-        "0.5",
-        "--formats",
-        "stl,ply",
-    ]);
-    assert!(!bad.status.success());
-    assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown format `ply`"));
-    assert!(!d.join("bad").exists());
+    // Bad mesh options are refused before any work, with what was wrong.
+    let bar = example("graded_bar.rhai");
+    let bad_dir = d.join("bad");
+    let refused = |extra: &[&str]| {
+        let mut args = vec!["export", "mesh", &bar, "--out", bad_dir.to_str().unwrap()];
+        args.extend(["--voxel", "0.5"]);
+        args.extend(extra);
+        let out = volcad(&args);
+        assert!(!out.status.success(), "{extra:?}");
+        assert!(!bad_dir.exists(), "{extra:?}");
+        String::from_utf8_lossy(&out.stderr).to_string()
+    };
+    assert!(refused(&["--formats", "stl,ply"]).contains("unknown format `ply`"));
+    // A range count without a material to split by would be ignored.
+    let err = refused(&["--segments", "4"]);
+    assert!(
+        err.contains("--segments 4") && err.contains("--by red"),
+        "{err}"
+    );
 
     let fea = d.join("fea");
     ok(&volcad(&[

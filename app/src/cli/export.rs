@@ -60,9 +60,9 @@ pub struct ExportArgs {
     /// png: also write 1-bit stacks, one folder per material.
     #[arg(long)]
     pub bitmaps: bool,
-    /// mesh: number of fraction ranges.
-    #[arg(long, default_value_t = 4)]
-    pub segments: usize,
+    /// mesh: number of fraction ranges with `--by MATERIAL` (default 4).
+    #[arg(long)]
+    pub segments: Option<usize>,
     /// mesh: material whose fraction splits the part, or `dominant`.
     #[arg(long)]
     pub by: Option<String>,
@@ -213,9 +213,23 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
                 None | Some("dominant") => SegmentBy::Dominant,
                 Some(name) => SegmentBy::Material(model.table().id(name).context("--by")?),
             };
+            // Dominant segments are one per material: a range count would
+            // be silently ignored, and the files would not be what was asked.
+            if let (SegmentBy::Dominant, Some(n)) = (by, a.segments) {
+                bail!(
+                    "--segments {n}: ranges split one material's fraction; add --by MATERIAL \
+                     (for example --by {}), or leave --segments out for one segment per \
+                     dominant material",
+                    model
+                        .materials()
+                        .first()
+                        .map(|&id| model.table().name(id).to_string())
+                        .unwrap_or_else(|| "red".into())
+                );
+            }
             let p = MeshParams {
                 voxel: voxel.context("--voxel is required for mesh (e.g. --voxel 0.25)")?,
-                segments: a.segments,
+                segments: a.segments.unwrap_or(MeshParams::default().segments),
                 by,
                 formats: parse_formats(&a.formats)?,
                 infill_expr: a.infill.clone(),

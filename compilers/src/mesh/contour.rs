@@ -175,6 +175,11 @@ pub struct Contourer {
     /// cubes that have one.
     prev_flat: Vec<u32>,
     prev_list: Vec<(usize, u8)>,
+    /// The layer table before that, reset to [`NOT_FLAT`] where it was set
+    /// (a sparse reset), and an empty list: reused, so a layer does not
+    /// allocate and fill a fresh table the size of a plane.
+    spare_flat: Vec<u32>,
+    spare_list: Vec<(usize, u8)>,
 }
 
 impl Contourer {
@@ -192,6 +197,8 @@ impl Contourer {
             regions: Regions::new(iface.stride()),
             prev_flat: Vec::new(),
             prev_list: Vec::new(),
+            spare_flat: Vec::new(),
+            spare_list: Vec::new(),
         }
     }
 
@@ -353,9 +360,12 @@ impl Contourer {
     fn flat_layer(&mut self, pz: usize, lo: &Plane, hi: &Plane, flats: Vec<BandFlats>) {
         let [nx, ny, _] = self.grid.dims;
         let (cw, ch) = (nx - 1, ny - 1);
-        let mut cur = vec![NOT_FLAT; cw * ch];
+        let mut cur = std::mem::take(&mut self.spare_flat);
+        if cur.len() != cw * ch {
+            cur = vec![NOT_FLAT; cw * ch];
+        }
         // (cube, corners labelled x as a bit mask)
-        let mut list = Vec::new();
+        let mut list = std::mem::take(&mut self.spare_list);
         for band in flats {
             let first = self
                 .regions
@@ -396,7 +406,8 @@ impl Contourer {
             }
         }
         // Top faces of the layer below, against this layer's cubes.
-        for (c, mask) in std::mem::take(&mut self.prev_list) {
+        let below = std::mem::take(&mut self.prev_list);
+        for &(c, mask) in &below {
             let id = self.prev_flat[c];
             if !face_cut(mask, 2, 1)
                 || (cur[c] != NOT_FLAT && self.regions.key(cur[c]) == self.regions.key(id))
@@ -406,7 +417,13 @@ impl Contourer {
             let cube = self.cube([c % cw, c / cw, pz], lo, hi);
             self.outline(pz, id, &cube, 2, 0, true);
         }
-        self.prev_flat = cur;
+        let mut old = std::mem::replace(&mut self.prev_flat, cur);
+        for &(c, _) in &below {
+            old[c] = NOT_FLAT;
+        }
+        self.spare_flat = old;
+        self.spare_list = below;
+        self.spare_list.clear();
         self.prev_list = list;
     }
 
