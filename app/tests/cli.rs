@@ -292,6 +292,12 @@ fn export_png_mesh_and_fea() {
         err.contains("--segments 4") && err.contains("--by red"),
         "{err}"
     );
+    // Options of another export kind would be ignored: refused, by name.
+    let err = refused(&["--dither", "diffusion", "--element", "c3d4"]);
+    assert!(
+        err.contains("--dither, --element do not apply to `volcad export mesh`"),
+        "{err}"
+    );
 
     let fea = d.join("fea");
     ok(&volcad(&[

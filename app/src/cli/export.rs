@@ -54,9 +54,9 @@ pub struct ExportArgs {
     /// png: only layers A..B (global indices kept in file names).
     #[arg(long)]
     pub layers: Option<String>,
-    /// png: random or diffusion.
-    #[arg(long, default_value = "random")]
-    pub dither: String,
+    /// png: random (default) or diffusion.
+    #[arg(long)]
+    pub dither: Option<String>,
     /// png: also write 1-bit stacks, one folder per material.
     #[arg(long)]
     pub bitmaps: bool,
@@ -69,12 +69,12 @@ pub struct ExportArgs {
     /// mesh: 3MF infill percent as a math string of f (the segment's mid fraction).
     #[arg(long)]
     pub infill: Option<String>,
-    /// mesh: files to write, a comma list of stl, obj, 3mf.
-    #[arg(long, default_value = "stl,obj,3mf")]
-    pub formats: String,
-    /// fea: c3d8r (bricks) or c3d4 (adaptive tets).
-    #[arg(long, default_value = "c3d8r")]
-    pub element: String,
+    /// mesh: files to write, a comma list of stl, obj, 3mf (default: all three).
+    #[arg(long)]
+    pub formats: Option<String>,
+    /// fea: c3d8r (bricks, the default) or c3d4 (adaptive tets).
+    #[arg(long)]
+    pub element: Option<String>,
     /// fea: smallest tet cell (mm).
     #[arg(long)]
     pub min_cell: Option<f64>,
@@ -148,8 +148,43 @@ fn parse_formats(s: &str) -> anyhow::Result<MeshFormats> {
     Ok(f)
 }
 
+/// The options given that belong to another kind of export than `a.kind`.
+fn foreign_options(a: &ExportArgs) -> Vec<&'static str> {
+    let given = [
+        ("--layers", a.layers.is_some(), Kind::Png),
+        ("--dither", a.dither.is_some(), Kind::Png),
+        ("--bitmaps", a.bitmaps, Kind::Png),
+        ("--segments", a.segments.is_some(), Kind::Mesh),
+        ("--by", a.by.is_some(), Kind::Mesh),
+        ("--infill", a.infill.is_some(), Kind::Mesh),
+        ("--formats", a.formats.is_some(), Kind::Mesh),
+        ("--element", a.element.is_some(), Kind::Fea),
+        ("--min-cell", a.min_cell.is_some(), Kind::Fea),
+        ("--max-cell", a.max_cell.is_some(), Kind::Fea),
+        ("--sizing", a.sizing.is_some(), Kind::Fea),
+        ("--step", a.step.is_some(), Kind::Fea),
+    ];
+    given
+        .iter()
+        .filter(|(_, on, kind)| *on && *kind != a.kind)
+        .map(|(name, ..)| *name)
+        .collect()
+}
+
 /// Run `volcad export`.
 pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
+    // Options of another export kind would be ignored, and the files would
+    // not be what the command line asked for: refuse them before any work.
+    let foreign = foreign_options(a);
+    if !foreign.is_empty() {
+        let kind = format!("{:?}", a.kind).to_lowercase();
+        bail!(
+            "{} {} not apply to `volcad export {kind}`; see `volcad export --help` for which \
+             export each option belongs to",
+            foreign.join(", "),
+            if foreign.len() == 1 { "does" } else { "do" }
+        );
+    }
     let l = load_design(&a.design)?;
     let model = l.model.clone();
     let voxel = match (&a.voxel, &a.preset) {
@@ -179,7 +214,7 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
     let dest = a.out.clone();
     let handle = match a.kind {
         Kind::Png => {
-            let dither = match a.dither.as_str() {
+            let dither = match a.dither.as_deref().unwrap_or("random") {
                 "random" => Dither::Random,
                 "diffusion" => Dither::Diffusion,
                 d => bail!("--dither {d}: expected random or diffusion"),
@@ -231,7 +266,7 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
                 voxel: voxel.context("--voxel is required for mesh (e.g. --voxel 0.25)")?,
                 segments: a.segments.unwrap_or(MeshParams::default().segments),
                 by,
-                formats: parse_formats(&a.formats)?,
+                formats: parse_formats(a.formats.as_deref().unwrap_or("stl,obj,3mf"))?,
                 infill_expr: a.infill.clone(),
                 threads,
             };
@@ -240,7 +275,7 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
             })
         }
         Kind::Fea => {
-            let element = match a.element.as_str() {
+            let element = match a.element.as_deref().unwrap_or("c3d8r") {
                 "c3d8r" | "C3D8R" => Element::C3D8R,
                 "c3d4" | "C3D4" => Element::C3D4,
                 e => bail!("--element {e}: expected c3d8r or c3d4"),
