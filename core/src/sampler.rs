@@ -195,11 +195,12 @@ pub struct SampleStats {
     pub solid_blocks: AtomicU64,
 }
 
-/// Repeat `one` (a voxel's fractions) over `run`. The usual few materials
-/// get a fixed-size copy the compiler turns into plain stores; a copy of
-/// run-time length was a library call per voxel (a tenth of a graded mesh
-/// export).
-fn fill_pattern(run: &mut [f32], one: &[f32]) {
+/// Repeat `one` (a voxel's fractions, or a mesh label's interface values)
+/// over `run`. The usual few materials get a fixed-size copy the compiler
+/// turns into plain stores; a copy of run-time length was a library call
+/// per voxel (a tenth of a graded mesh export). An empty `one` writes
+/// nothing.
+pub fn fill_pattern(run: &mut [f32], one: &[f32]) {
     fn fixed<const K: usize>(run: &mut [f32], one: &[f32]) {
         let mut p = [0.0; K];
         p.copy_from_slice(one);
@@ -208,6 +209,7 @@ fn fill_pattern(run: &mut [f32], one: &[f32]) {
         }
     }
     match one.len() {
+        0 => {}
         1 => run.fill(one[0]),
         2 => fixed::<2>(run, one),
         3 => fixed::<3>(run, one),
