@@ -140,6 +140,28 @@ fn bad_input_is_a_clear_error() {
     assert!(err.contains("bad.rhai:2:"), "{err}");
     assert!(err.contains("did you mean \"red\""), "{err}");
 
+    // Parameters: a typo or a value outside the declared range is refused,
+    // not ignored or clamped.
+    let lattice = example("bcc_sphere.rhai");
+    let err = fails(&volcad(&["info", &lattice, "--param", "strut_radiu=0.3"]));
+    assert!(
+        err.contains("declares no parameter `strut_radiu`; did you mean `strut_radius`?"),
+        "{err}"
+    );
+    let err = fails(&volcad(&["info", &lattice, "--param", "strut_radius=9"]));
+    assert!(
+        err.contains("--param strut_radius=9: outside the range"),
+        "{err}"
+    );
+    let err = fails(&volcad(&[
+        "eval",
+        &example("hello_cube.rhai"),
+        "nan",
+        "0",
+        "0",
+    ]));
+    assert!(err.contains("X = NaN: give a finite coordinate"), "{err}");
+
     let pts = d.join("pts.csv");
     std::fs::write(&pts, "x,y,z\n1,2,3\n1,oops,3\n").unwrap();
     let err = fails(&volcad(&[

@@ -6,7 +6,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
 use volcad_core::Model;
-use volcad_core::script::{Design, ScriptOptions, run_script};
+use volcad_core::material::edit_distance;
+use volcad_core::script::{Design, Param, ScriptOptions, run_script};
 
 use super::DesignArgs;
 
@@ -38,6 +39,45 @@ fn parse_params(params: &[String]) -> anyhow::Result<HashMap<String, f64>> {
     Ok(out)
 }
 
+/// Every `--param` must name a parameter the design declares, with a value
+/// in its range. The script itself ignores unknown names and clamps values
+/// to the range (right for the studio's sliders); on the command line a
+/// typo or a value out of range would give files that are not what was
+/// asked for, so it is refused.
+fn check_params(given: &HashMap<String, f64>, declared: &[Param]) -> anyhow::Result<()> {
+    let mut names: Vec<&String> = given.keys().collect();
+    names.sort();
+    for name in names {
+        let v = given[name];
+        match declared.iter().find(|p| &p.name == name) {
+            Some(p) if !(p.min..=p.max).contains(&v) => bail!(
+                "--param {name}={v}: outside the range {}..={} that the design declares",
+                p.min,
+                p.max
+            ),
+            Some(_) => {}
+            None => {
+                let near = declared
+                    .iter()
+                    .map(|p| (edit_distance(name, &p.name), &p.name))
+                    .filter(|(d, _)| *d <= 2)
+                    .min();
+                let hint = near.map_or(String::new(), |(_, n)| format!("; did you mean `{n}`?"));
+                let list: Vec<&str> = declared.iter().map(|p| p.name.as_str()).collect();
+                bail!(
+                    "--param {name}: the design declares no parameter `{name}`{hint} (its parameters: {})",
+                    if list.is_empty() {
+                        "none".to_string()
+                    } else {
+                        list.join(", ")
+                    }
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Run and prepare the design named by `args`; warnings go to stderr.
 pub fn load_design(args: &DesignArgs) -> anyhow::Result<Loaded> {
     let source = std::fs::read_to_string(&args.design)
@@ -48,6 +88,7 @@ pub fn load_design(args: &DesignArgs) -> anyhow::Result<Loaded> {
     let start = Instant::now();
     let design = run_script(&source, &name, &opts)?;
     let script_time = start.elapsed();
+    check_params(&opts.params, &design.params)?;
     for line in &design.log {
         eprintln!("[script] {line}");
     }

@@ -40,6 +40,11 @@ pub fn info(args: &DesignArgs) -> anyhow::Result<()> {
 
 /// `volcad eval DESIGN X Y Z`.
 pub fn eval(args: &DesignArgs, x: f64, y: f64, z: f64) -> anyhow::Result<()> {
+    for (axis, v) in [("X", x), ("Y", y), ("Z", z)] {
+        if !v.is_finite() {
+            anyhow::bail!("{axis} = {v}: give a finite coordinate in mm");
+        }
+    }
     let l = load_design(args)?;
     let (d, fracs) = l.model.eval_point(DVec3::new(x, y, z));
     println!("distance: {d}");
