@@ -51,13 +51,14 @@ pub enum ExportError {
         /// What is wrong and what is allowed.
         message: String,
     },
-    /// Writing failed.
-    #[error("{path}: {source}")]
+    /// Writing failed. The OS error is part of the message, not a chained
+    /// source: printed with its chain, it appeared twice.
+    #[error("{}: {err}", .path.display())]
     Io {
         /// The file or folder.
         path: PathBuf,
         /// The OS error.
-        source: std::io::Error,
+        err: std::io::Error,
     },
     /// The destination exists and is not a folder we may replace.
     #[error("{0}: the destination exists and is not an export folder; choose another or remove it")]
@@ -72,10 +73,10 @@ pub enum ExportError {
 
 impl ExportError {
     /// An I/O error at `path`.
-    pub fn io(path: &Path, source: std::io::Error) -> Self {
+    pub fn io(path: &Path, err: std::io::Error) -> Self {
         ExportError::Io {
             path: path.to_owned(),
-            source,
+            err,
         }
     }
 
@@ -284,6 +285,19 @@ where
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
+    // A file where a folder must be: "File exists" from the OS says neither
+    // which path nor what is wrong with it.
+    if let Some(file) = parent
+        .ancestors()
+        .find(|a| a.exists())
+        .filter(|a| !a.is_dir())
+    {
+        return Err(ExportError::Other(format!(
+            "{}: is a file, not a folder, so {} cannot be created in it",
+            file.display(),
+            dest.display()
+        )));
+    }
     std::fs::create_dir_all(parent).map_err(|e| ExportError::io(parent, e))?;
     let name = dest
         .file_name()
@@ -403,5 +417,17 @@ mod tests {
         let h = spawn(dest.clone(), "abc".into(), |_| Ok(Summary::default()));
         assert!(matches!(h.join(), Err(ExportError::DestinationExists(_))));
         assert!(dest.join("precious.txt").exists());
+    }
+
+    #[test]
+    fn a_file_in_the_path_is_named() {
+        let dir = tmp("file_in_path");
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("plain.txt");
+        std::fs::write(&file, "x").unwrap();
+        let h = spawn(file.join("out"), "abc".into(), |_| Ok(Summary::default()));
+        let e = h.join().unwrap_err().to_string();
+        assert!(e.contains("plain.txt: is a file, not a folder"), "{e}");
+        assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
     }
 }

@@ -35,13 +35,14 @@ pub struct FrdResult {
 /// Why a result file could not be read.
 #[derive(Debug, thiserror::Error)]
 pub enum FrdError {
-    /// The file could not be read or written.
-    #[error("{path}: {source}")]
+    /// The file could not be read or written (the OS error is part of the
+    /// message, not a chained source, so it is printed once).
+    #[error("{path}: {err}")]
     Io {
         /// The file.
         path: String,
         /// The OS error.
-        source: std::io::Error,
+        err: std::io::Error,
     },
     /// A line is not what the format says.
     #[error("{path}:{line}: {message}")]
@@ -58,10 +59,10 @@ pub enum FrdError {
     NoDisplacement(String),
 }
 
-fn io_err(path: &Path, source: std::io::Error) -> FrdError {
+fn io_err(path: &Path, err: std::io::Error) -> FrdError {
     FrdError::Io {
         path: path.display().to_string(),
-        source,
+        err,
     }
 }
 

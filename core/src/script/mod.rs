@@ -199,7 +199,7 @@ pub fn run_script(source: &str, name: &str, opts: &ScriptOptions) -> Result<Desi
         state: Arc::new(Mutex::new(RunState::default())),
     };
     let engine = build_engine(&ctx, opts);
-    let err = |e: &EvalAltResult| to_script_error(e, name);
+    let err = |e: &EvalAltResult| to_script_error(e, name, &engine);
     let ast = engine.compile(source).map_err(|e| {
         let pos = e.position();
         ScriptError {
@@ -267,7 +267,7 @@ fn check_materials(root: &Node, table: &MaterialTable, name: &str) -> Result<(),
 
 /// Flatten Rhai's nested "error in function call" wrappers into the inner
 /// message at the innermost known position.
-fn to_script_error(e: &EvalAltResult, file: &str) -> ScriptError {
+fn to_script_error(e: &EvalAltResult, file: &str, engine: &Engine) -> ScriptError {
     let mut cur = e;
     let mut pos = e.position();
     while let EvalAltResult::ErrorInFunctionCall(_, _, inner, p) = cur {
@@ -285,6 +285,7 @@ fn to_script_error(e: &EvalAltResult, file: &str) -> ScriptError {
         EvalAltResult::ErrorTooManyOperations(_) => {
             "stopped: the script ran too many operations (an endless loop?)".into()
         }
+        EvalAltResult::ErrorFunctionNotFound(sig, _) => not_found(sig, engine),
         other => {
             let mut s = other.to_string();
             if let Some(i) = s.rfind(" (line ") {
@@ -298,6 +299,57 @@ fn to_script_error(e: &EvalAltResult, file: &str) -> ScriptError {
         line: pos.line(),
         column: pos.position(),
         message,
+    }
+}
+
+/// rhai's "Function not found: Tile (volcad_core::node::Node, Vec3)" in the
+/// script's terms: argument types by the names a script knows them by; for
+/// a known name, that no form of it takes those arguments; for an unknown
+/// name, the nearest known one.
+fn not_found(sig: &str, engine: &Engine) -> String {
+    let (name, args) = match sig.split_once(" (") {
+        Some((n, a)) => (n.trim(), a.strip_suffix(')').unwrap_or(a)),
+        None => (sig.trim(), ""),
+    };
+    let args: Vec<&str> = args
+        .split(", ")
+        .filter(|a| !a.is_empty())
+        .map(script_type)
+        .collect();
+    let mut known: Vec<String> = engine
+        .gen_fn_signatures(false)
+        .iter()
+        .filter_map(|s| s.split('(').next())
+        .map(|n| n.trim().to_owned())
+        .collect();
+    known.sort();
+    known.dedup();
+    if known.iter().any(|k| k == name) {
+        return format!(
+            "no form of `{name}` takes ({}): check the number, order and types of its \
+             arguments (the README's script table lists each form)",
+            args.join(", ")
+        );
+    }
+    let near = known
+        .iter()
+        .map(|k| (crate::material::edit_distance(name, k), k))
+        .filter(|(d, _)| *d <= 2)
+        .min();
+    match near {
+        Some((_, k)) => format!("unknown function `{name}`; did you mean `{k}`?"),
+        None => format!("unknown function `{name}`"),
+    }
+}
+
+/// A Rust type name as rhai prints it, in a script's words.
+fn script_type(t: &str) -> &str {
+    match t.trim() {
+        "f64" | "f32" => "number",
+        "i64" | "i32" | "usize" => "integer",
+        "ImmutableString" | "&str" | "String" | "string" => "string",
+        "()" => "nothing",
+        other => other.rsplit("::").next().unwrap_or(other),
     }
 }
 

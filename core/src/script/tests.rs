@@ -54,6 +54,28 @@ fn errors_carry_line_and_column() {
 }
 
 #[test]
+fn wrong_arguments_and_unknown_functions_read_as_script_words() {
+    let e = run(
+        "let m = default_materials();\nTile(Sphere(Vec3(0,0,0), 1, m.id(\"red\")), Vec3(3,3,3))",
+    )
+    .unwrap_err();
+    assert_eq!(e.line, Some(2), "{e}");
+    assert!(
+        e.message.contains("no form of `Tile` takes (Node, Vec3)"),
+        "{e}"
+    );
+    assert!(!e.message.contains("volcad_core"), "{e}");
+    let e = run("let m = default_materials();\nSpher(Vec3(0,0,0), 1, m.id(\"red\"))").unwrap_err();
+    assert!(
+        e.message
+            .contains("unknown function `Spher`; did you mean `Sphere`?"),
+        "{e}"
+    );
+    let e = run("Frobnicate(1.0)").unwrap_err();
+    assert_eq!(e.message, "unknown function `Frobnicate`", "{e}");
+}
+
+#[test]
 fn unknown_material_suggests() {
     let e = run("let m = default_materials();\nSphere(Vec3(0,0,0), 1, m.id(\"rde\"))").unwrap_err();
     assert_eq!(e.line, Some(2));
