@@ -273,8 +273,11 @@ impl Viewport {
                 *mode = ViewMode::Volume;
             }
             if ui
-                .selectable_label(is_iso, "Iso")
-                .on_hover_text("Surface where one material's fraction equals a level")
+                .selectable_label(is_iso, "Fraction")
+                .on_hover_text(
+                    "Iso-fraction surface: where one material's fraction equals a level \
+                     (not the Iso view above)",
+                )
                 .clicked()
                 && !is_iso
             {
