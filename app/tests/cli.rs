@@ -386,3 +386,67 @@ fn bench_reports_evaluation_and_export_rates() {
         .unwrap();
     assert_eq!(row.split_whitespace().count(), 5, "{row}");
 }
+
+/// Ctrl-C (SIGINT), `kill` (SIGTERM) and a closed terminal (SIGHUP) cancel
+/// an export cleanly: the process ends soon with an error, and neither the
+/// destination nor the hidden staging folder is left.
+#[cfg(unix)]
+#[test]
+fn signals_cancel_exports_and_leave_nothing() {
+    use std::time::{Duration, Instant};
+    for signal in ["INT", "TERM", "HUP"] {
+        let d = tmp(&format!("signal_{signal}"));
+        let dest = d.join("stack");
+        // Fine enough to run for many seconds: a debug build at 0.01 mm.
+        let mut child = Command::new(env!("CARGO_BIN_EXE_volcad"))
+            .args(["export", "png", &example("graded_bar.rhai"), "--out"])
+            .arg(&dest)
+            .args(["--voxel", "0.01"])
+            .env("XDG_RUNTIME_DIR", runtime_dir())
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let staging = || {
+            std::fs::read_dir(&d).unwrap().flatten().any(|e| {
+                e.file_name()
+                    .to_string_lossy()
+                    .starts_with(".stack.partial-")
+            })
+        };
+        let start = Instant::now();
+        while !staging() {
+            assert!(
+                start.elapsed() < Duration::from_secs(60),
+                "no staging folder"
+            );
+            assert!(
+                child.try_wait().unwrap().is_none(),
+                "the export ended early"
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let sent = Command::new("kill")
+            .args([&format!("-{signal}"), &child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(sent.success());
+        let start = Instant::now();
+        let status = loop {
+            if let Some(s) = child.try_wait().unwrap() {
+                break s;
+            }
+            assert!(
+                start.elapsed() < Duration::from_secs(30),
+                "SIG{signal}: still running"
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        };
+        let mut err = String::new();
+        std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+        assert_eq!(status.code(), Some(1), "SIG{signal}: {status:?} {err}");
+        assert!(err.contains("cancel"), "SIG{signal}: {err}");
+        assert!(!dest.exists(), "SIG{signal}");
+        assert!(!staging(), "SIG{signal}: staging left");
+    }
+}

@@ -259,6 +259,46 @@ where
     }
 }
 
+/// Staging folders left beside `parent/name` by earlier runs whose process
+/// is gone (killed outright, or the machine went down) are removed, so
+/// crashed exports do not pile up hidden gigabytes beside the destination.
+/// A folder whose process still runs (another export to the same place)
+/// is left alone, and so is every folder where that cannot be told.
+fn remove_stale_staging(parent: &Path, name: &str) {
+    let prefix = format!(".{name}.partial-");
+    let Ok(entries) = std::fs::read_dir(parent) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let pid = e
+            .file_name()
+            .to_str()
+            .and_then(|n| n.strip_prefix(&prefix))
+            .and_then(|p| p.parse::<u32>().ok());
+        if let Some(pid) = pid
+            && pid != std::process::id()
+            && process_gone(pid)
+        {
+            let _ = std::fs::remove_dir_all(e.path());
+        }
+    }
+}
+
+/// True when no process `pid` exists: `kill(pid, 0)` fails with `ESRCH`.
+#[cfg(unix)]
+fn process_gone(pid: u32) -> bool {
+    let pid = i32::try_from(pid)
+        .ok()
+        .and_then(rustix::process::Pid::from_raw);
+    pid.is_some_and(|p| rustix::process::test_kill_process(p) == Err(rustix::io::Errno::SRCH))
+}
+
+/// Elsewhere the question is not asked: nothing is removed.
+#[cfg(not(unix))]
+fn process_gone(_pid: u32) -> bool {
+    false
+}
+
 /// Run `work` on this thread (the CLI uses this through `spawn` too; tests
 /// may call it directly).
 pub fn run_job<F>(
@@ -303,6 +343,7 @@ where
         .file_name()
         .map(|n| n.to_string_lossy().to_string())
         .unwrap_or_else(|| "export".into());
+    remove_stale_staging(parent, &name);
     let staging = parent.join(format!(".{name}.partial-{}", std::process::id()));
     if staging.exists() {
         let _ = std::fs::remove_dir_all(&staging);
@@ -417,6 +458,30 @@ mod tests {
         let h = spawn(dest.clone(), "abc".into(), |_| Ok(Summary::default()));
         assert!(matches!(h.join(), Err(ExportError::DestinationExists(_))));
         assert!(dest.join("precious.txt").exists());
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn staging_of_dead_processes_is_removed() {
+        let dir = tmp("stale");
+        std::fs::create_dir_all(&dir).unwrap();
+        // A process that has ended: its id names no process now.
+        let mut child = std::process::Command::new("true").spawn().unwrap();
+        let dead = child.id();
+        child.wait().unwrap();
+        let stale = dir.join(format!(".out.partial-{dead}"));
+        std::fs::create_dir_all(&stale).unwrap();
+        std::fs::write(stale.join("layer_0001.png"), "x").unwrap();
+        // This process is alive, and another destination's folder is not ours.
+        let alive = dir.join(".out.partial-1");
+        let other = dir.join(format!(".other.partial-{dead}"));
+        std::fs::create_dir_all(&alive).unwrap();
+        std::fs::create_dir_all(&other).unwrap();
+        let h = spawn(dir.join("out"), "abc".into(), |_| Ok(Summary::default()));
+        h.join().unwrap();
+        assert!(!stale.exists());
+        assert!(alive.exists() && other.exists());
+        assert!(dir.join("out/manifest.json").exists());
     }
 
     #[test]

@@ -270,6 +270,16 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
                 infill_expr: a.infill.clone(),
                 threads,
             };
+            let est = volcad_compilers::mesh::estimate_mesh(&model, &p)?;
+            let [nx, ny, nz] = est.grid.dims;
+            eprintln!(
+                "grid {nx} x {ny} x {nz} ({} voxels), {} segments; about {:.1e} triangles, {:.1} MB on disk, {:.1} MB working memory",
+                est.voxels,
+                est.segments,
+                est.triangles as f64,
+                est.disk_bytes as f64 / 1e6,
+                est.memory_bytes as f64 / 1e6
+            );
             job::spawn(dest, hash, move |ctx| {
                 volcad_compilers::mesh::export_meshes(&model, &p, ctx)
             })
