@@ -62,9 +62,16 @@ pub fn probe(model: &Model, voxel: DVec3) -> Probe {
                         n_mixed += 1;
                     }
                 }
+                let dims = [nx, ny, nz];
                 for (a, (c, step)) in [(x, 1), (y, nx), (z, nx * ny)].into_iter().enumerate() {
                     if c > 0 && inside(v) != inside(v - step) {
                         crossings[a] += 1;
+                    }
+                    // Beyond the box there is no part: an inside sample on
+                    // the grid's edge has surface there (a box-shaped part
+                    // fills its box and has no other crossings at all).
+                    if inside(v) && (c == 0 || c + 1 == dims[a]) {
+                        crossings[a] += 1 + usize::from(dims[a] == 1);
                     }
                 }
             }
@@ -99,5 +106,17 @@ mod tests {
         assert!((p.inside - 0.524).abs() < 0.05, "{p:?}");
         assert_eq!(p.mixed, 0.0);
         assert!((p.surface_mm2 / 1257.0 - 1.0).abs() < 0.25, "{p:?}");
+    }
+
+    #[test]
+    fn a_part_that_fills_its_box_has_surface() {
+        let src =
+            "let m = default_materials(); RectPrism(Vec3(0,0,0), Vec3(10,10,10), m.id(\"red\"))";
+        let d = volcad_core::script::run_script(src, "t.rhai", &Default::default()).unwrap();
+        let model = Model::prepare(&d.root, d.materials.clone()).unwrap();
+        let p = probe(&model, DVec3::splat(0.1));
+        // 600 mm² (the 2/3 orientation factor makes it 400 for a box).
+        assert!(p.inside > 0.9, "{p:?}");
+        assert!((300.0..900.0).contains(&p.surface_mm2), "{p:?}");
     }
 }

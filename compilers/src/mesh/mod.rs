@@ -142,7 +142,9 @@ pub struct MeshEstimate {
     pub segments: usize,
     /// Layers sampled per slab.
     pub slab_layers: usize,
-    /// Rough triangle count over all segments.
+    /// Rough triangle count over all segments, from the probed surface area
+    /// as marching tetrahedra would cut it: flat faces merge into far fewer
+    /// (the memory and disk checks err on the safe side there).
     pub triangles: u64,
     /// Working memory, meshes included (bytes, rough).
     pub memory_bytes: u64,
