@@ -25,8 +25,11 @@ pub struct Probe {
     pub inside: f64,
     /// Share of the box inside with no material at 99% or more, 0..=1.
     pub mixed: f64,
-    /// Estimated surface area (mm²).
+    /// Estimated surface area (mm²) inside the box.
     pub surface_mm2: f64,
+    /// Area of the part's faces on its bounding box (mm²): planar, so a
+    /// mesh export merges them into few triangles.
+    pub flat_mm2: f64,
 }
 
 /// Probe `model` over its bounding box with voxels no finer than `voxel`.
@@ -50,6 +53,7 @@ pub fn probe(model: &Model, voxel: DVec3) -> Probe {
     let inside = |v: usize| slab.dist[v] <= 0.0;
     let (mut n_in, mut n_mixed) = (0usize, 0usize);
     let mut crossings = [0usize; 3];
+    let mut on_box = [0usize; 3];
     for z in 0..nz {
         for y in 0..ny {
             for x in 0..nx {
@@ -68,10 +72,10 @@ pub fn probe(model: &Model, voxel: DVec3) -> Probe {
                         crossings[a] += 1;
                     }
                     // Beyond the box there is no part: an inside sample on
-                    // the grid's edge has surface there (a box-shaped part
+                    // the grid's edge has a face there (a box-shaped part
                     // fills its box and has no other crossings at all).
                     if inside(v) && (c == 0 || c + 1 == dims[a]) {
-                        crossings[a] += 1 + usize::from(dims[a] == 1);
+                        on_box[a] += 1 + usize::from(dims[a] == 1);
                     }
                 }
             }
@@ -80,15 +84,14 @@ pub fn probe(model: &Model, voxel: DVec3) -> Probe {
     let total = (nx * ny * nz) as f64;
     let h = grid.voxel;
     let faces = [h.y * h.z, h.x * h.z, h.x * h.y];
-    let cuberille: f64 = crossings
-        .iter()
-        .zip(faces)
-        .map(|(c, a)| *c as f64 * a)
-        .sum();
+    let area =
+        |counts: [usize; 3]| -> f64 { counts.iter().zip(faces).map(|(c, a)| *c as f64 * a).sum() };
     Probe {
         inside: n_in as f64 / total,
         mixed: n_mixed as f64 / total,
-        surface_mm2: cuberille * 2.0 / 3.0,
+        surface_mm2: area(crossings) * 2.0 / 3.0,
+        // Axis-aligned: the cuberille area is the true area.
+        flat_mm2: area(on_box),
     }
 }
 
@@ -106,6 +109,9 @@ mod tests {
         assert!((p.inside - 0.524).abs() < 0.05, "{p:?}");
         assert_eq!(p.mixed, 0.0);
         assert!((p.surface_mm2 / 1257.0 - 1.0).abs() < 0.25, "{p:?}");
+        // It touches its box only at six points (a little more at the
+        // probe's resolution).
+        assert!(p.flat_mm2 < 0.1 * 1257.0, "{p:?}");
     }
 
     #[test]
@@ -115,8 +121,9 @@ mod tests {
         let d = volcad_core::script::run_script(src, "t.rhai", &Default::default()).unwrap();
         let model = Model::prepare(&d.root, d.materials.clone()).unwrap();
         let p = probe(&model, DVec3::splat(0.1));
-        // 600 mm² (the 2/3 orientation factor makes it 400 for a box).
+        // Its 600 mm² all lie on its box.
         assert!(p.inside > 0.9, "{p:?}");
-        assert!((300.0..900.0).contains(&p.surface_mm2), "{p:?}");
+        assert!((p.flat_mm2 / 600.0 - 1.0).abs() < 0.05, "{p:?}");
+        assert_eq!(p.surface_mm2, 0.0);
     }
 }

@@ -273,7 +273,7 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
             let est = volcad_compilers::mesh::estimate_mesh(&model, &p)?;
             let [nx, ny, nz] = est.grid.dims;
             eprintln!(
-                "grid {nx} x {ny} x {nz} ({} voxels), {} segments; about {:.1e} triangles and {:.1} MB on disk before flat faces merge (they merge into far fewer), {:.1} MB working memory",
+                "grid {nx} x {ny} x {nz} ({} voxels), {} segments; about {:.1e} triangles and {:.1} MB on disk, {:.1} MB working memory",
                 est.voxels,
                 est.segments,
                 est.triangles as f64,

@@ -118,7 +118,7 @@ fn estimate(model: &Model, p: &Params) -> Result<String, String> {
             let est = volcad_compilers::mesh::estimate_mesh(model, p).map_err(e)?;
             let [nx, ny, nz] = est.grid.dims;
             format!(
-                "{nx} × {ny} × {nz} voxels ({:.3e}), {} segments, about {} triangles and {} on disk before flat faces merge",
+                "{nx} × {ny} × {nz} voxels ({:.3e}), {} segments, about {} triangles, {} on disk",
                 est.voxels as f64,
                 est.segments,
                 est.triangles,
