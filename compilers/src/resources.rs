@@ -48,8 +48,8 @@ pub fn run_with_threads<T: Send>(
 ) -> Result<T, ExportError> {
     match threads {
         None => f(),
-        Some(0) => Err(ExportError::param("--threads", "must be at least 1")),
         Some(n) => {
+            check_threads(n)?;
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(n)
                 .build()
@@ -57,6 +57,35 @@ pub fn run_with_threads<T: Send>(
             pool.install(f)
         }
     }
+}
+
+/// A worker thread count an export may use: 1 to [`max_threads`].
+pub fn check_threads(n: usize) -> Result<(), ExportError> {
+    if n == 0 {
+        return Err(ExportError::param("--threads", "must be at least 1"));
+    }
+    if n > max_threads() {
+        return Err(ExportError::param(
+            "--threads",
+            format!(
+                "{n} threads; at most {} here ({} cores: more threads than cores do not run faster, and each costs memory)",
+                max_threads(),
+                cores()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Cores of this machine (1 when unknown).
+fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// Most worker threads an export may ask for: eight per core, and at least
+/// 64 (tests ask for a few more threads than a small machine has cores).
+pub fn max_threads() -> usize {
+    (8 * cores()).max(64)
 }
 
 /// `n` bytes for people: "1.5 GiB", "12 MiB", "300 B".
@@ -134,6 +163,19 @@ mod tests {
             assert!(available_memory().is_some_and(|m| m > 0));
             assert!(available_disk(&std::env::temp_dir()).is_some_and(|d| d > 0));
         }
+    }
+
+    #[test]
+    fn thread_counts_are_bounded() {
+        let e = run_with_threads(Some(100_000), || Ok(()))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("--threads") && e.contains("100000 threads; at most"),
+            "{e}"
+        );
+        assert!(run_with_threads(Some(max_threads()), || Ok(())).is_ok());
+        assert!(run_with_threads(Some(0), || Ok(())).is_err());
     }
 
     #[test]

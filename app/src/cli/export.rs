@@ -205,10 +205,8 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
         l.source.as_bytes(),
         format!("{:?}", a.design.params).as_bytes(),
     ]);
-    if let Some(t) = a.threads
-        && t == 0
-    {
-        bail!("--threads must be at least 1");
+    if let Some(t) = a.threads {
+        volcad_compilers::resources::check_threads(t)?;
     }
     let threads = a.threads;
     let dest = a.out.clone();
@@ -319,7 +317,15 @@ fn follow(handle: job::JobHandle) -> anyhow::Result<()> {
     let flag = interrupted.clone();
     // A second handler cannot be installed (e.g. in tests running several
     // exports in one process); the job then simply runs to its end.
-    let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
+    // The first signal cancels (the job removes its staging folder); a
+    // second one exits at once, for a job that does not stop promptly (the
+    // next export to the same place removes what it left).
+    let _ = ctrlc::set_handler(move || {
+        if flag.swap(true, Ordering::Relaxed) {
+            eprintln!("interrupted again: exiting without waiting for the export to stop");
+            std::process::exit(130);
+        }
+    });
     let bar = indicatif::ProgressBar::new(1000);
     bar.set_style(
         indicatif::ProgressStyle::with_template(
