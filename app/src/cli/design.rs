@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
 use volcad_core::Model;
-use volcad_core::material::edit_distance;
+use volcad_core::material::nearest_name;
 use volcad_core::script::{Design, Param, ScriptOptions, run_script};
 
 use super::DesignArgs;
@@ -57,12 +57,8 @@ fn check_params(given: &HashMap<String, f64>, declared: &[Param]) -> anyhow::Res
             ),
             Some(_) => {}
             None => {
-                let near = declared
-                    .iter()
-                    .map(|p| (edit_distance(name, &p.name), &p.name))
-                    .filter(|(d, _)| *d <= 2)
-                    .min();
-                let hint = near.map_or(String::new(), |(_, n)| format!("; did you mean `{n}`?"));
+                let near = nearest_name(name, declared.iter().map(|p| p.name.as_str()));
+                let hint = near.map_or(String::new(), |n| format!("; did you mean `{n}`?"));
                 let list: Vec<&str> = declared.iter().map(|p| p.name.as_str()).collect();
                 bail!(
                     "--param {name}: the design declares no parameter `{name}`{hint} (its parameters: {})",

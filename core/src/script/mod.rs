@@ -331,13 +331,8 @@ fn not_found(sig: &str, engine: &Engine) -> String {
             args.join(", ")
         );
     }
-    let near = known
-        .iter()
-        .map(|k| (crate::material::edit_distance(name, k), k))
-        .filter(|(d, _)| *d <= 2)
-        .min();
-    match near {
-        Some((_, k)) => format!("unknown function `{name}`; did you mean `{k}`?"),
+    match crate::material::nearest_name(name, known.iter().map(String::as_str)) {
+        Some(k) => format!("unknown function `{name}`; did you mean `{k}`?"),
         None => format!("unknown function `{name}`"),
     }
 }
