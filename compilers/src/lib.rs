@@ -17,10 +17,12 @@ pub mod lazy_random;
 pub mod design;
 pub mod dither;
 pub mod mesh;
+pub mod par_deflate;
 pub mod png_io;
 pub mod png_stack;
 mod presets;
 mod probe;
 pub mod resources;
+pub mod zip_writer;
 
 pub use job::{ExportError, JobHandle, Progress, Summary};

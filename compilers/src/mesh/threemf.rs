@@ -8,16 +8,27 @@
 //! (one `<volume firstid lastid>` per part: 0-based inclusive triangle
 //! indices, with `name` and the part's settings). Values use PrusaSlicer's
 //! `.ini` syntax: `fill_density` must carry `%`. Vertices are world
-//! coordinates in millimetres; no transform. Entries are deflated with a
-//! fixed 1980-01-01 time stamp, so the bytes repeat run to run; level 1
-//! (fast) deflate, since mesh XML is large and compresses well anyway.
+//! coordinates in millimetres; no transform.
+//!
+//! The ZIP is written by [`crate::zip_writer`]: entries deflated (level 1)
+//! on every core with a fixed 1980-01-01 time stamp, so the bytes repeat run
+//! to run and on any thread count. The model XML is formatted in parallel
+//! too, in blocks of [`BLOCK`] vertices or triangles; on a curved design it
+//! is hundreds of megabytes, and one core formatting and deflating it made
+//! the 3MF the slowest file of a mesh export.
 
-use std::io::{self, BufWriter, Seek, Write};
+use std::io::{self, Seek, Write};
 
-use zip::write::SimpleFileOptions;
-use zip::{CompressionMethod, DateTime, ZipWriter};
+use rayon::prelude::*;
 
 use super::indexed::IndexedMesh;
+use crate::zip_writer::ZipOut;
+
+/// Vertices or triangles formatted per parallel task.
+const BLOCK: usize = 1 << 15;
+/// Blocks formatted per batch before they are handed to the deflater
+/// (bounds the text held in memory to about 100 MB).
+const BLOCKS_PER_BATCH: usize = 64;
 
 /// One part (volume) of the object.
 pub struct Part<'a> {
@@ -58,39 +69,24 @@ pub fn xml_escape(s: &str) -> String {
     out
 }
 
-fn zip_err(e: zip::result::ZipError) -> io::Error {
-    match e {
-        zip::result::ZipError::Io(e) => e,
-        e => io::Error::other(e.to_string()),
-    }
-}
-
 /// Write the package for object `object_name` made of `parts` (each
 /// non-empty) to `w`.
 pub fn write_3mf<W: Write + Seek>(parts: &[Part<'_>], object_name: &str, w: W) -> io::Result<()> {
     let triangles: usize = parts.iter().map(|p| p.mesh.triangles.len()).sum();
-    let opts = SimpleFileOptions::default()
-        .compression_method(CompressionMethod::Deflated)
-        .compression_level(Some(1))
-        .last_modified_time(DateTime::default())
-        .unix_permissions(0o644)
-        .large_file(triangles > 10_000_000);
-    let mut zip = ZipWriter::new(w);
-    zip.start_file("[Content_Types].xml", opts)
-        .map_err(zip_err)?;
-    zip.write_all(CONTENT_TYPES.as_bytes())?;
-    zip.start_file("_rels/.rels", opts).map_err(zip_err)?;
-    zip.write_all(RELS.as_bytes())?;
-    zip.start_file("3D/3dmodel.model", opts).map_err(zip_err)?;
-    {
-        let mut m = BufWriter::with_capacity(1 << 20, &mut zip);
-        write_model(parts, object_name, &mut m)?;
-        m.flush()?;
-    }
-    zip.start_file("Metadata/Slic3r_PE_model.config", opts)
-        .map_err(zip_err)?;
-    write_config(parts, object_name, &mut zip)?;
-    zip.finish().map_err(zip_err)?;
+    let mut zip = ZipOut::new(w);
+    zip.entry("[Content_Types].xml", false, |z| {
+        z.write_all(CONTENT_TYPES.as_bytes())
+    })?;
+    zip.entry("_rels/.rels", false, |z| z.write_all(RELS.as_bytes()))?;
+    // About 50 bytes a triangle and 60 a vertex: past 4 GiB of XML near
+    // 40 million triangles; Zip64 from 10 million keeps a wide margin.
+    zip.entry("3D/3dmodel.model", triangles > 10_000_000, |z| {
+        write_model(parts, object_name, z)
+    })?;
+    zip.entry("Metadata/Slic3r_PE_model.config", false, |z| {
+        write_config(parts, object_name, z)
+    })?;
+    zip.finish()?;
     Ok(())
 }
 
@@ -108,32 +104,33 @@ fn write_model(parts: &[Part<'_>], object_name: &str, m: &mut impl Write) -> io:
         xml_escape(object_name)
     )?;
     writeln!(m, "   <mesh>\n    <vertices>")?;
-    // ryu/itoa: millions of numbers; `{}` formatting dominated the export.
-    let (mut f, mut i) = (ryu::Buffer::new(), itoa::Buffer::new());
     for p in parts {
-        for [x, y, z] in &p.mesh.vertices {
-            m.write_all(b"     <vertex x=\"")?;
-            m.write_all(f.format(*x).as_bytes())?;
-            m.write_all(b"\" y=\"")?;
-            m.write_all(f.format(*y).as_bytes())?;
-            m.write_all(b"\" z=\"")?;
-            m.write_all(f.format(*z).as_bytes())?;
-            m.write_all(b"\"/>\n")?;
-        }
+        write_blocks(&p.mesh.vertices, m, |out, [x, y, z]| {
+            // ryu/itoa: millions of numbers; `{}` formatting dominated.
+            let mut f = ryu::Buffer::new();
+            out.extend_from_slice(b"     <vertex x=\"");
+            out.extend_from_slice(f.format(*x).as_bytes());
+            out.extend_from_slice(b"\" y=\"");
+            out.extend_from_slice(f.format(*y).as_bytes());
+            out.extend_from_slice(b"\" z=\"");
+            out.extend_from_slice(f.format(*z).as_bytes());
+            out.extend_from_slice(b"\"/>\n");
+        })?;
     }
     writeln!(m, "    </vertices>\n    <triangles>")?;
     let mut base = 0u64;
     for p in parts {
-        for t in &p.mesh.triangles {
+        write_blocks(&p.mesh.triangles, m, |out, t| {
+            let mut i = itoa::Buffer::new();
             let [a, b, c] = t.map(|v| base + u64::from(v));
-            m.write_all(b"     <triangle v1=\"")?;
-            m.write_all(i.format(a).as_bytes())?;
-            m.write_all(b"\" v2=\"")?;
-            m.write_all(i.format(b).as_bytes())?;
-            m.write_all(b"\" v3=\"")?;
-            m.write_all(i.format(c).as_bytes())?;
-            m.write_all(b"\"/>\n")?;
-        }
+            out.extend_from_slice(b"     <triangle v1=\"");
+            out.extend_from_slice(i.format(a).as_bytes());
+            out.extend_from_slice(b"\" v2=\"");
+            out.extend_from_slice(i.format(b).as_bytes());
+            out.extend_from_slice(b"\" v3=\"");
+            out.extend_from_slice(i.format(c).as_bytes());
+            out.extend_from_slice(b"\"/>\n");
+        })?;
         base += p.mesh.vertices.len() as u64;
     }
     writeln!(
@@ -144,6 +141,31 @@ fn write_model(parts: &[Part<'_>], object_name: &str, m: &mut impl Write) -> io:
         m,
         " <build>\n  <item objectid=\"1\" printable=\"1\"/>\n </build>\n</model>"
     )?;
+    Ok(())
+}
+
+/// Formats `items` with `line` in parallel blocks and writes the text in
+/// order (the same bytes as one loop over the items).
+fn write_blocks<T: Sync>(
+    items: &[T],
+    m: &mut impl Write,
+    line: impl Fn(&mut Vec<u8>, &T) + Sync,
+) -> io::Result<()> {
+    for batch in items.chunks(BLOCK * BLOCKS_PER_BATCH) {
+        let texts: Vec<Vec<u8>> = batch
+            .par_chunks(BLOCK)
+            .map(|block| {
+                let mut out = Vec::with_capacity(block.len() * 64);
+                for it in block {
+                    line(&mut out, it);
+                }
+                out
+            })
+            .collect();
+        for t in &texts {
+            m.write_all(t)?;
+        }
+    }
     Ok(())
 }
 
