@@ -432,8 +432,10 @@ pub fn export_meshes(
         debug_assert!(nz > 0);
         ctx.check_cancel()?;
         ctx.progress("writing", 0, 1, "files", 0.9);
-        let files = write_files(&segs, p, ctx)?;
-        Ok(summary(model, p, &pl, &segs, files))
+        // The checks read the meshes as the writers do: both at once, so a
+        // core left idle by the last (longest) file checks the meshes.
+        let (files, checks) = rayon::join(|| write_files(&segs, p, ctx), || checks(&segs));
+        Ok(summary(model, p, &pl, &segs, files?, &checks))
     })
 }
 
@@ -506,12 +508,22 @@ fn write_files(
         .collect()
 }
 
+/// Volume and watertightness of every segment. The contouring guarantees
+/// watertightness; checked anyway (a linear pass over the edges), every
+/// segment on its own thread.
+fn checks(segs: &[SegmentMesh]) -> Vec<(f64, bool)> {
+    segs.par_iter()
+        .map(|s| (s.mesh.volume(), s.mesh.is_watertight()))
+        .collect()
+}
+
 fn summary(
     model: &Model,
     p: &MeshParams,
     pl: &Plan,
     segs: &[SegmentMesh],
     files: Vec<String>,
+    checks: &[(f64, bool)],
 ) -> Summary {
     let [nx, ny, nz] = pl.grid.dims;
     let mut notes = vec![format!(
@@ -527,13 +539,7 @@ fn summary(
         ));
     }
     let mut total_volume = 0.0;
-    // The contouring guarantees watertightness; checked anyway (a linear
-    // pass over the edges), every segment on its own thread.
-    let checks: Vec<(f64, bool)> = segs
-        .par_iter()
-        .map(|s| (s.mesh.volume(), s.mesh.is_watertight()))
-        .collect();
-    for (s, &(v, watertight)) in segs.iter().zip(&checks) {
+    for (s, &(v, watertight)) in segs.iter().zip(checks) {
         if s.mesh.is_empty() {
             notes.push(format!(
                 "{}: empty (no voxel in this range), no file",
