@@ -37,6 +37,7 @@ pub mod node;
 pub mod sampler;
 pub mod script;
 pub mod simfield;
+pub mod sincos;
 
 pub use bounds::Aabb;
 pub use glam::DVec3;

@@ -18,6 +18,7 @@ use glam::DVec3;
 use crate::bounds::Aabb;
 use crate::interval::Interval;
 use crate::node::TpmsType;
+use crate::sincos::sin_cos;
 
 /// A prepared TPMS sheet.
 #[derive(Clone, Copy, Debug)]
@@ -52,9 +53,9 @@ impl Tpms {
     #[inline]
     fn field(&self, p: DVec3) -> (f64, DVec3) {
         let q = p * self.k;
-        let (sx, cx) = q.x.sin_cos();
-        let (sy, cy) = q.y.sin_cos();
-        let (sz, cz) = q.z.sin_cos();
+        let (sx, cx) = sin_cos(q.x);
+        let (sy, cy) = sin_cos(q.y);
+        let (sz, cz) = sin_cos(q.z);
         match self.kind {
             TpmsType::Gyroid => (
                 sx * cy + sy * cz + sz * cx,
