@@ -44,15 +44,29 @@ pub const COORD_VARS: [&str; 9] = ["x", "y", "z", "rho", "phic", "r", "theta", "
 /// If `slots` has fewer than 8 elements.
 #[inline]
 pub fn fill_derived_coords(slots: &mut [f64]) {
+    fill_derived_coords_used(slots, u64::MAX);
+}
+
+/// [`fill_derived_coords`] for the slots whose bit is set in `used` (bit
+/// `i` for slot `i`); the others are left as they are. The azimuth's
+/// `atan2` and the polar angle's `acos` cost more than the rest of a graded
+/// primitive's evaluation, so an expression of `rho` alone skips them.
+#[inline]
+pub fn fill_derived_coords_used(slots: &mut [f64], used: u64) {
     let (x, y, z) = (slots[0], slots[1], slots[2]);
-    let rho2 = x * x + y * y;
-    let azimuth = y.atan2(x);
-    let r = (rho2 + z * z).sqrt();
-    slots[3] = rho2.sqrt();
-    slots[4] = azimuth;
-    slots[5] = r;
-    slots[6] = azimuth;
-    slots[7] = (z / r).acos();
+    if used & (1 << 3) != 0 {
+        slots[3] = (x * x + y * y).sqrt();
+    }
+    if used & (1 << 4 | 1 << 6) != 0 {
+        let azimuth = y.atan2(x);
+        slots[4] = azimuth;
+        slots[6] = azimuth;
+    }
+    if used & (1 << 5 | 1 << 7) != 0 {
+        let r = (x * x + y * y + z * z).sqrt();
+        slots[5] = r;
+        slots[7] = (z / r).acos();
+    }
 }
 
 /// Interval counterpart of [`fill_derived_coords`]: bounds on the derived coordinates

@@ -653,3 +653,32 @@ fn affine_intervals_contain_points_and_reach_the_corners() {
         }
     }
 }
+
+#[test]
+fn derived_coords_fill_what_is_used_with_the_same_bits() {
+    for p in [
+        [1.0, 2.0, 3.0],
+        [-0.3, 0.0, -7.5],
+        [0.0, 0.0, 0.0],
+        [5.0, -1e-9, 2.0],
+    ] {
+        let mut all = [0.0; 9];
+        all[..3].copy_from_slice(&p);
+        fill_derived_coords(&mut all);
+        for slot in 3..8 {
+            let mut s = [f64::INFINITY; 9];
+            s[..3].copy_from_slice(&p);
+            fill_derived_coords_used(&mut s, 1 << slot);
+            assert_eq!(
+                s[slot].to_bits(),
+                all[slot].to_bits(),
+                "slot {slot} at {p:?}"
+            );
+        }
+        // Nothing derived asked: nothing computed.
+        let mut s = [f64::INFINITY; 9];
+        s[..3].copy_from_slice(&p);
+        fill_derived_coords_used(&mut s, 0b111);
+        assert!(s[3..8].iter().all(|v| *v == f64::INFINITY));
+    }
+}

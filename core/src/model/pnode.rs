@@ -417,6 +417,6 @@ pub fn coord_slots(p: DVec3, used: u64, slots: &mut [f64]) {
     slots[1] = p.y;
     slots[2] = p.z;
     if used & DERIVED_MASK != 0 {
-        crate::expr::fill_derived_coords(slots);
+        crate::expr::fill_derived_coords_used(slots, used);
     }
 }
