@@ -27,6 +27,7 @@
 pub mod bench;
 pub mod bounds;
 pub mod expr;
+pub mod fastmath;
 pub mod interval;
 pub mod lattice;
 pub mod material;
@@ -37,7 +38,6 @@ pub mod node;
 pub mod sampler;
 pub mod script;
 pub mod simfield;
-pub mod sincos;
 
 pub use bounds::Aabb;
 pub use glam::DVec3;

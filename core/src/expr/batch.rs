@@ -93,7 +93,7 @@ fn step<const N: usize, const L: usize>(ins: &Instr, regs: &[[f64; L]; N]) -> [f
         Op::Cos => lanes!(|x| x.cos()),
         Op::Exp => lanes!(|x| x.exp()),
         Op::Ln => lanes!(|x| x.ln()),
-        Op::Floor => lanes!(|x| x.floor()),
+        Op::Floor => lanes!(|x| crate::fastmath::floor(x)),
         Op::PowC => lanes!(|x| x.powf(imm)),
         Op::Select => {
             let c = &regs[ins.c as usize % N];

@@ -281,7 +281,7 @@ impl Op {
             Square => a * a,
             Sqrt => a.sqrt(),
             Ceil => a.ceil(),
-            Floor => a.floor(),
+            Floor => crate::fastmath::floor(a),
             Round => a.round(),
             Trunc => a.trunc(),
             Frac => a - a.trunc(),

@@ -45,6 +45,13 @@ impl Capsule {
         sdf::capsule(p, self.a, self.ab, self.inv_ab2, self.r)
     }
 
+    /// Squared distance from `p` to the axis segment: `dist` is its square
+    /// root minus `r`, computed the same way.
+    #[inline]
+    pub fn axis_dist2(&self, p: DVec3) -> f64 {
+        sdf::segment_dist2(p, self.a, self.ab, self.inv_ab2)
+    }
+
     pub fn bbox(&self) -> Aabb {
         let b = self.a + self.ab;
         Aabb::new(self.a.min(b), self.a.max(b)).expand(self.r)
@@ -130,9 +137,11 @@ pub enum PNode {
         t: Tpms,
         m: Slot,
     },
-    /// Struts, optionally clipped to a centred box of half size `clip_h`.
+    /// Struts of one radius `r`, optionally clipped to a centred box of
+    /// half size `clip_h`.
     Lattice {
         struts: Vec<Capsule>,
+        r: f64,
         clip_h: Option<DVec3>,
         m: Slot,
     },
@@ -263,11 +272,17 @@ impl PNode {
                 expr.eval(&slots).max(sdf::rect_prism(p, *clip_c, *clip_h))
             }
             PNode::Tpms { t, .. } => t.dist(p),
-            PNode::Lattice { struts, clip_h, .. } => {
-                let mut d = f64::INFINITY;
+            PNode::Lattice {
+                struts, clip_h, r, ..
+            } => {
+                // min(√d²ᵢ − r) = √(min d²ᵢ) − r, bit for bit (the square
+                // root is monotone): one square root a point, not one a
+                // strut (they were most of an FCC lattice's time).
+                let mut d2 = f64::INFINITY;
                 for s in struts {
-                    d = d.min(s.dist(p));
+                    d2 = d2.min(s.axis_dist2(p));
                 }
+                let d = d2.sqrt() - r;
                 match clip_h {
                     Some(h) => d.max(sdf::rect_prism(p, DVec3::ZERO, *h)),
                     None => d,
@@ -406,7 +421,7 @@ impl NAry {
 /// at every cell centre `(k + ½)·c`.
 #[inline]
 pub fn tile_local(p: DVec3, cell: DVec3) -> DVec3 {
-    p - cell * (p / cell).floor() - cell * 0.5
+    p - cell * crate::fastmath::floor3(p / cell) - cell * 0.5
 }
 
 /// Fill the coordinate slots an expression reads: x y z always, the derived

@@ -211,6 +211,7 @@ impl Preparer {
                 (
                     PNode::Lattice {
                         struts,
+                        r: *radius,
                         clip_h: cell.map(|c| c * 0.5),
                         m: self.slot(*material),
                     },

@@ -32,9 +32,16 @@ pub fn cylinder(p: DVec3, c: DVec3, r: f64, hh: f64) -> f64 {
 /// (0 for a degenerate strut, which is a sphere).
 #[inline]
 pub fn capsule(p: DVec3, a: DVec3, ab: DVec3, inv_ab2: f64, r: f64) -> f64 {
+    segment_dist2(p, a, ab, inv_ab2).sqrt() - r
+}
+
+/// Squared distance from `p` to the segment from `a` to `a + ab`
+/// (`inv_ab2 = 1/|ab|²`, 0 for a point).
+#[inline]
+pub fn segment_dist2(p: DVec3, a: DVec3, ab: DVec3, inv_ab2: f64) -> f64 {
     let ap = p - a;
     let t = (ap.dot(ab) * inv_ab2).clamp(0.0, 1.0);
-    (ap - ab * t).length() - r
+    (ap - ab * t).length_squared()
 }
 
 /// pyvcad's quadratic smooth minimum with k' = 4k (OPENVCAD.md, Union):

@@ -16,9 +16,9 @@
 use glam::DVec3;
 
 use crate::bounds::Aabb;
+use crate::fastmath::sin_cos;
 use crate::interval::Interval;
 use crate::node::TpmsType;
-use crate::sincos::sin_cos;
 
 /// A prepared TPMS sheet.
 #[derive(Clone, Copy, Debug)]

@@ -248,7 +248,7 @@ impl TetLocator {
             }
         }
         let g = &self.grid;
-        let c = ((p - g.origin) * g.inv_cell).floor();
+        let c = crate::fastmath::floor3((p - g.origin) * g.inv_cell);
         if c.x < 0.0 || c.y < 0.0 || c.z < 0.0 {
             return None;
         }

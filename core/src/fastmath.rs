@@ -1,19 +1,26 @@
-//! Sine and cosine together, for the TPMS sheets' hot loop.
+//! Inlined replacements for two C-library calls in hot loops: `sin_cos`
+//! and `floor`. On the x86-64 baseline (no SSE4.1 rounding instruction)
+//! `f64::floor` is a call, and `sin_cos` always is; both showed at the top
+//! of evaluation profiles (`cargo bench -p volcad-core --bench eval`):
+//! `sin_cos` was 43 % of the gyroid, `floor` 12 % of the tiled lattices.
+//! Both give the same bits on every machine and thread count (plain IEEE
+//! operations, no FMA contraction), which the C library does not promise
+//! across platforms.
 //!
-//! The gyroid takes three `sin_cos` a point; through the C library they were
-//! 43 % of its evaluation (`cargo bench -p volcad-core --bench eval
-//! gyroid`). This is fdlibm's method (Sun Microsystems, 1993; the same
-//! kernels as musl and Go): reduce `x` by multiples of π/2 with a two-part
-//! π/2 (Cody and Waite), then evaluate the degree-13 and degree-14 minimax
-//! polynomials of `__kernel_sin` and `__kernel_cos` on `[−π/4, π/4]`, and
-//! pick the pair by the quadrant. Inlined, with no table and no call, the
-//! three pairs of a point overlap in the pipeline.
+//! # `sin_cos`
+//! fdlibm's method (Sun Microsystems, 1993; the same kernels as musl and
+//! Go): reduce `x` by multiples of π/2 with a two-part π/2 (Cody and
+//! Waite), then evaluate the degree-13 and degree-14 minimax polynomials of
+//! `__kernel_sin` and `__kernel_cos` on `[−π/4, π/4]`, and pick the pair by
+//! the quadrant without a branch. Inlined, with no table and no call, the
+//! three pairs of a gyroid point overlap in the pipeline. Accuracy: within
+//! 1 ulp of the C library's values (0.5 ulp of 1 measured) for
+//! `|x| ≤ REDUCE_MAX`; larger or non-finite arguments go to the C library.
 //!
-//! Accuracy: within 1 ulp of the C library's values (0.5 ulp of 1 measured) for
-//! `|x| ≤ REDUCE_MAX` (the tests compare with the C library over that range);
-//! larger or non-finite arguments go to the C library. Results are the same
-//! on every machine and thread count (no FMA contraction, plain IEEE
-//! operations), which the C library does not promise across platforms.
+//! # `floor`
+//! Truncation through an integer conversion (one SSE2 instruction each
+//! way), minus one where that rounded up; exactly `f64::floor`, signed
+//! zeros, infinities and NaN included (tested).
 
 // The constants are fdlibm's, digit for digit as published (more digits
 // than an f64 holds; each rounds to the intended double).
@@ -42,6 +49,26 @@ const C3: f64 = 2.480_158_728_947_672_941_78e-05;
 const C4: f64 = -2.755_731_435_139_066_330_35e-07;
 const C5: f64 = 2.087_572_321_298_174_827_90e-09;
 const C6: f64 = -1.135_964_755_778_819_482_65e-11;
+
+/// `floor(x)`, bit for bit as `f64::floor`.
+#[inline(always)]
+pub fn floor(x: f64) -> f64 {
+    // 2⁵²: from there on every f64 is an integer (and NaN fails the test).
+    if x.abs() < 4_503_599_627_370_496.0 {
+        let t = x as i64 as f64;
+        let f = if t > x { t - 1.0 } else { t };
+        // −0.0 truncates to +0.0; floor keeps the zero's sign.
+        if f == 0.0 { 0f64.copysign(x) } else { f }
+    } else {
+        x
+    }
+}
+
+/// `floor` of each component.
+#[inline(always)]
+pub fn floor3(v: glam::DVec3) -> glam::DVec3 {
+    glam::DVec3::new(floor(v.x), floor(v.y), floor(v.z))
+}
 
 /// `(sin x, cos x)`.
 #[inline(always)]
@@ -110,6 +137,50 @@ mod tests {
             let (s, c) = sin_cos(x);
             assert!(ulps(s, x.sin()) <= 1.0 && ulps(c, x.cos()) <= 1.0, "{x}");
         }
+    }
+
+    #[test]
+    fn floor_is_the_c_librarys() {
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut values = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            1.5,
+            -1.5,
+            0.999_999_999_999_999_9,
+            -1e-300,
+            1e-300,
+            4_503_599_627_370_495.5,
+            -4_503_599_627_370_495.5,
+            4_503_599_627_370_496.0,
+            -9.007_199_254_740_993e15,
+            1e300,
+            -1e300,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::MAX,
+            f64::MIN,
+            f64::MIN_POSITIVE,
+        ];
+        for _ in 0..200_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            values.push(f64::from_bits(state)); // every exponent and sign
+            values.push((state >> 11) as f64 / (1u64 << 40) as f64 - 4096.0);
+        }
+        for x in values {
+            let (a, b) = (floor(x), x.floor());
+            assert!(
+                a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
+                "{x:e}"
+            );
+        }
+        assert!(floor(f64::NAN).is_nan());
     }
 
     #[test]
