@@ -7,6 +7,8 @@
 //! exactly two triangles, once in each direction (which also makes the
 //! orientation consistent), and no triangle repeats an index.
 
+use rayon::prelude::*;
+
 /// Triangles over shared vertices (mm), counter-clockwise seen from outside.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct IndexedMesh {
@@ -102,9 +104,9 @@ impl IndexedMesh {
     /// Count open, repeated and degenerate edges.
     ///
     /// Directed edges `a → b` are grouped by their start vertex (a counting
-    /// sort, linear in the edge count; each vertex has a handful), each
-    /// group sorted. `a → b` repeated is counted once per extra copy; an
-    /// edge is open when `a → b` occurs more often than `b → a` (each copy
+    /// sort, linear in the edge count; each vertex has a handful), and the
+    /// groups are checked in parallel. `a → b` repeated is counted once per
+    /// extra copy; an edge is open when `a → b` occurs more often than `b → a` (each copy
     /// of `b → a` pairs with one copy of `a → b`).
     pub fn edge_report(&self) -> EdgeReport {
         let mut r = EdgeReport::default();
@@ -129,24 +131,48 @@ impl IndexedMesh {
                 fill[a as usize] += 1;
             }
         }
+        // A vertex has a handful of edges: its list is scanned. Long lists
+        // (a fan in an imported mesh) are sorted and searched, so a hub of
+        // degree D costs D log D, not D².
+        const SHORT: usize = 32;
         for v in 0..nv {
-            ends[start[v] as usize..start[v + 1] as usize].sort_unstable();
+            let list = &mut ends[start[v] as usize..start[v + 1] as usize];
+            if list.len() > SHORT {
+                list.sort_unstable();
+            }
         }
         let out = |v: u32| &ends[start[v as usize] as usize..start[v as usize + 1] as usize];
         let count = |list: &[u32], x: u32| {
-            list.partition_point(|&e| e <= x) - list.partition_point(|&e| e < x)
-        };
-        for a in 0..nv as u32 {
-            let list = out(a);
-            let mut i = 0;
-            while i < list.len() {
-                let b = list[i];
-                let m = count(&list[i..], b);
-                r.repeated += m - 1;
-                r.open += m.saturating_sub(count(out(b), a));
-                i += m;
+            if list.len() > SHORT {
+                list.partition_point(|&e| e <= x) - list.partition_point(|&e| e < x)
+            } else {
+                list.iter().filter(|&&e| e == x).count()
             }
-        }
+        };
+        let (repeated, open) = (0..nv as u32)
+            .into_par_iter()
+            .with_min_len(1 << 14)
+            .map(|a| {
+                let list = out(a);
+                let (mut repeated, mut open) = (0, 0);
+                for (i, &b) in list.iter().enumerate() {
+                    let seen = if list.len() > SHORT {
+                        i > 0 && list[i - 1] == b
+                    } else {
+                        list[..i].contains(&b)
+                    };
+                    if seen {
+                        continue; // counted at its first copy
+                    }
+                    let m = count(list, b);
+                    repeated += m - 1;
+                    open += m.saturating_sub(count(out(b), a));
+                }
+                (repeated, open)
+            })
+            .reduce(|| (0, 0), |x, y| (x.0 + y.0, x.1 + y.1));
+        r.repeated = repeated;
+        r.open = open;
         r
     }
 
@@ -213,5 +239,46 @@ mod tests {
         let mut m = cube();
         m.triangles.push(m.triangles[0]);
         assert!(!m.is_watertight());
+    }
+
+    /// A double cone of `n` ring vertices: the apexes have `n` edges each
+    /// (the sorted path of `edge_report`).
+    fn double_cone(n: u32) -> IndexedMesh {
+        let mut vertices = vec![[0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+        for i in 0..n {
+            let a = i as f32 / n as f32 * std::f32::consts::TAU;
+            vertices.push([a.cos(), a.sin(), 0.0]);
+        }
+        let ring = |i: u32| 2 + i % n;
+        let mut triangles = Vec::new();
+        for i in 0..n {
+            triangles.push([0, ring(i), ring(i + 1)]);
+            triangles.push([1, ring(i + 1), ring(i)]);
+        }
+        IndexedMesh {
+            vertices,
+            triangles,
+        }
+    }
+
+    #[test]
+    fn hubs_of_high_degree_are_checked_too() {
+        for n in [5, 200] {
+            let m = double_cone(n);
+            assert!(m.is_watertight(), "{n}");
+            let mut open = m.clone();
+            open.triangles.remove(7);
+            assert_eq!(open.edge_report().open, 3, "{n}");
+            let mut twice = m.clone();
+            twice.triangles.push(m.triangles[4]);
+            let r = twice.edge_report();
+            assert_eq!((r.repeated, r.open), (3, 3), "{n}: {r:?}");
+            let mut flipped = m.clone();
+            let t = flipped.triangles[2];
+            flipped.triangles[2] = [t[0], t[2], t[1]];
+            let r = flipped.edge_report();
+            // Each flipped edge doubles its neighbour's and leaves no reverse.
+            assert_eq!((r.repeated, r.open), (3, 6), "{n}: {r:?}");
+        }
     }
 }
