@@ -54,8 +54,7 @@ impl Tpms {
     fn field(&self, p: DVec3) -> (f64, DVec3) {
         let q = p * self.k;
         let (sx, cx) = sin_cos(q.x);
-        let (sy, cy) = sin_cos(q.y);
-        let (sz, cz) = sin_cos(q.z);
+        let [sy, cy, sz, cz] = row::sin_cos_yz(q.y, q.z);
         match self.kind {
             TpmsType::Gyroid => (
                 sx * cy + sy * cz + sz * cx,
@@ -90,6 +89,35 @@ impl Tpms {
     }
 }
 
+/// Samplers walk rows of voxels along x, where y and z stay the same: the
+/// last `(y, z)` pair's sines and cosines are kept per thread and reused
+/// when the same bits come again. They are a pure function of those bits,
+/// so the values are exactly the ones a fresh computation gives.
+mod row {
+    use std::cell::Cell;
+
+    use crate::fastmath::sin_cos;
+
+    thread_local! {
+        static LAST: Cell<(u64, u64, [f64; 4])> = const { Cell::new((u64::MAX, u64::MAX, [f64::NAN; 4])) };
+    }
+
+    /// `[sin y, cos y, sin z, cos z]`.
+    #[inline]
+    pub fn sin_cos_yz(y: f64, z: f64) -> [f64; 4] {
+        LAST.with(|c| {
+            let (ky, kz, v) = c.get();
+            if ky == y.to_bits() && kz == z.to_bits() {
+                return v;
+            }
+            let ((sy, cy), (sz, cz)) = (sin_cos(y), sin_cos(z));
+            let v = [sy, cy, sz, cz];
+            c.set((y.to_bits(), z.to_bits(), v));
+            v
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -112,6 +140,32 @@ mod tests {
                     let d = t.dist(p);
                     assert!(iv.lo <= d + 1e-12 && d <= iv.hi, "{kind:?} {iv:?} {d}");
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn row_cache_gives_the_fresh_values() {
+        let a = Tpms::new(TpmsType::Gyroid, DVec3::new(5.0, 6.0, 7.0), 0.4);
+        let b = Tpms::new(TpmsType::Diamond, DVec3::splat(3.0), 0.2);
+        // Rows along x (cache hits), alternating nodes and rows (misses).
+        let pts: Vec<DVec3> = (0..400)
+            .map(|i| DVec3::new(i as f64 * 0.07, (i / 50) as f64 * 0.3, -((i / 30) as f64)))
+            .collect();
+        let fresh = |t: &Tpms, p: DVec3| {
+            let q = p * t.k;
+            let ((sx, cx), (sy, cy), (sz, cz)) = (sin_cos(q.x), sin_cos(q.y), sin_cos(q.z));
+            match t.kind {
+                TpmsType::Gyroid => sx * cy + sy * cz + sz * cx,
+                _ => sx * sy * sz + sx * cy * cz + cx * sy * cz + cx * cy * sz,
+            }
+        };
+        for (i, p) in pts.iter().enumerate() {
+            // Mostly one node along a row (hits), now and then the other
+            // node in between (a miss, then a miss back).
+            let nodes: &[&Tpms] = if i % 7 == 0 { &[&a, &b, &a] } else { &[&a] };
+            for t in nodes {
+                assert_eq!(t.field(*p).0.to_bits(), fresh(t, *p).to_bits(), "{p}");
             }
         }
     }
