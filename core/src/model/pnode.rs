@@ -11,6 +11,7 @@ use std::sync::Arc;
 use glam::{DMat3, DVec2, DVec3};
 
 use super::sdf;
+use super::strut_grid::StrutGrid;
 use super::tpms::Tpms;
 use super::union_index::{Candidates, UnionIndex};
 use crate::bounds::Aabb;
@@ -142,6 +143,8 @@ pub enum PNode {
     Lattice {
         struts: Vec<Capsule>,
         r: f64,
+        /// Short strut lists per sub-cell of the clip box (see `strut_grid`).
+        grid: Option<Box<StrutGrid>>,
         clip_h: Option<DVec3>,
         m: Slot,
     },
@@ -273,14 +276,27 @@ impl PNode {
             }
             PNode::Tpms { t, .. } => t.dist(p),
             PNode::Lattice {
-                struts, clip_h, r, ..
+                struts,
+                clip_h,
+                r,
+                grid,
+                ..
             } => {
                 // min(√d²ᵢ − r) = √(min d²ᵢ) − r, bit for bit (the square
                 // root is monotone): one square root a point, not one a
                 // strut (they were most of an FCC lattice's time).
                 let mut d2 = f64::INFINITY;
-                for s in struts {
-                    d2 = d2.min(s.axis_dist2(p));
+                match grid.as_ref().and_then(|g| g.candidates(p)) {
+                    Some(list) => {
+                        for &k in list {
+                            d2 = d2.min(struts[k as usize].axis_dist2(p));
+                        }
+                    }
+                    None => {
+                        for s in struts {
+                            d2 = d2.min(s.axis_dist2(p));
+                        }
+                    }
                 }
                 let d = d2.sqrt() - r;
                 match clip_h {

@@ -8,6 +8,7 @@ use std::sync::Arc;
 use glam::{DMat3, DVec2, DVec3};
 
 use super::pnode::{Capsule, Grade, LineCapsule, NAry, PNode, Prism, SimGrade, Slot};
+use super::strut_grid::StrutGrid;
 use super::tpms::Tpms;
 use super::union_index::UnionIndex;
 use super::{MAX_MATERIALS, PrepareError};
@@ -210,6 +211,7 @@ impl Preparer {
                 };
                 (
                     PNode::Lattice {
+                        grid: cell.and_then(|c| StrutGrid::new(&struts, c * 0.5).map(Box::new)),
                         struts,
                         r: *radius,
                         clip_h: cell.map(|c| c * 0.5),
