@@ -43,8 +43,8 @@ fn mesh_interval(mesh: &crate::mesh::TriangleMesh, b: &Aabb) -> Interval {
 /// The part of a Tile child's domain that box `b` maps to: the mapped box if
 /// `b` lies in one cell, else the whole cell.
 fn tile_box(b: &Aabb, cell: DVec3) -> Aabb {
-    let lo = (b.min / cell).floor();
-    let hi = (b.max / cell).floor();
+    let lo = crate::fastmath::floor3(b.min / cell);
+    let hi = crate::fastmath::floor3(b.max / cell);
     if lo == hi {
         let q = tile_local(b.min, cell);
         Aabb::new(q, q + b.size())
