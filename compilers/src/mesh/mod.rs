@@ -34,6 +34,7 @@ pub mod indexed;
 pub mod obj;
 pub mod segment;
 pub mod stl;
+mod text_blocks;
 pub mod threemf;
 mod vertex_keys;
 

@@ -6,6 +6,7 @@
 use std::io::{self, Write};
 
 use super::indexed::IndexedMesh;
+use super::text_blocks::write_blocks;
 
 /// Write `mesh` as OBJ object `name`.
 pub fn write_obj(mesh: &IndexedMesh, name: &str, w: &mut impl Write) -> io::Result<()> {
@@ -18,26 +19,26 @@ pub fn write_obj(mesh: &IndexedMesh, name: &str, w: &mut impl Write) -> io::Resu
     )?;
     writeln!(w, "o {name}")?;
     // ryu/itoa: millions of numbers; `{}` formatting dominated the export.
-    let (mut f, mut i) = (ryu::Buffer::new(), itoa::Buffer::new());
-    for [x, y, z] in &mesh.vertices {
-        w.write_all(b"v ")?;
-        w.write_all(f.format(*x).as_bytes())?;
-        w.write_all(b" ")?;
-        w.write_all(f.format(*y).as_bytes())?;
-        w.write_all(b" ")?;
-        w.write_all(f.format(*z).as_bytes())?;
-        w.write_all(b"\n")?;
-    }
-    for [a, b, c] in &mesh.triangles {
-        w.write_all(b"f ")?;
-        w.write_all(i.format(a + 1).as_bytes())?;
-        w.write_all(b" ")?;
-        w.write_all(i.format(b + 1).as_bytes())?;
-        w.write_all(b" ")?;
-        w.write_all(i.format(c + 1).as_bytes())?;
-        w.write_all(b"\n")?;
-    }
-    Ok(())
+    write_blocks(&mesh.vertices, w, |out, [x, y, z]| {
+        let mut f = ryu::Buffer::new();
+        out.extend_from_slice(b"v ");
+        out.extend_from_slice(f.format(*x).as_bytes());
+        out.push(b' ');
+        out.extend_from_slice(f.format(*y).as_bytes());
+        out.push(b' ');
+        out.extend_from_slice(f.format(*z).as_bytes());
+        out.push(b'\n');
+    })?;
+    write_blocks(&mesh.triangles, w, |out, [a, b, c]| {
+        let mut i = itoa::Buffer::new();
+        out.extend_from_slice(b"f ");
+        out.extend_from_slice(i.format(a + 1).as_bytes());
+        out.push(b' ');
+        out.extend_from_slice(i.format(b + 1).as_bytes());
+        out.push(b' ');
+        out.extend_from_slice(i.format(c + 1).as_bytes());
+        out.push(b'\n');
+    })
 }
 
 #[cfg(test)]

@@ -13,22 +13,15 @@
 //! The ZIP is written by [`crate::zip_writer`]: entries deflated (level 1)
 //! on every core with a fixed 1980-01-01 time stamp, so the bytes repeat run
 //! to run and on any thread count. The model XML is formatted in parallel
-//! too, in blocks of [`BLOCK`] vertices or triangles; on a curved design it
+//! too (`text_blocks`); on a curved design it
 //! is hundreds of megabytes, and one core formatting and deflating it made
 //! the 3MF the slowest file of a mesh export.
 
 use std::io::{self, Seek, Write};
 
-use rayon::prelude::*;
-
 use super::indexed::IndexedMesh;
+use super::text_blocks::write_blocks;
 use crate::zip_writer::ZipOut;
-
-/// Vertices or triangles formatted per parallel task.
-const BLOCK: usize = 1 << 15;
-/// Blocks formatted per batch before they are handed to the deflater
-/// (bounds the text held in memory to about 100 MB).
-const BLOCKS_PER_BATCH: usize = 64;
 
 /// One part (volume) of the object.
 pub struct Part<'a> {
@@ -141,31 +134,6 @@ fn write_model(parts: &[Part<'_>], object_name: &str, m: &mut impl Write) -> io:
         m,
         " <build>\n  <item objectid=\"1\" printable=\"1\"/>\n </build>\n</model>"
     )?;
-    Ok(())
-}
-
-/// Formats `items` with `line` in parallel blocks and writes the text in
-/// order (the same bytes as one loop over the items).
-fn write_blocks<T: Sync>(
-    items: &[T],
-    m: &mut impl Write,
-    line: impl Fn(&mut Vec<u8>, &T) + Sync,
-) -> io::Result<()> {
-    for batch in items.chunks(BLOCK * BLOCKS_PER_BATCH) {
-        let texts: Vec<Vec<u8>> = batch
-            .par_chunks(BLOCK)
-            .map(|block| {
-                let mut out = Vec::with_capacity(block.len() * 64);
-                for it in block {
-                    line(&mut out, it);
-                }
-                out
-            })
-            .collect();
-        for t in &texts {
-            m.write_all(t)?;
-        }
-    }
     Ok(())
 }
 
