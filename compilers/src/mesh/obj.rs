@@ -6,7 +6,7 @@
 use std::io::{self, Write};
 
 use super::indexed::IndexedMesh;
-use super::text_blocks::write_blocks;
+use super::text_blocks::{Floats, Ints, push_line, write_blocks};
 
 /// Write `mesh` as OBJ object `name`.
 pub fn write_obj(mesh: &IndexedMesh, name: &str, w: &mut impl Write) -> io::Result<()> {
@@ -19,25 +19,12 @@ pub fn write_obj(mesh: &IndexedMesh, name: &str, w: &mut impl Write) -> io::Resu
     )?;
     writeln!(w, "o {name}")?;
     // ryu/itoa: millions of numbers; `{}` formatting dominated the export.
-    write_blocks(&mesh.vertices, w, |out, [x, y, z]| {
-        let mut f = ryu::Buffer::new();
-        out.extend_from_slice(b"v ");
-        out.extend_from_slice(f.format(*x).as_bytes());
-        out.push(b' ');
-        out.extend_from_slice(f.format(*y).as_bytes());
-        out.push(b' ');
-        out.extend_from_slice(f.format(*z).as_bytes());
-        out.push(b'\n');
+    write_blocks(&mesh.vertices, w, |out, v| {
+        push_line(out, [b"v ", b" ", b" ", b"\n"], Floats::new().format(*v));
     })?;
-    write_blocks(&mesh.triangles, w, |out, [a, b, c]| {
-        let mut i = itoa::Buffer::new();
-        out.extend_from_slice(b"f ");
-        out.extend_from_slice(i.format(a + 1).as_bytes());
-        out.push(b' ');
-        out.extend_from_slice(i.format(b + 1).as_bytes());
-        out.push(b' ');
-        out.extend_from_slice(i.format(c + 1).as_bytes());
-        out.push(b'\n');
+    write_blocks(&mesh.triangles, w, |out, t| {
+        let t = t.map(|i| u64::from(i) + 1);
+        push_line(out, [b"f ", b" ", b" ", b"\n"], Ints::new().format(t));
     })
 }
 

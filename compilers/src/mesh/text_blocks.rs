@@ -37,3 +37,56 @@ pub fn write_blocks<T: Sync>(
     }
     Ok(())
 }
+
+/// Appends `glue[0] a glue[1] b glue[2] c glue[3]`: one vertex or
+/// triangle line of any of the text formats.
+#[inline(always)]
+pub fn push_line(out: &mut Vec<u8>, glue: [&[u8]; 4], [a, b, c]: [&str; 3]) {
+    out.extend_from_slice(glue[0]);
+    out.extend_from_slice(a.as_bytes());
+    out.extend_from_slice(glue[1]);
+    out.extend_from_slice(b.as_bytes());
+    out.extend_from_slice(glue[2]);
+    out.extend_from_slice(c.as_bytes());
+    out.extend_from_slice(glue[3]);
+}
+
+/// Three floats as shortest round-trip text (ryu).
+pub struct Floats([ryu::Buffer; 3]);
+
+impl Floats {
+    /// Buffers for [`Floats::format`].
+    #[inline(always)]
+    pub fn new() -> Self {
+        Floats([ryu::Buffer::new(), ryu::Buffer::new(), ryu::Buffer::new()])
+    }
+
+    /// The three values' text.
+    #[inline(always)]
+    pub fn format(&mut self, v: [f32; 3]) -> [&str; 3] {
+        let [a, b, c] = &mut self.0;
+        [a.format(v[0]), b.format(v[1]), c.format(v[2])]
+    }
+}
+
+/// Three integers as text (itoa).
+pub struct Ints([itoa::Buffer; 3]);
+
+impl Ints {
+    /// Buffers for [`Ints::format`].
+    #[inline(always)]
+    pub fn new() -> Self {
+        Ints([
+            itoa::Buffer::new(),
+            itoa::Buffer::new(),
+            itoa::Buffer::new(),
+        ])
+    }
+
+    /// The three values' text.
+    #[inline(always)]
+    pub fn format(&mut self, v: [u64; 3]) -> [&str; 3] {
+        let [a, b, c] = &mut self.0;
+        [a.format(v[0]), b.format(v[1]), c.format(v[2])]
+    }
+}

@@ -20,7 +20,7 @@
 use std::io::{self, Seek, Write};
 
 use super::indexed::IndexedMesh;
-use super::text_blocks::write_blocks;
+use super::text_blocks::{Floats, Ints, push_line, write_blocks};
 use crate::zip_writer::ZipOut;
 
 /// One part (volume) of the object.
@@ -98,31 +98,21 @@ fn write_model(parts: &[Part<'_>], object_name: &str, m: &mut impl Write) -> io:
     )?;
     writeln!(m, "   <mesh>\n    <vertices>")?;
     for p in parts {
-        write_blocks(&p.mesh.vertices, m, |out, [x, y, z]| {
-            // ryu/itoa: millions of numbers; `{}` formatting dominated.
-            let mut f = ryu::Buffer::new();
-            out.extend_from_slice(b"     <vertex x=\"");
-            out.extend_from_slice(f.format(*x).as_bytes());
-            out.extend_from_slice(b"\" y=\"");
-            out.extend_from_slice(f.format(*y).as_bytes());
-            out.extend_from_slice(b"\" z=\"");
-            out.extend_from_slice(f.format(*z).as_bytes());
-            out.extend_from_slice(b"\"/>\n");
+        write_blocks(&p.mesh.vertices, m, |out, v| {
+            let glue: [&[u8]; 4] = [b"     <vertex x=\"", b"\" y=\"", b"\" z=\"", b"\"/>\n"];
+            push_line(out, glue, Floats::new().format(*v));
         })?;
     }
     writeln!(m, "    </vertices>\n    <triangles>")?;
     let mut base = 0u64;
     for p in parts {
         write_blocks(&p.mesh.triangles, m, |out, t| {
-            let mut i = itoa::Buffer::new();
-            let [a, b, c] = t.map(|v| base + u64::from(v));
-            out.extend_from_slice(b"     <triangle v1=\"");
-            out.extend_from_slice(i.format(a).as_bytes());
-            out.extend_from_slice(b"\" v2=\"");
-            out.extend_from_slice(i.format(b).as_bytes());
-            out.extend_from_slice(b"\" v3=\"");
-            out.extend_from_slice(i.format(c).as_bytes());
-            out.extend_from_slice(b"\"/>\n");
+            let glue: [&[u8]; 4] = [b"     <triangle v1=\"", b"\" v2=\"", b"\" v3=\"", b"\"/>\n"];
+            push_line(
+                out,
+                glue,
+                Ints::new().format(t.map(|v| base + u64::from(v))),
+            );
         })?;
         base += p.mesh.vertices.len() as u64;
     }
