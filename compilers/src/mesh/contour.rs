@@ -150,6 +150,15 @@ struct BandFlats {
     kept: KeptCubes,
 }
 
+impl BandFlats {
+    fn with_capacity(cubes: usize, stride: usize) -> Self {
+        BandFlats {
+            at: Vec::with_capacity(cubes),
+            kept: KeptCubes::with_capacity(cubes, stride),
+        }
+    }
+}
+
 /// Rows of cubes a contouring task takes: fewer, larger tasks cost less
 /// to schedule and allocate for than one per row (most rows of a solid
 /// part hold two surface cubes).
@@ -180,6 +189,12 @@ pub struct Contourer {
     /// allocate and fill a fresh table the size of a plane.
     spare_flat: Vec<u32>,
     spare_list: Vec<(usize, u8)>,
+    /// Per band of rows, the triangles and flat cubes it made in the last
+    /// layer: the next layer's buffers start at that size (plus an eighth),
+    /// since growing them by doubling copied and faulted in their memory
+    /// again and again (kernel page handling was about 9 % of a graded-bar
+    /// export).
+    band_sizes: Vec<(usize, usize)>,
 }
 
 impl Contourer {
@@ -199,6 +214,7 @@ impl Contourer {
             prev_list: Vec::new(),
             spare_flat: Vec::new(),
             spare_list: Vec::new(),
+            band_sizes: Vec::new(),
         }
     }
 
@@ -244,16 +260,22 @@ impl Contourer {
         // label's mesh (one map lookup per row vertex instead of one per
         // triangle corner: the sequential part was a third of contouring).
         let rows = ny.saturating_sub(1);
-        let bands: Vec<(BandMesh, BandFlats)> = (0..rows.div_ceil(BAND))
+        let sizes = &self.band_sizes;
+        let bands: Vec<(BandMesh, BandFlats, (usize, usize))> = (0..rows.div_ceil(BAND))
             .into_par_iter()
             .map(|b| {
                 let js = b * BAND..((b + 1) * BAND).min(rows);
-                let (tris, flats) = self.band(pz, js, &lo, &plane);
-                (BandMesh::new(tris), flats)
+                let hint = sizes
+                    .get(b)
+                    .map_or((0, 0), |&(t, f)| (t + t / 8, f + f / 8));
+                let (tris, flats) = self.band(pz, js, &lo, &plane, hint);
+                let made = (tris.len(), flats.at.len());
+                (BandMesh::new(tris), flats, made)
             })
             .collect();
+        self.band_sizes = bands.iter().map(|b| b.2).collect();
         let mut global = Vec::new();
-        for (row, _) in &bands {
+        for (row, _, _) in &bands {
             global.clear();
             for &(label, key, pos) in &row.verts {
                 global.push(self.index_of(pz, label, VRef { key, pos }));
@@ -324,10 +346,11 @@ impl Contourer {
         js: std::ops::Range<usize>,
         lo: &Plane,
         hi: &Plane,
+        (tris, flat): (usize, usize),
     ) -> (Vec<Tri>, BandFlats) {
         let nx = self.grid.dims[0];
-        let mut out = Vec::new();
-        let mut flats = BandFlats::default();
+        let mut out = Vec::with_capacity(tris);
+        let mut flats = BandFlats::with_capacity(flat, self.iface.stride());
         let mut scratch = Scratch::default();
         for j in js {
             let rows = [

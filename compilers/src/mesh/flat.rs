@@ -147,6 +147,14 @@ pub(super) struct KeptCubes {
 }
 
 impl KeptCubes {
+    /// Room for `cubes` cubes of `stride` interface values a sample.
+    pub fn with_capacity(cubes: usize, stride: usize) -> Self {
+        KeptCubes {
+            cubes: Vec::with_capacity(cubes),
+            values: Vec::with_capacity(cubes * 8 * stride),
+        }
+    }
+
     /// Keep `cube`'s samples.
     pub fn push(&mut self, cube: &Cube) {
         self.cubes.push(Kept {
