@@ -201,6 +201,35 @@ fn bad_input_is_a_clear_error() {
         "cell",
     ]));
     assert!(err.contains("expected NAME=VALUE"), "{err}");
+
+    // A step larger than the part (the graded bar is 5 mm tall) is refused
+    // before anything is written; zero is allowed with a note.
+    let fea = |step: &str, out: &Path| {
+        volcad(&[
+            "export",
+            "fea",
+            &example("graded_bar.rhai"),
+            "--out",
+            out.to_str().unwrap(),
+            "--voxel",
+            "1",
+            "--step",
+            step,
+        ])
+    };
+    let err = fails(&fea("1e300", &d.join("f1")));
+    assert!(
+        err.contains("--step") && err.contains("not smaller than the part's height (5.0000 mm)"),
+        "{err}"
+    );
+    assert!(!d.join("f1").exists());
+    let text = ok(&fea("0", &d.join("f2")));
+    assert!(
+        text.contains("--step 0: the top is held in place"),
+        "{text}"
+    );
+    let text = ok(&fea("-1", &d.join("f3")));
+    assert!(text.contains("20 % of the part's height"), "{text}");
 }
 
 #[test]

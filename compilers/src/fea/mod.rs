@@ -373,20 +373,44 @@ fn for_samples(n: usize, mut f: impl FnMut(DVec3)) {
     }
 }
 
+/// The `--step` displacement against the part's height `h` (mm): a number,
+/// and smaller than `h` (a top moved by the whole height has crushed the
+/// part or doubled it, far outside the small strains of a linear static
+/// step); a note past a tenth of `h`, and for 0 (the solution is zero).
+fn check_step(d: f64, h: f64, notes: &mut Vec<String>) -> Result<(), ExportError> {
+    if !d.is_finite() {
+        return Err(ExportError::param(
+            "--step",
+            format!("the top displacement must be a number of mm, got {d}"),
+        ));
+    }
+    if d.abs() >= h {
+        return Err(ExportError::param(
+            "--step",
+            format!(
+                "{d} mm is not smaller than the part's height ({h:.4} mm); a linear static step needs small strains (a few percent of the height)"
+            ),
+        ));
+    }
+    if d == 0.0 {
+        notes.push(
+            "--step 0: the top is held in place, so every displacement and stress is 0".into(),
+        );
+    } else if d.abs() > 0.1 * h {
+        notes.push(format!(
+            "--step {d} mm is {:.0} % of the part's height ({h:.4} mm): a linear static step assumes small strains, so the result is only indicative",
+            100.0 * d.abs() / h
+        ));
+    }
+    Ok(())
+}
+
 /// Mesh `model` and write `<staging>/model.inp` (see the module doc).
 pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summary, ExportError> {
     let start = Instant::now();
     let (materials, mut notes) = elastic_materials(model)?;
-    if let Some(s) = &p.step
-        && !s.top_displacement.is_finite()
-    {
-        return Err(ExportError::param(
-            "--step",
-            format!(
-                "the top displacement must be a number of mm, got {}",
-                s.top_displacement
-            ),
-        ));
+    if let Some(s) = &p.step {
+        check_step(s.top_displacement, model.bbox().size().z, &mut notes)?;
     }
     let progress = |stage: &str, done: u64, total: u64, frac: f64| {
         ctx.progress(stage, done, total, "elements", frac * 0.9)
