@@ -264,6 +264,8 @@ fn write_stack(
         Some(_) => Sampler::new(model, grid, true),
         None => Sampler::new(model, grid, true).with_lazy_fractions(),
     };
+    // Pixels need the sign of the distance only.
+    let sampler = sampler.with_signs_only();
     let first = if diffuser.is_some() {
         Diffuser::warmup_start(est.layers.start)
     } else {

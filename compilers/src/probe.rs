@@ -41,7 +41,8 @@ pub fn probe(model: &Model, voxel: DVec3) -> Probe {
         return Probe::default();
     };
     let [nx, ny, nz] = grid.dims;
-    let sampler = Sampler::new(model, grid, true);
+    // Counts read signs only.
+    let sampler = Sampler::new(model, grid, true).with_signs_only();
     let mut slab = Slab::default();
     if sampler
         .sample_layers(0, nz, &mut slab, &AtomicBool::new(false))

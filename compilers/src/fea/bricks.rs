@@ -55,7 +55,8 @@ pub fn brick_mesh(
 ) -> Result<FeaMesh, ExportError> {
     let grid = grid(model, voxel)?;
     let [nx, ny, nz] = grid.dims;
-    let sampler = Sampler::new(model, grid, true);
+    // A brick is kept by the sign at its centre only.
+    let sampler = Sampler::new(model, grid, true).with_signs_only();
     let slots = model.materials();
     let mut mesh = FeaMesh::new(super::Element::C3D8R);
     let mut slab = Slab::default();

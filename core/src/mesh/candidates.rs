@@ -201,15 +201,7 @@ impl CandidateGrid {
     /// cell's side (0 when unknown); `None` when `p`'s cell keeps no list.
     #[inline]
     pub fn nearest(&self, mesh: &TriangleMesh, p: DVec3) -> Option<(usize, f64, i8)> {
-        let g = (p - self.min) * self.inv_cell;
-        if !(g.x >= 0.0 && g.y >= 0.0 && g.z >= 0.0) {
-            return None;
-        }
-        let (x, y, z) = (g.x as usize, g.y as usize, g.z as usize);
-        if x >= self.dims[0] || y >= self.dims[1] || z >= self.dims[2] {
-            return None;
-        }
-        let i = x + self.dims[0] * (y + self.dims[1] * z);
+        let (i, [x, y, z]) = self.cell_of(p)?;
         let list = &self.items[self.offsets[i] as usize..self.offsets[i + 1] as usize];
         let first = list.first()?;
         let c = self.min + (DVec3::new(x as f64, y as f64, z as f64) + 0.5) * self.cell;
@@ -235,6 +227,32 @@ impl CandidateGrid {
             }
         }
         Some((slot as usize, best, self.side[i]))
+    }
+
+    /// The cell holding `p` (index and coordinates); `None` outside the
+    /// grid or for a non-finite `p`.
+    #[inline]
+    fn cell_of(&self, p: DVec3) -> Option<(usize, [usize; 3])> {
+        let g = (p - self.min) * self.inv_cell;
+        if !(g.x >= 0.0 && g.y >= 0.0 && g.z >= 0.0) {
+            return None;
+        }
+        let (x, y, z) = (g.x as usize, g.y as usize, g.z as usize);
+        if x >= self.dims[0] || y >= self.dims[1] || z >= self.dims[2] {
+            return None;
+        }
+        Some((x + self.dims[0] * (y + self.dims[1] * z), [x, y, z]))
+    }
+
+    /// `+1` or `−1` when every point of `p`'s cell is on that side of the
+    /// surface (set at build time from the exact distance at the centre,
+    /// larger than the half diagonal); `None` when the surface may cross
+    /// the cell or `p` is outside the grid.
+    #[inline]
+    pub fn side(&self, p: DVec3) -> Option<i8> {
+        let (i, _) = self.cell_of(p)?;
+        let s = self.side[i];
+        (s != 0).then_some(s)
     }
 }
 

@@ -188,6 +188,18 @@ impl TriangleMesh {
         }
     }
 
+    /// True inside or on the surface: `signed_distance_bound(p, ε) ≤ 0`
+    /// for a tiny ε, without computing the distance where the candidate
+    /// grid knows the side of `p`'s whole cell (near the surface, where
+    /// the exact query is the expensive part). What a union asks when it
+    /// picks the child that holds a point's material.
+    pub fn contains(&self, p: DVec3) -> bool {
+        if let Some(side) = self.candidates.as_ref().and_then(|g| g.side(p)) {
+            return side < 0;
+        }
+        self.signed_distance_bound(p, 1e-9) <= 0.0
+    }
+
     /// Generalised winding number (Jacobson et al. 2013) by the hierarchical
     /// approximation of Barill et al. 2018 (exact near field, second-order
     /// far field): ≈1 inside a closed outward mesh, ≈0 outside, fractional

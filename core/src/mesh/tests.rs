@@ -168,6 +168,16 @@ fn bunny_near_surface_signs_match_winding() {
     }
 }
 
+/// A point within `reach` (per axis, half of it) of a random point on a
+/// random triangle.
+fn near_surface(rng: &mut Rng, v: &[DVec3], tris: &[[u32; 3]], reach: f64) -> DVec3 {
+    let t = tris[(rng.next_u64() % tris.len() as u64) as usize];
+    let (u, w) = (rng.f64() * 0.5, rng.f64() * 0.5);
+    let s = v[t[0] as usize] * (1.0 - u - w) + v[t[1] as usize] * u + v[t[2] as usize] * w;
+    let dir = DVec3::new(rng.f64() - 0.5, rng.f64() - 0.5, rng.f64() - 0.5);
+    s + dir * reach * rng.f64()
+}
+
 #[test]
 fn candidate_grid_matches_the_bvh() {
     // The per-cell lists must give the same nearest distance (bit for bit)
@@ -187,11 +197,7 @@ fn candidate_grid_matches_the_bvh() {
             rng.in_box(&region)
         } else {
             near += 1;
-            let t = tris[(rng.next_u64() % tris.len() as u64) as usize];
-            let (u, w) = (rng.f64() * 0.5, rng.f64() * 0.5);
-            let s = v[t[0] as usize] * (1.0 - u - w) + v[t[1] as usize] * u + v[t[2] as usize] * w;
-            let dir = DVec3::new(rng.f64() - 0.5, rng.f64() - 0.5, rng.f64() - 0.5);
-            s + dir * 2.0 * rng.f64()
+            near_surface(&mut rng, &v, &tris, 2.0)
         };
         let Some((slot, d2, side)) = g.nearest(&m, p) else {
             continue;
@@ -210,6 +216,33 @@ fn candidate_grid_matches_the_bvh() {
     }
     // The lists serve (at least) the points near the surface.
     assert!(used >= near, "{used} of {near}");
+}
+
+#[test]
+fn contains_agrees_with_the_signed_distance() {
+    // `contains` answers from the cell's side where it can; it must say
+    // what the exact signed distance says, near the surface and far.
+    let m = bunny();
+    let g = m.candidates.as_ref().expect("candidate grid");
+    let mut rng = Rng::new(11);
+    let region = m.bbox().expand(2.0);
+    let (v, tris) = (m.vertices().to_vec(), m.triangles().to_vec());
+    let (mut by_side, mut inside) = (0, 0);
+    for i in 0..20000 {
+        let p = if i % 4 == 0 {
+            rng.in_box(&region)
+        } else {
+            near_surface(&mut rng, &v, &tris, 3.0)
+        };
+        let exact = m.signed_distance(p);
+        assert_eq!(m.contains(p), exact <= 0.0, "point {i} {p}: {exact}");
+        by_side += usize::from(g.side(p).is_some());
+        inside += usize::from(exact <= 0.0);
+    }
+    // Both sides occur, and the side answers a good share (2,885 here).
+    assert!(inside > 2000 && inside < 18000, "{inside}");
+    assert!(by_side > 1500, "{by_side}");
+    assert!(!m.contains(DVec3::NAN));
 }
 
 #[test]

@@ -11,7 +11,7 @@ use super::MAX_MATERIALS;
 use super::pnode::{
     COORD_SLOTS, D_SLOT, Grade, NAry, PNode, SimGrade, Slot, coord_slots, tile_local,
 };
-use super::union_index::Candidates;
+use super::union_index::{Candidates, Entry};
 
 impl PNode {
     /// Distance at `p`, and the fractions into `out` (zeroed by the caller)
@@ -264,9 +264,17 @@ impl NAry {
             } = index.candidates(p)
         {
             // Only children whose lower bound is ≤ 0 can contain p; they
-            // come first. Visit them in child order.
+            // come first. Visit them in child order. A linear scan finds
+            // their end: they are few (a bunny-lattice voxel has 1 to 5 of
+            // a cell's hundred or so), they are all visited after, and a
+            // binary search's unpredictable branches cost more (it was
+            // 16 % of the bunny lattice's slice stack).
             let slack = self.slack(index, p, centre);
-            let n = entries.partition_point(|e| f64::from(e.lo) + slack <= 0.0);
+            let may_contain = |e: &Entry| f64::from(e.lo) + slack <= 0.0;
+            let n = entries
+                .iter()
+                .position(|e| !may_contain(e))
+                .unwrap_or(entries.len());
             let mut inside: [u32; 64] = [0; 64];
             if n <= inside.len() {
                 for (o, e) in inside.iter_mut().zip(&entries[..n]) {

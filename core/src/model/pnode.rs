@@ -249,8 +249,8 @@ impl PNode {
     #[inline]
     pub fn contains(&self, p: DVec3) -> bool {
         match self {
-            PNode::Mesh { mesh, .. } => mesh.signed_distance_bound(p, 1e-9) <= 0.0,
-            PNode::SimField(g) => g.field.boundary_mesh().signed_distance_bound(p, 1e-9) <= 0.0,
+            PNode::Mesh { mesh, .. } => mesh.contains(p),
+            PNode::SimField(g) => g.field.boundary_mesh().contains(p),
             _ => self.dist(p) <= 0.0,
         }
     }
