@@ -106,7 +106,10 @@ pub struct Summary {
     pub parameters: serde_json::Value,
     /// Free-form lines for the user (quality figures, warnings).
     pub notes: Vec<String>,
-    /// Wall time in seconds.
+    /// Wall time in seconds. Not written to the manifest, which records
+    /// only what defines the output: two runs of the same export write
+    /// the same bytes, manifest included.
+    #[serde(skip)]
     pub seconds: f64,
 }
 

@@ -50,7 +50,7 @@ use crate::lazy_random;
 use crate::png_io::{self, bit_row_bytes};
 pub use crate::presets::{Preset, preset, presets};
 use crate::probe::probe;
-use crate::resources::{check_disk, check_memory, human_bytes, run_with_threads};
+use crate::resources::{check_disk, check_memory, run_with_threads};
 
 /// How each voxel's material is chosen from its fractions.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -413,7 +413,9 @@ fn summary(
             est.layers.end
         ),
         "orientation: column 0 = min X, row 0 = max Y (top view), layer 0 = lowest Z".to_owned(),
-        format!("working memory about {}", human_bytes(est.memory_bytes)),
+        // No working-memory figure: it grows with the thread count, and
+        // the notes go into the manifest, which must not (the command line
+        // prints the estimate before it starts).
     ];
     for (name, c) in &counts {
         notes.push(format!(

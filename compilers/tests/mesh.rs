@@ -9,7 +9,7 @@ use std::io::{Cursor, Read};
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
-use common::{model, read_tree, run, tmp};
+use common::{manifest, model, read_tree, run, tmp};
 use glam::DVec3;
 use volcad_compilers::ExportError;
 use volcad_compilers::mesh::{
@@ -341,7 +341,7 @@ fn files_and_3mf_structure() {
 #[test]
 fn runs_and_thread_counts_give_identical_bytes() {
     let m = model(GRADED_BAR);
-    let mut trees = Vec::new();
+    let (mut trees, mut manifests) = (Vec::new(), Vec::new());
     for threads in [None, None, Some(1), Some(2)] {
         let dir = tmp();
         let p = MeshParams {
@@ -351,6 +351,7 @@ fn runs_and_thread_counts_give_identical_bytes() {
         };
         export(&m, &p, &dir.path().join("out")).unwrap();
         trees.push(read_tree(&dir.path().join("out")));
+        manifests.push(manifest(&dir.path().join("out")));
     }
     assert_eq!(trees[0].len(), 7);
     for t in &trees[1..] {
@@ -359,6 +360,10 @@ fn runs_and_thread_counts_give_identical_bytes() {
             "output differs between runs or thread counts"
         );
     }
+    assert!(
+        manifests.windows(2).all(|w| w[0] == w[1]),
+        "manifests differ"
+    );
 }
 
 #[test]

@@ -6,7 +6,7 @@ mod common;
 
 use std::sync::Arc;
 
-use common::{colour_counts, decode, model, read_tree, run, tmp};
+use common::{colour_counts, decode, manifest, model, read_tree, run, tmp};
 use glam::DVec3;
 use volcad_compilers::ExportError;
 use volcad_compilers::png_stack::{Dither, PngParams, estimate, export_png_stack, preset};
@@ -117,7 +117,7 @@ fn graded_sphere_with_diffusion_keeps_fractions_at_the_surface() {
 fn runs_and_thread_counts_give_identical_bytes() {
     let m = model(GRADED_BAR);
     for dither in [Dither::Random, Dither::Diffusion] {
-        let mut trees = Vec::new();
+        let (mut trees, mut manifests) = (Vec::new(), Vec::new());
         for threads in [None, None, Some(1), Some(2)] {
             let dir = tmp();
             let p = PngParams {
@@ -127,7 +127,12 @@ fn runs_and_thread_counts_give_identical_bytes() {
             };
             export(&m, &p, &dir.path().join("out")).unwrap();
             trees.push(read_tree(&dir.path().join("out")));
+            manifests.push(manifest(&dir.path().join("out")));
         }
+        assert!(
+            manifests.windows(2).all(|w| w[0] == w[1]),
+            "manifests differ"
+        );
         assert_eq!(trees[0].len(), 25 * 3, "RGBA + two 1-bit stacks");
         for t in &trees[1..] {
             assert!(

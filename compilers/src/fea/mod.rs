@@ -101,7 +101,9 @@ pub struct FeaParams {
     pub seed: u64,
     /// Append a ready static step.
     pub step: Option<StepParams>,
-    /// Worker threads (`None`: all cores). The output does not depend on it.
+    /// Worker threads (`None`: all cores). The output does not depend on
+    /// it, so the manifest does not record it either.
+    #[serde(skip)]
     pub threads: Option<usize>,
 }
 

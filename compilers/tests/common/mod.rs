@@ -27,6 +27,12 @@ where
 
 /// Every file under `dir` but the manifest (which holds timings), by
 /// relative path.
+/// The bytes of `dir/manifest.json` (compared on their own: a layer range's
+/// manifest differs from the full stack's, its files do not).
+pub fn manifest(dir: &Path) -> Vec<u8> {
+    std::fs::read(dir.join("manifest.json")).expect("every output has a manifest")
+}
+
 pub fn read_tree(dir: &Path) -> BTreeMap<String, Vec<u8>> {
     let mut out = BTreeMap::new();
     let mut stack = vec![dir.to_path_buf()];
