@@ -140,6 +140,30 @@ fn bad_input_is_a_clear_error() {
     assert!(err.contains("bad.rhai:2:"), "{err}");
     assert!(err.contains("did you mean \"red\""), "{err}");
 
+    // A script whose data doubles in a loop stops at its memory budget
+    // (here 64 MiB) with an error, instead of exhausting the machine.
+    let runaway = d.join("runaway.rhai");
+    std::fs::write(
+        &runaway,
+        "let m = default_materials();\nlet s = \"ab\";\nfor i in 0..60 { s += s; }\nSphere(Vec3(0,0,0), 1, m.id(\"red\"))\n",
+    )
+    .unwrap();
+    let run = |budget: &str| {
+        Command::new(env!("CARGO_BIN_EXE_volcad"))
+            .args(["info", runaway.to_str().unwrap()])
+            .env("VOLCAD_SCRIPT_MEMORY_MB", budget)
+            .output()
+            .expect("run volcad")
+    };
+    let err = fails(&run("64"));
+    assert!(err.contains("runaway.rhai:3:"), "{err}");
+    assert!(err.contains("grew past 64 MiB of memory"), "{err}");
+    let err = fails(&run("lots"));
+    assert!(
+        err.contains("VOLCAD_SCRIPT_MEMORY_MB=lots: give the script's memory budget"),
+        "{err}"
+    );
+
     // Parameters: a typo or a value outside the declared range is refused,
     // not ignored or clamped.
     let lattice = example("bcc_sphere.rhai");

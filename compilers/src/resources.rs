@@ -9,14 +9,7 @@ use std::path::Path;
 
 use crate::job::ExportError;
 
-/// Bytes of memory available to new allocations (`MemAvailable` from
-/// `/proc/meminfo`), or `None` where that is not known.
-pub fn available_memory() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024)
-}
+pub use volcad_core::heap::{available_memory, human_bytes};
 
 /// Free bytes on the file system holding `dir` (POSIX `df -Pk`: the fourth
 /// column of the second line is the space available in KiB), or `None`.
@@ -86,24 +79,6 @@ fn cores() -> usize {
 /// 64 (tests ask for a few more threads than a small machine has cores).
 pub fn max_threads() -> usize {
     (8 * cores()).max(64)
-}
-
-/// `n` bytes for people: "1.5 GiB", "12 MiB", "300 B".
-pub fn human_bytes(n: u64) -> String {
-    const UNITS: [&str; 5] = ["B", "KiB", "MiB", "GiB", "TiB"];
-    let mut v = n as f64;
-    let mut u = 0;
-    while v >= 1024.0 && u + 1 < UNITS.len() {
-        v /= 1024.0;
-        u += 1;
-    }
-    if u == 0 {
-        format!("{n} B")
-    } else if v < 10.0 {
-        format!("{v:.1} {}", UNITS[u])
-    } else {
-        format!("{v:.0} {}", UNITS[u])
-    }
 }
 
 /// Refuse when `needed` bytes of working memory exceed what is available

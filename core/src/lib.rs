@@ -28,6 +28,7 @@ pub mod bench;
 pub mod bounds;
 pub mod expr;
 pub mod fastmath;
+pub mod heap;
 pub mod interval;
 pub mod lattice;
 pub mod material;

@@ -12,6 +12,11 @@ use std::sync::atomic::Ordering;
 use clap::Parser;
 use volcad_studio::studio::{StudioApp, StudioOptions};
 
+/// Live heap bytes are counted so that a runaway script stops with an error
+/// instead of exhausting memory (`volcad_core::heap`).
+#[global_allocator]
+static HEAP: volcad_core::heap::CountingAllocator = volcad_core::heap::CountingAllocator;
+
 /// Volcad Studio: write a design script, see it live, export it.
 #[derive(Parser, Debug)]
 #[command(name = "volcad-studio", version)]

@@ -3,6 +3,11 @@
 
 use clap::Parser;
 
+/// Live heap bytes are counted so that a runaway script stops with an error
+/// instead of exhausting memory (`volcad_core::heap`).
+#[global_allocator]
+static HEAP: volcad_core::heap::CountingAllocator = volcad_core::heap::CountingAllocator;
+
 fn main() {
     let cli = volcad_studio::cli::Cli::parse();
     if let Err(e) = volcad_studio::cli::run(cli) {

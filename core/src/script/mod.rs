@@ -52,6 +52,10 @@ pub struct ScriptOptions {
     pub cancel: Option<Arc<AtomicBool>>,
     /// Operation limit (a runaway loop stops with an error).
     pub max_operations: u64,
+    /// Most bytes the process heap may grow by while the script runs (a
+    /// runaway allocation stops with an error; see [`crate::heap`]).
+    /// Checked only where the binary installs the counting allocator.
+    pub max_heap: u64,
 }
 
 impl Default for ScriptOptions {
@@ -61,6 +65,7 @@ impl Default for ScriptOptions {
             params: HashMap::new(),
             cancel: None,
             max_operations: 500_000_000,
+            max_heap: crate::heap::default_script_budget(),
         }
     }
 }
@@ -198,8 +203,16 @@ pub fn run_script(source: &str, name: &str, opts: &ScriptOptions) -> Result<Desi
         overrides: Arc::new(opts.params.clone()),
         state: Arc::new(Mutex::new(RunState::default())),
     };
+    if let Err(message) = crate::heap::budget_from_env() {
+        return Err(ScriptError {
+            file: name.to_owned(),
+            line: None,
+            column: None,
+            message,
+        });
+    }
     let engine = build_engine(&ctx, opts);
-    let err = |e: &EvalAltResult| to_script_error(e, name, &engine);
+    let err = |e: &EvalAltResult| to_script_error(e, name, &engine, opts.max_heap);
     let ast = engine.compile(source).map_err(|e| {
         let pos = e.position();
         ScriptError {
@@ -267,7 +280,10 @@ fn check_materials(root: &Node, table: &MaterialTable, name: &str) -> Result<(),
 
 /// Flatten Rhai's nested "error in function call" wrappers into the inner
 /// message at the innermost known position.
-fn to_script_error(e: &EvalAltResult, file: &str, engine: &Engine) -> ScriptError {
+/// The token of a script stopped by its heap budget.
+const HEAP_STOP: &str = "heap budget";
+
+fn to_script_error(e: &EvalAltResult, file: &str, engine: &Engine, max_heap: u64) -> ScriptError {
     let mut cur = e;
     let mut pos = e.position();
     while let EvalAltResult::ErrorInFunctionCall(_, _, inner, p) = cur {
@@ -281,6 +297,17 @@ fn to_script_error(e: &EvalAltResult, file: &str, engine: &Engine) -> ScriptErro
     }
     let message = match cur {
         EvalAltResult::ErrorRuntime(v, _) => v.to_string(),
+        EvalAltResult::ErrorTerminated(token, _)
+            if token
+                .clone()
+                .into_immutable_string()
+                .is_ok_and(|s| s == HEAP_STOP) =>
+        {
+            format!(
+                "stopped: the script's data grew past {} of memory (a value doubled in a loop?)",
+                crate::heap::human_bytes(max_heap)
+            )
+        }
         EvalAltResult::ErrorTerminated(..) => "stopped: the script was cancelled".into(),
         EvalAltResult::ErrorTooManyOperations(_) => {
             "stopped: the script ran too many operations (an endless loop?)".into()
@@ -353,8 +380,20 @@ fn build_engine(ctx: &RunContext, opts: &ScriptOptions) -> Engine {
     engine.set_max_call_levels(256);
     engine.set_max_expr_depths(512, 256);
     engine.set_max_operations(opts.max_operations);
-    if let Some(cancel) = opts.cancel.clone() {
-        engine.on_progress(move |_| cancel.load(Ordering::Relaxed).then_some(Dynamic::UNIT));
+    // Every operation: cancel, and the heap budget (where counted).
+    let cancel = opts.cancel.clone();
+    let heap_limit =
+        crate::heap::live_bytes().map(|live| (live as u64).saturating_add(opts.max_heap) as usize);
+    if cancel.is_some() || heap_limit.is_some() {
+        engine.on_progress(move |_| {
+            if cancel.as_ref().is_some_and(|c| c.load(Ordering::Relaxed)) {
+                return Some(Dynamic::UNIT);
+            }
+            let limit = heap_limit?;
+            crate::heap::live_bytes()
+                .is_some_and(|live| live > limit)
+                .then(|| Dynamic::from(HEAP_STOP))
+        });
     }
     let log = ctx.clone();
     engine.on_print(move |s| log.lock().log.push(s.to_owned()));
