@@ -20,13 +20,8 @@ use crate::Model;
 /// points if the band is too thin to find them.
 pub fn near_surface_points(model: &Model, n: usize, band: f64, seed: u64) -> Vec<DVec3> {
     let b = model.bbox();
-    let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
-    let mut next = || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = crate::xorshift::XorShift::new(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+    let mut next = || rng.next_f64();
     const CELLS: usize = 32;
     let cell = b.size() / CELLS as f64;
     let near: Vec<DVec3> = (0..CELLS * CELLS * CELLS)

@@ -112,13 +112,8 @@ mod tests {
 
     #[test]
     fn agrees_with_the_c_library() {
-        let mut state = 0x2545_F491_4F6C_DD1Du64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::xorshift::XorShift::new(0x2545_F491_4F6C_DD1Du64);
+        let mut next = || rng.next_f64();
         let mut worst = 0.0f64;
         for i in 0..400_000 {
             // Uniform on growing ranges up to REDUCE_MAX, both signs.

@@ -39,6 +39,7 @@ pub mod node;
 pub mod sampler;
 pub mod script;
 pub mod simfield;
+pub mod xorshift;
 
 pub use bounds::Aabb;
 pub use glam::DVec3;

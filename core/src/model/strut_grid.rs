@@ -118,13 +118,8 @@ mod tests {
                 "{kind:?} {}",
                 g.mean_len()
             );
-            let mut state = 0x1234_5678_9ABC_DEF1u64;
-            let mut next = || {
-                state ^= state << 13;
-                state ^= state >> 7;
-                state ^= state << 17;
-                (state >> 11) as f64 / (1u64 << 53) as f64
-            };
+            let mut rng = crate::xorshift::XorShift::new(0x1234_5678_9ABC_DEF1u64);
+            let mut next = || rng.next_f64();
             for _ in 0..20_000 {
                 // Inside the cell, and on sub-cell faces (multiples of 1/8).
                 let f = DVec3::new(next(), next(), next());

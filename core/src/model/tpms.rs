@@ -189,13 +189,8 @@ mod tests {
     fn second_order_bounds_hold_and_settle_leaf_tiles() {
         // Random boxes, flat ones (a sampler's tile lies in one layer) and
         // cubes, dense samples in each: every sample inside the interval.
-        let mut state = 0x2545_F491_4F6C_DD1Du64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::xorshift::XorShift::new(0x2545_F491_4F6C_DD1Du64);
+        let mut next = || rng.next_f64();
         for kind in [TpmsType::Gyroid, TpmsType::SchwarzP, TpmsType::Diamond] {
             let t = Tpms::new(kind, DVec3::new(8.0, 7.0, 9.0), 0.8);
             let (mut settled, mut first_order) = (0, 0);
