@@ -27,7 +27,6 @@
 use glam::DVec3;
 
 use crate::bounds::Aabb;
-use crate::fastmath::sin_cos;
 use crate::interval::Interval;
 use crate::node::TpmsType;
 
@@ -64,8 +63,7 @@ impl Tpms {
     #[inline]
     fn field(&self, p: DVec3) -> (f64, DVec3) {
         let q = p * self.k;
-        let (sx, cx) = sin_cos(q.x);
-        let [sy, cy, sz, cz] = row::sin_cos_yz(q.y, q.z);
+        let [sx, cx, sy, cy, sz, cz] = row::sin_cos_xyz(q);
         match self.kind {
             TpmsType::Gyroid => (
                 sx * cy + sy * cz + sz * cx,
@@ -130,31 +128,59 @@ impl Tpms {
     }
 }
 
-/// Samplers walk rows of voxels along x, where y and z stay the same: the
-/// last `(y, z)` pair's sines and cosines are kept per thread and reused
-/// when the same bits come again. They are a pure function of those bits,
-/// so the values are exactly the ones a fresh computation gives.
+/// Samplers walk rows of voxels along x, where y and z stay the same, and
+/// every row of a grid has the same x values. So per thread the last
+/// `(y, z)` pair's sines and cosines are kept, and those of x in a small
+/// direct-mapped table keyed by its bits (1024 entries: a row of a fine
+/// grid fits). The values are a pure function of the bits, so they are
+/// exactly the ones a fresh computation gives.
 mod row {
-    use std::cell::Cell;
+    use std::cell::RefCell;
+
+    use glam::DVec3;
 
     use crate::fastmath::sin_cos;
 
-    thread_local! {
-        static LAST: Cell<(u64, u64, [f64; 4])> = const { Cell::new((u64::MAX, u64::MAX, [f64::NAN; 4])) };
+    const SLOTS: usize = 1024;
+
+    struct Cache {
+        yz: (u64, u64, [f64; 4]),
+        x: [(u64, f64, f64); SLOTS],
     }
 
-    /// `[sin y, cos y, sin z, cos z]`.
+    thread_local! {
+        static CACHE: RefCell<Cache> = const {
+            RefCell::new(Cache {
+                yz: (u64::MAX, u64::MAX, [f64::NAN; 4]),
+                // NaN's bits never match a key a sampler asks (it asks
+                // finite values; a NaN is computed, not looked up).
+                x: [(u64::MAX, f64::NAN, f64::NAN); SLOTS],
+            })
+        };
+    }
+
+    /// `[sin x, cos x, sin y, cos y, sin z, cos z]` of `q`.
     #[inline]
-    pub fn sin_cos_yz(y: f64, z: f64) -> [f64; 4] {
-        LAST.with(|c| {
-            let (ky, kz, v) = c.get();
-            if ky == y.to_bits() && kz == z.to_bits() {
-                return v;
+    pub fn sin_cos_xyz(q: DVec3) -> [f64; 6] {
+        if !q.is_finite() {
+            let ((sx, cx), (sy, cy), (sz, cz)) = (sin_cos(q.x), sin_cos(q.y), sin_cos(q.z));
+            return [sx, cx, sy, cy, sz, cz];
+        }
+        CACHE.with(|c| {
+            let mut c = c.borrow_mut();
+            let (ky, kz) = (q.y.to_bits(), q.z.to_bits());
+            if c.yz.0 != ky || c.yz.1 != kz {
+                let ((sy, cy), (sz, cz)) = (sin_cos(q.y), sin_cos(q.z));
+                c.yz = (ky, kz, [sy, cy, sz, cz]);
             }
-            let ((sy, cy), (sz, cz)) = (sin_cos(y), sin_cos(z));
-            let v = [sy, cy, sz, cz];
-            c.set((y.to_bits(), z.to_bits(), v));
-            v
+            let [sy, cy, sz, cz] = c.yz.2;
+            let kx = q.x.to_bits();
+            let slot = &mut c.x[(kx ^ (kx >> 17) ^ (kx >> 34)) as usize % SLOTS];
+            if slot.0 != kx {
+                let (sx, cx) = sin_cos(q.x);
+                *slot = (kx, sx, cx);
+            }
+            [slot.1, slot.2, sy, cy, sz, cz]
         })
     }
 }
@@ -162,6 +188,7 @@ mod row {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fastmath::sin_cos;
 
     #[test]
     fn interval_contains_samples() {
@@ -241,7 +268,9 @@ mod tests {
                 _ => sx * sy * sz + sx * cy * cz + cx * sy * cz + cx * cy * sz,
             }
         };
-        for (i, p) in pts.iter().enumerate() {
+        // Twice: the second pass finds every x in the table (and the rows
+        // of a grid repeat their x values like this).
+        for (i, p) in pts.iter().chain(&pts).enumerate() {
             // Mostly one node along a row (hits), now and then the other
             // node in between (a miss, then a miss back).
             let nodes: &[&Tpms] = if i % 7 == 0 { &[&a, &b, &a] } else { &[&a] };
