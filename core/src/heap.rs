@@ -15,8 +15,9 @@
 //! cancel). It stops when the heap has grown by more than its budget since
 //! the script started (`ScriptOptions::max_heap`). Growth by doubling is
 //! caught one doubling after the budget, so the peak stays within about
-//! three budgets. One single enormous allocation is not caught: it happens
-//! inside one operation.
+//! three budgets. One single enormous allocation happens inside one
+//! operation: Rhai's functions that allocate by count (`pad`, `blob`) are
+//! replaced by ones that check the budget first (`script/bulk.rs`).
 //!
 //! Where no counting allocator is installed (a library user's program),
 //! [`live_bytes`] is `None` and scripts run without the check.

@@ -8,6 +8,7 @@
 //! runaway script stops at an operation limit or when its cancel flag is set.
 //! The design is the script's final value, or else a variable named `root`.
 
+mod bulk;
 mod file_cache;
 mod files_api;
 mod nodes_api;
@@ -407,6 +408,7 @@ fn build_engine(ctx: &RunContext, opts: &ScriptOptions) -> Engine {
     nodes_api::register_composites(&mut engine);
     nodes_api::register_methods(&mut engine);
     files_api::register(&mut engine, ctx);
+    bulk::register(&mut engine, opts.max_heap);
 
     let params = ctx.clone();
     engine.register_fn(

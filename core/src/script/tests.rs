@@ -115,6 +115,51 @@ fn runaway_script_stops() {
 }
 
 #[test]
+fn bulk_allocations_are_checked_and_keep_rhai_semantics() {
+    let opts = ScriptOptions {
+        max_heap: 64 << 20,
+        ..ScriptOptions::default()
+    };
+    let design = |body: &str| {
+        format!("let m = default_materials();\n{body}\nSphere(Vec3(0,0,0), 1, m.id(\"red\"))")
+    };
+    for (call, what) in [
+        (
+            "let a = []; a.pad(100000000000, 0);",
+            "pad: 100000000000 would need 1.5 TiB",
+        ),
+        (
+            "let s = \"\"; s.pad(100000000000, \"x\");",
+            "pad: 100000000000 would need",
+        ),
+        (
+            "let s = \"\"; s.pad(100000000000, 'x');",
+            "pad: 100000000000 would need 93 GiB",
+        ),
+        (
+            "let b = blob(100000000000);",
+            "blob: 100000000000 would need 93 GiB",
+        ),
+    ] {
+        let e = run_script(&design(call), "t.rhai", &opts).unwrap_err();
+        assert!(e.message.contains(what), "{call}: {e}");
+        assert!(e.message.contains("budget of 64 MiB"), "{e}");
+        assert_eq!(e.line, Some(2), "{e}");
+    }
+    // Within the budget: what Rhai's own functions give.
+    let checks = r#"
+        let a = [1]; a.pad(3, 7); if a != [1, 7, 7] { throw "array " + a; }
+        a.pad(2, 0); if a.len() != 3 { throw "array shrank"; }
+        let s = "ab"; s.pad(5, '-'); if s != "ab---" { throw "char " + s; }
+        let t = "é"; t.pad(6, "xyz"); if t != "éxyzxy" { throw "string " + t; }
+        let b = blob(3, 0x1ff); if b.len() != 3 || b[0] != 0xff { throw "blob"; }
+        b.pad(4, 2); if b[3] != 2 { throw "blob pad"; }
+        if blob(-1).len() != 0 { throw "negative"; }
+    "#;
+    run_script(&design(checks), "t.rhai", &opts).expect("same semantics as Rhai");
+}
+
+#[test]
 fn no_design_is_an_error() {
     let e = run("let x = 1;").unwrap_err();
     assert!(e.message.contains("built no design"), "{e}");
