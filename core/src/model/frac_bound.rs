@@ -5,8 +5,17 @@
 //! export's segment label: which range of one material's fraction, or
 //! which material dominates) can skip evaluating every voxel of a region
 //! where the bounds prove that function constant. The rules mirror
-//! [`PNode::frac`]; nodes without a cheap bound (a `Blend`, a smooth
-//! union) answer "unknown" and the caller samples as before. An FEA field
+//! [`PNode::frac`]; nodes without a cheap bound (a blending union or
+//! intersection) answer "unknown" and the caller samples as before.
+//!
+//! A `Blend` averages its child's fractions over stencil points within `r`
+//! (per axis) of p, all inside the child: an average lies in the hull, so
+//! the child's bounds over the box grown by `r` hold (widened by 10⁻¹² for
+//! the rounding of the average). A smooth union gives a point the
+//! fractions of the first child containing it or, in a fillet, of the
+//! nearest child; inside the union that child is within `(n − 1)·k` (each
+//! of the n − 1 folds of the smooth minimum lowers it by at most k), so the
+//! hull is over the children whose interval starts below that. An FEA field
 //! (`SimulationField`) is bounded through the nodal ranges of the
 //! tetrahedra that meet the box (`SimField::bounds`).
 //!
@@ -17,6 +26,8 @@
 //! numerator is 0: an all-zero sum gives zero fractions).
 
 use std::sync::Arc;
+
+use glam::DVec3;
 
 use super::MAX_MATERIALS;
 use super::bound::coord_intervals;
@@ -44,6 +55,17 @@ impl PNode {
         }
         match self {
             PNode::Union(u) if !u.blend && u.smooth <= 0.0 => u.union_bounds(b, out),
+            PNode::Union(u) if !u.blend => u.smooth_union_bounds(b, out),
+            PNode::Blend { r, child } => {
+                let grown = Aabb::new(b.min - DVec3::splat(*r), b.max + DVec3::splat(*r));
+                if !child.frac_bounds(&grown, out) {
+                    return false;
+                }
+                for o in out.iter_mut() {
+                    *o = Interval::new(o.lo - 1e-12, o.hi + 1e-12);
+                }
+                true
+            }
             PNode::Intersection(n) if !n.blend => n.children[0].frac_bounds(b, out),
             PNode::Difference { a, .. } => a.frac_bounds(b, out),
             PNode::FGrade(g) => g.bounds(b, out),
@@ -74,6 +96,26 @@ impl PNode {
             _ => true, // Blend, FEA fields
         }
     }
+
+    /// True when some part's fractions are averages over many samples of
+    /// a child (a `Blend`: 125 evaluations a point).
+    pub fn averages_fractions(&self) -> bool {
+        if self.leaf_material().is_some() {
+            return false;
+        }
+        if let Some(child) = self.fraction_child() {
+            return child.averages_fractions();
+        }
+        match self {
+            PNode::Union(n) | PNode::Intersection(n) => {
+                n.children.iter().any(|c| c.averages_fractions())
+            }
+            PNode::Difference { a, .. } => a.averages_fractions(),
+            PNode::FGrade(g) => g.child.averages_fractions(),
+            PNode::Blend { .. } => true,
+            _ => false,
+        }
+    }
 }
 
 impl NAry {
@@ -94,6 +136,36 @@ impl NAry {
             for (o, t) in out.iter_mut().zip(&tmp[..k]) {
                 *o = if j == 0 { *t } else { o.union(*t) };
             }
+        }
+        true
+    }
+}
+
+impl NAry {
+    /// A smooth union (no union index: those are built for sharp ones):
+    /// the hull over the children within `(n − 1)·k` of `b` (module doc).
+    fn smooth_union_bounds(&self, b: &Aabb, out: &mut [Interval]) -> bool {
+        if self.index.is_some() {
+            return false;
+        }
+        let reach = (self.children.len() - 1) as f64 * self.smooth;
+        let k = out.len();
+        let mut tmp = [ZERO; MAX_MATERIALS];
+        let mut first = true;
+        let mut used = 0;
+        for c in &self.children {
+            if c.interval(b).lo > reach {
+                continue;
+            }
+            used += 1;
+            tmp[..k].fill(ZERO);
+            if used > MAX_OVERLAPPING || !c.frac_bounds(b, &mut tmp[..k]) {
+                return false;
+            }
+            for (o, t) in out.iter_mut().zip(&tmp[..k]) {
+                *o = if first { *t } else { o.union(*t) };
+            }
+            first = false;
         }
         true
     }
@@ -219,6 +291,11 @@ mod tests {
             r#"Union(false, [FGrade(["z/4+0.5", "0.5-z/4"], [m.id("red"), m.id("blue")], true, Sphere(Vec3(0,0,0), 4, m.id("gray"))), RectPrism(Vec3(3,0,0), Vec3(6,6,6), m.id("green"))])"#,
             // A grade using the distance d.
             r#"FGrade(["-d", "1"], [m.id("red"), m.id("blue")], true, Sphere(Vec3(0,0,0), 5, m.id("gray")))"#,
+            // A smooth union of two materials (fillets take the nearest
+            // child's), and blends over a sharp and a smooth union.
+            r#"Union(1.5, false, [Sphere(Vec3(-3,0,0), 4, m.id("red")), Sphere(Vec3(3,0,0), 4, m.id("blue")), RectPrism(Vec3(0,4,0), Vec3(3,3,3), m.id("green"))])"#,
+            r#"Blend(0.8, Union(false, [Sphere(Vec3(-2,0,0), 4, m.id("red")), FGrade(["x/8+0.5", "0.5-x/8"], [m.id("yellow"), m.id("blue")], true, Sphere(Vec3(3,0,0), 4, m.id("gray")))]))"#,
+            r#"Blend(0.5, Shell(-1.0, Union(1.0, false, [Sphere(Vec3(-2,0,0), 4, m.id("red")), Sphere(Vec3(2,0,0), 4, m.id("blue"))])))"#,
         ];
         for src in designs {
             let m = model(src);
@@ -263,7 +340,7 @@ mod tests {
     #[test]
     fn unknown_where_no_cheap_bound() {
         let m = model(
-            r#"Blend(0.5, FGrade(["x", "1"], [m.id("red"), m.id("blue")], true, Sphere(Vec3(0,0,0), 3, m.id("gray"))))"#,
+            r#"Union(true, [FGrade(["x", "1"], [m.id("red"), m.id("blue")], true, Sphere(Vec3(0,0,0), 3, m.id("gray"))), Sphere(Vec3(0,0,0), 2, m.id("green"))])"#,
         );
         let mut iv = [ZERO; MAX_MATERIALS];
         let b = Aabb::new(DVec3::splat(-0.1), DVec3::splat(0.1));

@@ -56,6 +56,7 @@ pub struct Model {
     node_count: usize,
     prepare_time: Duration,
     varying: bool,
+    averaging: bool,
 }
 
 /// Points as structure of arrays (mm).
@@ -104,6 +105,7 @@ impl Model {
         }
         Ok(Model {
             varying: root_p.varying_fractions(),
+            averaging: root_p.averages_fractions(),
             root: root_p,
             bbox,
             materials,
@@ -215,6 +217,13 @@ impl Model {
     /// helps no one (the bunny lattice: 3,286 struts of fixed mixes).
     pub fn varying_fractions(&self) -> bool {
         self.varying
+    }
+
+    /// True when some part's fractions are averages over many samples (a
+    /// `Blend`): evaluating them costs far more than bounding them, so
+    /// samplers bound them even in tiles that a surface crosses.
+    pub fn averages_fractions(&self) -> bool {
+        self.averaging
     }
 
     /// Bounds of the fractions at every inside point of `b` into `out`

@@ -352,6 +352,8 @@ pub struct Sampler<'a> {
     solid_rects: bool,
     blocks: bool,
     signs_only: bool,
+    /// Lazy fractions in tiles a surface crosses too (see `tile`).
+    lazy_open: bool,
     /// Statistics since creation.
     pub stats: SampleStats,
 }
@@ -379,6 +381,7 @@ impl<'a> Sampler<'a> {
             solid_rects: false,
             blocks: false,
             signs_only: false,
+            lazy_open: false,
             stats: SampleStats::default(),
         }
     }
@@ -567,11 +570,14 @@ impl<'a> Sampler<'a> {
     /// the bounds do not settle what they need (random dithering): a solid
     /// tile whose fractions vary, and which `Model::fraction_bounds` can
     /// bound, gets `NaN` fractions instead of one evaluation per voxel (see
-    /// `Slab::fracs`). Nothing changes for a design whose fractions never
-    /// vary (`Model::varying_fractions`).
+    /// `Slab::fracs`). Where fractions are averages (`Blend`), so are the
+    /// inside voxels of bounded tiles that a surface crosses. Nothing
+    /// changes for a design whose fractions never vary
+    /// (`Model::varying_fractions`).
     pub fn with_lazy_fractions(mut self) -> Self {
         // Piecewise-constant designs have nothing to leave lazy.
         self.lazy = self.model.varying_fractions();
+        self.lazy_open = self.lazy && self.model.averages_fractions();
         self
     }
 
@@ -611,12 +617,24 @@ impl<'a> Sampler<'a> {
             return self.split(r, out);
         }
         let mut f = [0.0f64; MAX_MATERIALS];
+        // A lazy consumer bounds the fractions itself, run by run. Where
+        // fractions are averages (a `Blend`, 125 child samples a voxel) and
+        // their bounds over the tile are narrow, the inside voxels of tiles
+        // a surface crosses get `NaN` fractions too, and only their
+        // distance is evaluated (the csg_tour slice stack: 1.06 → 1.65 M
+        // voxels/s). For other designs the bound costs about what it saves.
+        let lazy = k > 0 && self.lazy_open && self.bounded(&b, k);
         for y in y0..y0 + h {
             let row = (y - row0) * nx;
             for x in x0..x0 + w {
                 let p = self.grid.center(x, y, z);
                 let v = row + x;
-                if k > 0 {
+                if lazy {
+                    let d = self.model.distance(p);
+                    out.dist[v] = d as f32;
+                    let mark = if d <= 0.0 { f32::NAN } else { 0.0 };
+                    out.fracs[v * k..(v + 1) * k].fill(mark);
+                } else if k > 0 {
                     out.dist[v] = self.model.eval_into(p, &mut f[..k]) as f32;
                     for (o, val) in out.fracs[v * k..(v + 1) * k].iter_mut().zip(&f[..k]) {
                         *o = *val as f32;
