@@ -470,9 +470,10 @@ fn blend_frac(child: &PNode, r: f64, p: DVec3, out: &mut [f64]) {
         for dy in S {
             for dz in S {
                 let q = p + DVec3::new(dx, dy, dz) * r;
-                if child.dist(q) <= 0.0 {
-                    tmp[..k].fill(0.0);
-                    child.frac(q, &mut tmp[..k]);
+                // One walk for the distance and the fractions (a union
+                // finds the child that holds q while taking the minimum).
+                tmp[..k].fill(0.0);
+                if child.eval(q, &mut tmp[..k]) <= 0.0 {
                     for j in 0..k {
                         out[j] += tmp[j];
                     }
