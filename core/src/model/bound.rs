@@ -174,6 +174,12 @@ impl PNode {
         if self.leaf_material().is_some() {
             return true;
         }
+        if let PNode::Offset { o, .. } = self
+            && *o > 0.0
+        {
+            // Points outside the child count too (see `frac_bounds`).
+            return self.fixed_fractions().is_some();
+        }
         if let Some((child, cb)) = self.fraction_child_box(b) {
             return child.constant_fractions(&cb);
         }

@@ -50,6 +50,14 @@ impl PNode {
             out[m as usize] = Interval::point(1.0);
             return true;
         }
+        if let PNode::Offset { o, .. } = self
+            && *o > 0.0
+        {
+            // Its inside points outside the child get the child's fractions
+            // there, which the child's bounds (of its own inside points)
+            // do not cover.
+            return false;
+        }
         if let Some((child, cb)) = self.fraction_child_box(b) {
             return child.frac_bounds(&cb, out);
         }
@@ -144,6 +152,9 @@ impl NAry {
 impl NAry {
     /// A smooth union (no union index: those are built for sharp ones):
     /// the hull over the children within `(n − 1)·k` of `b` (module doc).
+    /// A fillet point takes a child's fractions outside that child, which
+    /// its bounds (of its own inside points) do not cover, so only
+    /// children whose fractions are the same everywhere are bounded.
     fn smooth_union_bounds(&self, b: &Aabb, out: &mut [Interval]) -> bool {
         if self.index.is_some() {
             return false;
@@ -152,15 +163,17 @@ impl NAry {
         let k = out.len();
         let mut tmp = [ZERO; MAX_MATERIALS];
         let mut first = true;
-        let mut used = 0;
-        for c in &self.children {
+        for (c, fixed) in self.children.iter().zip(&self.fixed) {
             if c.interval(b).lo > reach {
                 continue;
             }
-            used += 1;
-            tmp[..k].fill(ZERO);
-            if used > MAX_OVERLAPPING || !c.frac_bounds(b, &mut tmp[..k]) {
+            let Some(fixed) = fixed else {
                 return false;
+            };
+            let mut f = [0.0; MAX_MATERIALS];
+            fixed.write(&mut f[..k]);
+            for (t, v) in tmp[..k].iter_mut().zip(&f[..k]) {
+                *t = Interval::point(*v);
             }
             for (o, t) in out.iter_mut().zip(&tmp[..k]) {
                 *o = if first { *t } else { o.union(*t) };
@@ -303,6 +316,42 @@ mod tests {
                 let checked = check(&m, size);
                 assert!(checked > 2000, "{src}: {checked} inside samples checked");
             }
+        }
+    }
+
+    #[test]
+    fn points_outside_a_child_are_not_misbounded() {
+        // A smooth union's fillet takes a graded child's fractions outside
+        // it; a growing offset's shell lies outside its child (a union, a
+        // grade). Where bounds are given, they must hold there too.
+        for src in [
+            r#"Union(1.0, false, [FGrade(["x/8+0.5", "0.5-x/8"], [m.id("red"), m.id("blue")], true, Sphere(Vec3(-2,0,0), 4, m.id("gray"))), Sphere(Vec3(3,0,0), 4, m.id("green"))])"#,
+            r#"Offset(1.0, Union(false, [Sphere(Vec3(-3,0,0), 2, m.id("red")), FGrade(["z/4+0.5", "0.5-z/4"], [m.id("yellow"), m.id("blue")], true, Sphere(Vec3(3,0,0), 2, m.id("gray")))]))"#,
+            r#"Offset(0.8, FGrade(["x/8+0.5", "0.5-x/8"], [m.id("red"), m.id("blue")], true, Sphere(Vec3(0,0,0), 3, m.id("gray"))))"#,
+        ] {
+            let m = model(src);
+            for size in [0.05, 0.5, 3.0] {
+                check(&m, size);
+            }
+            // A box in a growing offset's shell is not "constant".
+            let shell = Aabb::new(DVec3::new(-1.0, -0.5, 3.2), DVec3::new(1.0, 0.5, 3.6));
+            if src.starts_with("Offset(0.8") {
+                assert!(!m.constant_fractions(&shell));
+            }
+        }
+        // The shell of a grown union has the nearest child's material (it
+        // had none: a void shell inside the part).
+        let m = model(
+            r#"Offset(1.0, Union(false, [Sphere(Vec3(0,0,0), 2, m.id("red")), Sphere(Vec3(5,0,0), 2, m.id("blue"))]))"#,
+        );
+        let k = m.materials().len();
+        let mut f = [0.0; MAX_MATERIALS];
+        for (x, near) in [(2.2, 0), (2.8, 1)] {
+            assert!(m.eval_into(DVec3::new(x, 0.0, 0.0), &mut f[..k]) < 0.0);
+            let red = m.table().id("red").unwrap();
+            let slot = m.materials().iter().position(|&i| i == red).unwrap();
+            assert_eq!(f[slot], if near == 0 { 1.0 } else { 0.0 }, "at x = {x}");
+            assert_eq!(f[..k].iter().sum::<f64>(), 1.0, "at x = {x}");
         }
     }
 

@@ -311,7 +311,8 @@ impl NAry {
             }
         } else {
             // Sharp unions: containment is enough (cheap for meshes); the
-            // nearest child matters only in a smooth union's fillet.
+            // nearest child matters only in a smooth union's fillet, and
+            // where a growing `Offset` asks about a point outside the union.
             let smooth = self.smooth > 0.0;
             for i in ids {
                 let c = &self.children[i];
@@ -330,9 +331,44 @@ impl NAry {
                 }
             }
         }
+        if !self.blend && self.smooth <= 0.0 {
+            // No child holds p: it lies outside the union, inside a node
+            // that grows it (`Offset` with a positive distance). It takes the
+            // nearest child's fractions, as a smooth union's fillet does
+            // (it had none: a void shell inside the part).
+            nearest.1 = self.nearest_child(p);
+        }
         if nearest.1 != usize::MAX {
             self.children[nearest.1].frac(p, out);
         }
+    }
+
+    /// The child nearest to `p` (`usize::MAX` for no children).
+    fn nearest_child(&self, p: DVec3) -> usize {
+        let mut best = (f64::INFINITY, usize::MAX);
+        let visit = |i: usize, best: &mut (f64, usize)| {
+            let d = self.child_dist(i, p);
+            if d < best.0 || (d == best.0 && i < best.1) {
+                *best = (d, i);
+            }
+        };
+        match &self.index {
+            Some(index) => {
+                for &i in index.always() {
+                    visit(i as usize, &mut best);
+                }
+                index.bvh().nearest(p, best.0, |i| {
+                    visit(i as usize, &mut best);
+                    best.0
+                });
+            }
+            None => {
+                for i in 0..self.children.len() {
+                    visit(i, &mut best);
+                }
+            }
+        }
+        best.1
     }
 }
 
