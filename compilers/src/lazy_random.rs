@@ -225,7 +225,6 @@ mod tests {
             r#"Blend(0.8, Shell(-1.0, Union(1.0, false, [Sphere(Vec3(-2,0,0), 4, m.id("red")), Sphere(Vec3(2,0,0), 4, m.id("blue"))])))"#,
         );
         let (marked, evaluated, inside) = compare(&blend, 0.1, 3);
-        eprintln!("blend: {evaluated} of {marked} lazy of {inside} inside");
         assert!(marked * 4 > inside, "{marked} of {inside} lazy");
         assert!(evaluated * 2 < marked, "{evaluated} of {marked} evaluated");
     }

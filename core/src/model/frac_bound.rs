@@ -161,7 +161,6 @@ impl NAry {
         }
         let reach = (self.children.len() - 1) as f64 * self.smooth;
         let k = out.len();
-        let mut tmp = [ZERO; MAX_MATERIALS];
         let mut first = true;
         for (c, fixed) in self.children.iter().zip(&self.fixed) {
             if c.interval(b).lo > reach {
@@ -172,11 +171,9 @@ impl NAry {
             };
             let mut f = [0.0; MAX_MATERIALS];
             fixed.write(&mut f[..k]);
-            for (t, v) in tmp[..k].iter_mut().zip(&f[..k]) {
-                *t = Interval::point(*v);
-            }
-            for (o, t) in out.iter_mut().zip(&tmp[..k]) {
-                *o = if first { *t } else { o.union(*t) };
+            for (o, v) in out.iter_mut().zip(&f[..k]) {
+                let t = Interval::point(*v);
+                *o = if first { t } else { o.union(t) };
             }
             first = false;
         }

@@ -228,9 +228,10 @@ impl Model {
 
     /// Bounds of the fractions at every inside point of `b` into `out`
     /// (one per material of [`Self::materials`]); false when the design has
-    /// a node without a cheap bound (`Blend`, a smooth union, a union with
-    /// many children overlapping `b`, an FEA field with many tetrahedra in
-    /// `b`).
+    /// a node without a cheap bound (a blending union, a smooth union with
+    /// a graded child near `b`, a growing `Offset` of a graded part, a union
+    /// with many children overlapping `b`, an FEA field with many
+    /// tetrahedra in `b`).
     pub fn fraction_bounds(&self, b: &Aabb, out: &mut [Interval]) -> bool {
         out.fill(frac_bound::ZERO);
         self.root.frac_bounds(b, out)

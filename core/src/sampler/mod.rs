@@ -5,20 +5,22 @@
 //! `origin + (i + ½)·voxel`. [`Sampler::sample_layers`] fills a caller-owned
 //! [`Slab`] (a few z layers) in parallel: each layer is cut into rows of
 //! tiles, and each tile is refined quadtree-style with the model's interval
-//! bound. A tile whose interval is beyond ± one voxel diagonal is filled
-//! without evaluating its voxels (empty space, or solid interior); a solid
-//! tile with constant fractions gets one fraction evaluation. Two consumer
-//! options use fraction bounds (`Model::fraction_bounds`) on solid tiles:
-//! [`Sampler::with_uniform`] (meshes: one evaluation where the segment label
-//! is proved constant) and [`Sampler::with_lazy_fractions`] (random
-//! dithering: `NaN` fractions that the consumer evaluates only where its
-//! bounds leave a pick open). Memory is proportional to the slab, never to
-//! the volume.
+//! bound. A tile whose interval is beyond ± one voxel diagonal (beyond 0
+//! for [`Sampler::with_signs_only`]) is filled without evaluating its voxels
+//! (empty space, or solid interior); a solid tile with constant fractions
+//! gets one fraction evaluation. Two consumer options use fraction bounds
+//! (`Model::fraction_bounds`) on solid tiles: [`Sampler::with_uniform`]
+//! (meshes: one evaluation where the segment label is proved constant) and
+//! [`Sampler::with_lazy_fractions`] (random dithering: `NaN` fractions that
+//! the consumer evaluates only where its bounds leave a pick open; for
+//! blended designs also in tiles a surface crosses). Memory is proportional
+//! to the slab, never to the volume.
 //!
 //! Skipped voxels store the interval end (`lo` outside, `hi` inside): the
-//! sign is exact and the magnitude is a valid bound. Because a skipped voxel
-//! is farther than one voxel diagonal from the surface, no surface crossing
-//! lies on a grid edge that touches it, so meshers never interpolate it.
+//! sign is exact and the magnitude is a valid bound. Without
+//! `with_signs_only` a skipped voxel is farther than one voxel diagonal
+//! from the surface, so no surface crossing lies on a grid edge that
+//! touches it, and meshers never interpolate it.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 

@@ -44,42 +44,30 @@ pub fn register(engine: &mut Engine, budget: u64) {
             Ok(())
         },
     );
+    // Rhai's string pads: append the fill's characters, cycling, until the
+    // string has `len` characters.
+    let pad_string = move |c: &Ctx, s: &mut ImmutableString, len: INT, fill: &str| {
+        let len = usize::try_from(len).unwrap_or(0);
+        let have = s.chars().count();
+        if len > have && !fill.is_empty() {
+            let widest = fill.chars().map(char::len_utf8).max().unwrap_or(1);
+            check(c, "pad", len as u64, widest as u64)?;
+            let mut out = s.to_string();
+            out.extend(fill.chars().cycle().take(len - have));
+            *s = out.into();
+        }
+        Ok(())
+    };
     engine.register_fn(
         "pad",
         move |c: Ctx, s: &mut ImmutableString, len: INT, ch: char| -> RResult<()> {
-            let len = usize::try_from(len).unwrap_or(0);
-            let have = s.chars().count();
-            if len > have {
-                check(&c, "pad", len as u64, ch.len_utf8() as u64)?;
-                let mut out = String::with_capacity(s.len() + (len - have) * ch.len_utf8());
-                out.push_str(s);
-                out.extend(std::iter::repeat_n(ch, len - have));
-                *s = out.into();
-            }
-            Ok(())
+            pad_string(&c, s, len, ch.encode_utf8(&mut [0; 4]))
         },
     );
     engine.register_fn(
         "pad",
         move |c: Ctx, s: &mut ImmutableString, len: INT, fill: ImmutableString| -> RResult<()> {
-            let len = usize::try_from(len).unwrap_or(0);
-            let have = s.chars().count();
-            if len > have && !fill.is_empty() {
-                check(&c, "pad", len as u64, 4)?;
-                let mut out: String = s.to_string();
-                let mut n = have;
-                'fill: loop {
-                    for ch in fill.chars() {
-                        if n >= len {
-                            break 'fill;
-                        }
-                        out.push(ch);
-                        n += 1;
-                    }
-                }
-                *s = out.into();
-            }
-            Ok(())
+            pad_string(&c, s, len, &fill)
         },
     );
     engine.register_fn(

@@ -5,7 +5,8 @@
 //! The engine is built per run with the run's context (script folder,
 //! parameter overrides, cancel flag), compiled once and evaluated once; it is
 //! `Send + Sync` (Rhai's `sync` feature) so runs happen on worker threads. A
-//! runaway script stops at an operation limit or when its cancel flag is set.
+//! runaway script stops at an operation limit, at its heap budget (where the
+//! binary counts the heap, `crate::heap`), or when its cancel flag is set.
 //! The design is the script's final value, or else a variable named `root`.
 
 mod bulk;
@@ -279,11 +280,11 @@ fn check_materials(root: &Node, table: &MaterialTable, name: &str) -> Result<(),
     Ok(())
 }
 
-/// Flatten Rhai's nested "error in function call" wrappers into the inner
-/// message at the innermost known position.
 /// The token of a script stopped by its heap budget.
 const HEAP_STOP: &str = "heap budget";
 
+/// Flatten Rhai's nested "error in function call" wrappers into the inner
+/// message at the innermost known position.
 fn to_script_error(e: &EvalAltResult, file: &str, engine: &Engine, max_heap: u64) -> ScriptError {
     let mut cur = e;
     let mut pos = e.position();
