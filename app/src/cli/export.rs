@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::RecvTimeoutError;
 use std::time::Duration;
 
 use anyhow::{Context, bail};
@@ -334,15 +335,22 @@ fn follow(handle: job::JobHandle) -> anyhow::Result<()> {
         .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     let dest = handle.destination().to_path_buf();
+    // Waits on the progress channel, which closes when the job ends: the
+    // command returns as soon as the export is done (sleeping 50 ms between
+    // polls added 25 ms on average to every export, a fifth of a small
+    // mesh's time), and Ctrl-C is still seen within 50 ms.
     while !handle.is_finished() {
         if interrupted.load(Ordering::Relaxed) {
             handle.cancel();
         }
-        while let Ok(p) = handle.progress.try_recv() {
-            bar.set_message(p.stage.clone());
-            bar.set_position((p.fraction * 1000.0) as u64);
+        match handle.progress.recv_timeout(Duration::from_millis(50)) {
+            Ok(p) => {
+                bar.set_message(p.stage.clone());
+                bar.set_position((p.fraction * 1000.0) as u64);
+            }
+            Err(RecvTimeoutError::Timeout) => {}
+            Err(RecvTimeoutError::Disconnected) => break,
         }
-        std::thread::sleep(Duration::from_millis(50));
     }
     bar.finish_and_clear();
     let summary = handle.join()?;

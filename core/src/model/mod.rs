@@ -237,6 +237,20 @@ impl Model {
         self.root.frac_bounds(b, out)
     }
 
+    /// The fractions every inside point has, into `out` (as an evaluation
+    /// writes them), when they do not depend on the point at all (one
+    /// material, or a grade of constants); false otherwise.
+    pub fn fixed_fractions(&self, out: &mut [f64]) -> bool {
+        out.fill(0.0);
+        match self.root.fixed_fractions() {
+            Some(f) => {
+                f.write(out);
+                true
+            }
+            None => false,
+        }
+    }
+
     /// True when the fractions are the same at every inside point of `b`
     /// (samplers then evaluate one point and fill the rest).
     pub fn constant_fractions(&self, b: &Aabb) -> bool {
