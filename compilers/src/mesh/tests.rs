@@ -1,0 +1,222 @@
+//! Tests of the segmented-mesh pipeline: estimates, uniform tiles, blocks.
+
+use volcad_core::script::{ScriptOptions, model_of, model_of_file};
+
+use super::*;
+use std::sync::atomic::Ordering;
+
+/// `src` after `let m = default_materials();`, run and prepared (shared
+/// by the crate's test modules).
+pub(crate) fn model(src: &str) -> Model {
+    let src = format!("let m = default_materials();\n{src}");
+    model_of(&src, "t.rhai", &ScriptOptions::default()).expect("design")
+}
+
+/// Meshes and voxel counts with and without label-uniform tiles.
+fn both(m: &Model, p: &MeshParams) -> [Vec<SegmentMesh>; 2] {
+    let cancel = AtomicBool::new(false);
+    [true, false].map(|uniform_tiles| {
+        let mut pl = plan(m, p).expect("plan");
+        pl.uniform_tiles = uniform_tiles;
+        build(m, p, &pl, &cancel, &|_, _| {}).expect("build")
+    })
+}
+
+#[test]
+fn triangle_estimates_are_within_twice_the_count() {
+    let cube = model(r#"RectPrism(Vec3(0,0,0), Vec3(10,10,10), m.id("red"))"#);
+    let bar = model(
+        r#"FGrade(["x/15+0.5", "-x/15+0.5"], [m.id("red"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(15,10,5), m.id("gray")))"#,
+    );
+    let ball = model(r#"Sphere(Vec3(0,0,0), 5, m.id("red"))"#);
+    let red = bar.table().id("red").expect("red");
+    let cancel = AtomicBool::new(false);
+    for (name, m, by, segments) in [
+        ("cube", &cube, SegmentBy::Dominant, 1),
+        ("bar", &bar, SegmentBy::Dominant, 1),
+        ("bar in 4", &bar, SegmentBy::Material(red), 4),
+        ("sphere", &ball, SegmentBy::Dominant, 1),
+    ] {
+        let p = MeshParams {
+            voxel: DVec3::splat(0.1),
+            by,
+            segments,
+            ..MeshParams::default()
+        };
+        let est = estimate_mesh(m, &p).expect("estimate").triangles as f64;
+        let made: usize = segment_meshes(m, &p, &cancel, |_, _| {})
+            .expect("meshes")
+            .iter()
+            .map(|s| s.mesh.triangles.len())
+            .sum();
+        let ratio = est / made as f64;
+        assert!((0.5..2.0).contains(&ratio), "{name}: {est} for {made}");
+    }
+}
+
+#[test]
+fn uniform_tiles_give_the_same_meshes() {
+    let bar = model(
+        r#"FGrade(["x/15+0.5", "-x/15+0.5"], [m.id("red"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(15,10,5), m.id("gray")))"#,
+    );
+    let tilted = model(
+        r#"Rotate(20, 35, 10, Vec3(0,0,0), FGrade(["x/8+0.5", "0.3", "-y/8+0.5"], [m.id("red"), m.id("green"), m.id("blue")], true, Sphere(Vec3(0,0,0), 4, m.id("gray"))))"#,
+    );
+    let red = bar.table().id("red").expect("red");
+    let seat = model_of_file(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../assets/examples/bicycle_seat.rhai"),
+    )
+    .expect("seat");
+    let cyan = seat.table().id("VeroCyan").expect("VeroCyan");
+    let cases = [
+        (&seat, SegmentBy::Material(cyan), 4, 2.0),
+        (&bar, SegmentBy::Material(red), 4, 0.1),
+        (&bar, SegmentBy::Dominant, 1, 0.1),
+        (&tilted, SegmentBy::Material(red), 5, 0.1),
+        (&tilted, SegmentBy::Dominant, 1, 0.1),
+    ];
+    for (m, by, segments, voxel) in cases {
+        let p = MeshParams {
+            voxel: DVec3::splat(voxel),
+            segments,
+            by,
+            ..MeshParams::default()
+        };
+        let [fast, plain] = both(m, &p);
+        assert_eq!(fast.len(), plain.len());
+        let nonempty = plain.iter().filter(|s| !s.mesh.triangles.is_empty());
+        assert!(nonempty.count() >= segments.min(2), "too few segments");
+        for (a, b) in fast.iter().zip(&plain) {
+            assert_eq!(a.mesh, b.mesh, "{}: meshes differ", a.name);
+            assert_eq!(a.voxels, b.voxels, "{}: voxel counts differ", a.name);
+        }
+    }
+}
+
+#[test]
+fn uniform_tiles_are_used_and_agree_on_labels() {
+    let bar = model(
+        r#"FGrade(["x/15+0.5", "-x/15+0.5"], [m.id("red"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(15,10,5), m.id("gray")))"#,
+    );
+    let p = MeshParams {
+        voxel: DVec3::splat(0.1),
+        segments: 4,
+        by: SegmentBy::Material(bar.table().id("red").expect("red")),
+        ..MeshParams::default()
+    };
+    let pl = plan(&bar, &p).expect("plan");
+    let dims = pl.grid.dims;
+    let test = |b: &[volcad_core::interval::Interval]| pl.classifier.uniform(b);
+    let fast = Sampler::new(&bar, pl.grid, true).with_uniform(&test);
+    let plain = Sampler::new(&bar, pl.grid, true);
+    let rects = Sampler::new(&bar, pl.grid, true)
+        .with_uniform(&test)
+        .with_solid_rects();
+    let cancel = AtomicBool::new(false);
+    let (mut a, mut b, mut c) = (Slab::default(), Slab::default(), Slab::default());
+    // Stale fractions in the reused buffer must not matter.
+    c.fracs = vec![f32::NAN; dims[0] * dims[1] * 3];
+    let (mut filled, mut in_rects) = (0, 0);
+    for z in 0..dims[2] {
+        fast.sample_layers(z, z + 1, &mut a, &cancel)
+            .expect("sample");
+        plain
+            .sample_layers(z, z + 1, &mut b, &cancel)
+            .expect("sample");
+        rects
+            .sample_layers(z, z + 1, &mut c, &cancel)
+            .expect("sample");
+        let (la, ta) = pl.classifier.plane(&a, 0, dims, z);
+        let (lb, tb) = pl.classifier.plane(&b, 0, dims, z);
+        let (lc, tc) = pl.classifier.plane(&c, 0, dims, z);
+        assert_eq!(la.label, lb.label, "labels of layer {z}");
+        assert_eq!(ta.voxels, tb.voxels);
+        // Rectangles classified once give the same labels and values
+        // as their voxels one by one.
+        assert_eq!(lc.label, la.label, "labels of layer {z}, rectangles");
+        assert_eq!(lc.value, la.value, "values of layer {z}, rectangles");
+        assert_eq!(lc.dist, la.dist);
+        assert_eq!(tc.voxels, ta.voxels);
+        in_rects += c.rects.iter().map(|r| r.w * r.h).sum::<usize>();
+        let k = a.k;
+        filled += (0..a.dist.len())
+            .filter(|v| a.fracs[v * k..(v + 1) * k] != b.fracs[v * k..(v + 1) * k])
+            .count();
+    }
+    eprintln!(
+        "graded bar at 0.1 mm: {filled} of {} voxels filled",
+        dims[0] * dims[1] * dims[2]
+    );
+    // Most of the bar's voxels got their tile's centre fractions.
+    assert!(
+        filled > dims[0] * dims[1] * dims[2] / 4,
+        "{filled} voxels filled"
+    );
+    assert!(in_rects >= filled, "{in_rects} voxels in rectangles");
+}
+
+/// Blocks through a slab of layers (one bound for many layers) give the
+/// labels and counts of sampling every voxel, on a graded bar (uniform
+/// blocks) and a tilted two-material part (fixed mixes, empty space).
+#[test]
+fn blocks_through_layers_agree_on_labels() {
+    let designs = [
+        (
+            r#"FGrade(["x/15+0.5", "-x/15+0.5"], [m.id("red"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(15,10,5), m.id("gray")))"#,
+            SegmentBy::Dominant,
+            0.04,
+            10,
+        ),
+        (
+            r#"Rotate(20, 10, 0, Vec3(0,0,0), Union(false, [Sphere(Vec3(0,0,0), 4, m.id("red")), RectPrism(Vec3(3,0,0), Vec3(4,6,6), m.id("blue"))]))"#,
+            SegmentBy::Dominant,
+            0.08,
+            1000,
+        ),
+    ];
+    // The last number: at least 1/n of the voxels lie in solid blocks
+    // (rotated boxes bound loosely, so few of its blocks are proved).
+    for (src, by, voxel, n) in designs {
+        let m = model(src);
+        let p = MeshParams {
+            voxel: DVec3::splat(voxel),
+            by,
+            ..MeshParams::default()
+        };
+        let pl = plan(&m, &p).expect("plan");
+        let dims = pl.grid.dims;
+        let test = |b: &[volcad_core::interval::Interval]| pl.classifier.uniform(b);
+        let plain = Sampler::new(&m, pl.grid, true);
+        let blocks = Sampler::new(&m, pl.grid, true)
+            .with_uniform(&test)
+            .with_solid_rects()
+            .with_blocks();
+        let cancel = AtomicBool::new(false);
+        let (mut a, mut b) = (Slab::default(), Slab::default());
+        let mut z0 = 0;
+        while z0 < dims[2] {
+            let z1 = (z0 + 7).min(dims[2]);
+            plain
+                .sample_layers(z0, z1, &mut a, &cancel)
+                .expect("sample");
+            blocks
+                .sample_layers(z0, z1, &mut b, &cancel)
+                .expect("sample");
+            for z in z0..z1 {
+                let (la, ta) = pl.classifier.plane(&a, z - z0, dims, z);
+                let (lb, tb) = pl.classifier.plane(&b, z - z0, dims, z);
+                assert_eq!(la.label, lb.label, "{src}: labels of layer {z}");
+                assert_eq!(ta.voxels, tb.voxels, "{src}: counts of layer {z}");
+            }
+            z0 = z1;
+        }
+        // Solid blocks were used (so the comparison tested them).
+        let solid = blocks.stats.solid_blocks.load(Ordering::Relaxed) as usize;
+        let all = dims[0] * dims[1] * dims[2];
+        assert!(
+            solid > all / n,
+            "{src}: {solid} of {all} voxels in solid blocks"
+        );
+    }
+}
