@@ -19,11 +19,14 @@ mod interval_eval;
 mod lexer;
 mod ops;
 mod parser;
+mod set;
 mod tape;
 #[cfg(test)]
 mod tests;
 
 use std::fmt;
+
+pub use set::ExprSet;
 
 use crate::interval::Interval;
 

@@ -113,6 +113,12 @@ impl Builder {
         if op.is_commutative() && args[0] > args[1] {
             args.swap(0, 1);
         }
+        self.push_as_is(op, args, imm)
+    }
+
+    /// [`Self::push`] keeping the operands' order (a minimum of `-0` and
+    /// `+0` depends on it).
+    fn push_as_is(&mut self, op: Op, args: [u32; 3], imm: f64) -> u32 {
         let key = (op, args, imm.to_bits());
         if let Some(&v) = self.seen.get(&key) {
             return v;
@@ -195,9 +201,73 @@ impl Builder {
 pub(crate) fn compile(root: &Node) -> Result<Tape, TooManyRegisters> {
     let mut b = Builder::default();
     let result = b.emit(root) as usize;
-    let code = b.code;
+    let m = allocate(&b.code, &[result])?;
+    Ok(Tape {
+        instrs: m.instrs,
+        result: m.results[0],
+        regs: m.regs,
+    })
+}
 
-    // Last instruction index reading each value (the result lives to the end).
+/// Several tapes run as one, each result kept in its own register.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct MultiTape {
+    instrs: Box<[Instr]>,
+    results: Box<[u8]>,
+    regs: usize,
+}
+
+/// `tapes` as one tape: each is read back into SSA form (a register names
+/// the value last written to it) and identical instructions are shared by
+/// value numbering, so `clamp(0, rho/15, 1)` and `1 - clamp(0, rho/15, 1)`
+/// compute the clamp once. Every result is the same operation on the same
+/// operands as in its own tape, hence bit for bit the same value.
+pub(crate) fn fuse(tapes: &[&Tape]) -> Result<MultiTape, TooManyRegisters> {
+    let mut b = Builder::default();
+    let mut results = Vec::with_capacity(tapes.len());
+    for t in tapes {
+        let mut value = [0u32; MAX_REGS];
+        for ins in t.instrs.iter() {
+            let args = if ins.op == Op::Var {
+                [u32::from(ins.a), 0, 0]
+            } else {
+                let operand = |k: usize, r: u8| {
+                    if k < ins.op.arity() {
+                        value[r as usize]
+                    } else {
+                        0
+                    }
+                };
+                [operand(0, ins.a), operand(1, ins.b), operand(2, ins.c)]
+            };
+            value[ins.out as usize] = b.push_as_is(ins.op, args, ins.imm);
+        }
+        results.push(value[t.result as usize] as usize);
+    }
+    allocate(&b.code, &results)
+}
+
+impl MultiTape {
+    /// Instructions (to compare with the tapes it fused).
+    pub(crate) fn len(&self) -> usize {
+        self.instrs.len()
+    }
+
+    /// Every result, in the order of the fused tapes, into `out`.
+    #[inline]
+    pub(crate) fn eval_into(&self, slots: &[f64], out: &mut [f64]) {
+        match self.regs {
+            0..=8 => run_many::<8>(&self.instrs, &self.results, slots, out),
+            9..=32 => run_many::<32>(&self.instrs, &self.results, slots, out),
+            _ => run_many::<MAX_REGS>(&self.instrs, &self.results, slots, out),
+        }
+    }
+}
+
+/// Register allocation of SSA `code` whose values `results` are read after
+/// the last instruction.
+fn allocate(code: &[Ssa], results: &[usize]) -> Result<MultiTape, TooManyRegisters> {
+    // Last instruction index reading each value (results live to the end).
     const NEVER: usize = usize::MAX - 1;
     let mut last_use = vec![NEVER; code.len()];
     for (i, s) in code.iter().enumerate() {
@@ -205,7 +275,9 @@ pub(crate) fn compile(root: &Node) -> Result<Tape, TooManyRegisters> {
             last_use[arg as usize] = i;
         }
     }
-    last_use[result] = usize::MAX;
+    for &r in results {
+        last_use[r] = usize::MAX;
+    }
 
     let mut reg = vec![0u8; code.len()];
     let mut free: Vec<u8> = Vec::new();
@@ -246,9 +318,9 @@ pub(crate) fn compile(root: &Node) -> Result<Tape, TooManyRegisters> {
             free.push(out);
         }
     }
-    Ok(Tape {
+    Ok(MultiTape {
         instrs: instrs.into_boxed_slice(),
-        result: reg[result],
+        results: results.iter().map(|&r| reg[r]).collect(),
         regs,
     })
 }
@@ -274,10 +346,11 @@ impl Tape {
     }
 }
 
-/// The scalar hot loop. `N` is a power of two, so `% N` is a mask that keeps every
-/// index in range without a bounds check.
-#[inline]
-fn run<const N: usize>(code: &[Instr], result: u8, slots: &[f64]) -> f64 {
+/// The scalar hot loop: runs `code` over a register file of `N` entries
+/// and hands it back. `N` is a power of two, so `% N` is a mask that keeps
+/// every index in range without a bounds check.
+#[inline(always)]
+fn registers<const N: usize>(code: &[Instr], slots: &[f64]) -> [f64; N] {
     let mut r = [0.0f64; N];
     for ins in code {
         let v = match ins.op {
@@ -291,7 +364,22 @@ fn run<const N: usize>(code: &[Instr], result: u8, slots: &[f64]) -> f64 {
         };
         r[ins.out as usize % N] = v;
     }
-    r[result as usize % N]
+    r
+}
+
+/// A tape's value.
+#[inline]
+fn run<const N: usize>(code: &[Instr], result: u8, slots: &[f64]) -> f64 {
+    registers::<N>(code, slots)[result as usize % N]
+}
+
+/// A fused tape's values.
+#[inline]
+fn run_many<const N: usize>(code: &[Instr], results: &[u8], slots: &[f64], out: &mut [f64]) {
+    let r = registers::<N>(code, slots);
+    for (o, &res) in out.iter_mut().zip(results) {
+        *o = r[res as usize % N];
+    }
 }
 
 /// The interval loop: same tape, [`Interval`] registers.

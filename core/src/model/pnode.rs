@@ -219,6 +219,8 @@ pub struct NAry {
 #[derive(Debug)]
 pub struct Grade {
     pub exprs: Vec<Arc<Expr>>,
+    /// The same expressions, evaluated together (shared work fused).
+    pub set: crate::expr::ExprSet,
     pub mats: Vec<Slot>,
     /// Union of the expressions' used-variable masks.
     pub used: u64,
@@ -230,6 +232,8 @@ pub struct Grade {
 pub struct SimGrade {
     pub field: Arc<crate::simfield::SimField>,
     pub exprs: Vec<Arc<Expr>>,
+    /// The same expressions, evaluated together (shared work fused).
+    pub set: crate::expr::ExprSet,
     pub mats: Vec<Slot>,
     pub used: u64,
 }

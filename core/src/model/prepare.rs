@@ -2,6 +2,7 @@
 //! bounding boxes, build spatial indices, check what can only be checked
 //! with the whole tree (missing children, unbounded tiles).
 
+use crate::expr::ExprSet;
 use std::collections::{BTreeSet, HashMap};
 use std::sync::Arc;
 
@@ -345,6 +346,7 @@ impl Preparer {
                 (
                     PNode::FGrade(Box::new(Grade {
                         exprs: exprs.clone(),
+                        set: ExprSet::new(exprs.clone()),
                         mats,
                         used,
                         child: c,
@@ -381,6 +383,7 @@ impl Preparer {
                     PNode::SimField(Box::new(SimGrade {
                         field: field.clone(),
                         exprs: exprs.clone(),
+                        set: ExprSet::new(exprs.clone()),
                         mats,
                         used,
                     })),
