@@ -15,7 +15,13 @@ pub fn sphere(p: DVec3, c: DVec3, r: f64) -> f64 {
 /// (pyvcad uses the max-norm `max(q)`, which underestimates outside corners.)
 #[inline]
 pub fn rect_prism(p: DVec3, c: DVec3, h: DVec3) -> f64 {
-    let q = (p - c).abs() - h;
+    box_of_offsets((p - c).abs() - h)
+}
+
+/// The box distance from `q = |p − c| − h`. It does not decrease when any
+/// `qᵢ` grows (both terms are monotone), which gives exact intervals.
+#[inline]
+pub fn box_of_offsets(q: DVec3) -> f64 {
     q.max(DVec3::ZERO).length() + q.max_element().min(0.0)
 }
 
@@ -24,7 +30,14 @@ pub fn rect_prism(p: DVec3, c: DVec3, h: DVec3) -> f64 {
 #[inline]
 pub fn cylinder(p: DVec3, c: DVec3, r: f64, hh: f64) -> f64 {
     let q = p - c;
-    let d = DVec2::new(DVec2::new(q.x, q.y).length() - r, q.z.abs() - hh);
+    cylinder_of(DVec2::new(q.x, q.y).length(), q.z.abs(), r, hh)
+}
+
+/// The cylinder distance from the radial distance `rho` and `|z|`; it does
+/// not decrease when either grows, which gives exact intervals.
+#[inline]
+pub fn cylinder_of(rho: f64, z_abs: f64, r: f64, hh: f64) -> f64 {
+    let d = DVec2::new(rho - r, z_abs - hh);
     d.max_element().min(0.0) + d.max(DVec2::ZERO).length()
 }
 

@@ -380,6 +380,68 @@ fn intervals_contain_every_sample() {
 }
 
 #[test]
+fn primitive_intervals_are_exact_and_sound() {
+    // Sphere, box and cylinder: the interval's ends are the distances at
+    // the box's nearest and farthest points (per-axis offsets from the
+    // centre), and no sample, corners and faces included, falls outside
+    // (no tolerance: the samplers' settled tiles rely on the exact sign).
+    let srcs = [
+        "Sphere(Vec3(0.3, -0.2, 0.1), 4, m.id(\"red\"))",
+        "RectPrism(Vec3(0.3, -0.2, 0.1), Vec3(15, 10, 5), m.id(\"red\"))",
+        "Cylinder(Vec3(0.3, -0.2, 0.1), 4, 6, m.id(\"red\"))",
+    ];
+    let mut r = rng(77);
+    let mut tighter = 0;
+    for src in srcs {
+        let m = model(src);
+        for _ in 0..2_000 {
+            let c = DVec3::new(r() - 0.5, r() - 0.5, r() - 0.5) * 20.0;
+            let bx = Aabb::from_center_size(c, DVec3::new(r(), r(), r()) * 3.0);
+            let iv = m.interval(&bx);
+            let (lo, hi) = (bx.min, bx.max);
+            let corner = |k: usize| {
+                DVec3::new(
+                    if k & 1 == 0 { lo.x } else { hi.x },
+                    if k & 2 == 0 { lo.y } else { hi.y },
+                    if k & 4 == 0 { lo.z } else { hi.z },
+                )
+            };
+            let mut max_seen = f64::NEG_INFINITY;
+            for k in 0..8 {
+                let v = m.distance(corner(k));
+                assert!(iv.lo <= v && v <= iv.hi, "{src}: corner {v} not in {iv:?}");
+                max_seen = max_seen.max(v);
+            }
+            for _ in 0..30 {
+                // Inside, and on a face.
+                let mut p = lo + DVec3::new(r(), r(), r()) * bx.size();
+                if r() < 0.3 {
+                    p.x = if r() < 0.5 { lo.x } else { hi.x };
+                }
+                let v = m.distance(p);
+                assert!(
+                    iv.lo <= v && v <= iv.hi,
+                    "{src}: {v} not in {iv:?} over {bx:?}"
+                );
+            }
+            // The far end is a corner's distance (the farthest point of a
+            // box from any centre is a corner).
+            assert_eq!(iv.hi, max_seen, "{src}: far end over {bx:?}");
+            let dc = m.distance(bx.center());
+            let half = bx.half_diagonal();
+            assert!(iv.lo >= dc - half - 1e-12 && iv.hi <= dc + half + 1e-12);
+            if iv.hi < dc + half - 1e-3 {
+                tighter += 1;
+            }
+        }
+    }
+    assert!(
+        tighter > 3_000,
+        "{tighter} of 6000 tighter than the Lipschitz bound"
+    );
+}
+
+#[test]
 fn constant_fractions_are_constant() {
     for (n, src) in DESIGNS.iter().enumerate() {
         let m = model(src);
