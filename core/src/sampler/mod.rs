@@ -8,7 +8,8 @@
 //! bound. A tile whose interval is beyond ± one voxel diagonal (beyond 0
 //! for [`Sampler::with_signs_only`]) is filled without evaluating its voxels
 //! (empty space, or solid interior); a solid tile with constant fractions
-//! gets one fraction evaluation. Two consumer options use fraction bounds
+//! gets one fraction evaluation, and so do the inside voxels of an open
+//! tile where the fractions are fixed or proved constant (see `Shared`). Two consumer options use fraction bounds
 //! (`Model::fraction_bounds`) on solid tiles: [`Sampler::with_uniform`]
 //! (meshes: one evaluation where the segment label is proved constant) and
 //! [`Sampler::with_lazy_fractions`] (random dithering: `NaN` fractions that
