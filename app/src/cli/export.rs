@@ -211,6 +211,10 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
     }
     let threads = a.threads;
     let dest = a.out.clone();
+    // Before the job starts: a signal that came between the job creating
+    // its staging folder and the handler being installed ended the process
+    // with the folder left behind (seen once in CI).
+    let interrupted = interrupt_flag();
     let handle = match a.kind {
         Kind::Png => {
             let dither = match a.dither.as_deref().unwrap_or("random") {
@@ -309,11 +313,12 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
             })
         }
     };
-    follow(handle)
+    follow(handle, &interrupted)
 }
 
-/// Show progress until the job ends; Ctrl-C cancels it.
-fn follow(handle: job::JobHandle) -> anyhow::Result<()> {
+/// A flag that Ctrl-C, SIGTERM and SIGHUP set, for [`follow`] to cancel the
+/// export with.
+fn interrupt_flag() -> Arc<AtomicBool> {
     let interrupted = Arc::new(AtomicBool::new(false));
     let flag = interrupted.clone();
     // A second handler cannot be installed (e.g. in tests running several
@@ -327,6 +332,11 @@ fn follow(handle: job::JobHandle) -> anyhow::Result<()> {
             std::process::exit(130);
         }
     });
+    interrupted
+}
+
+/// Show progress until the job ends; a signal (`interrupted`) cancels it.
+fn follow(handle: job::JobHandle, interrupted: &AtomicBool) -> anyhow::Result<()> {
     let bar = indicatif::ProgressBar::new(1000);
     bar.set_style(
         indicatif::ProgressStyle::with_template(
