@@ -339,3 +339,46 @@ fn j750_preset_estimate() {
     assert_eq!(e.files, 186);
     assert!(e.memory_bytes > 0 && e.disk_bytes > 0);
 }
+
+/// A design of one material everywhere is sliced from signs alone (no
+/// fractions, no picks): every pixel is that material exactly where the
+/// voxel's centre is inside, with either dither.
+#[test]
+fn one_material_slices_are_the_inside_voxels() {
+    let m = model(
+        r#"let m = default_materials();
+Intersection(false, [Tile(GraphLattice(LatticeType::BodyCenteredCubic, Vec3(4,4,4), 0.5, m.id("red"))), Sphere(Vec3(0,0,0), 5, m.id("red"))])"#,
+    );
+    for dither in [Dither::Random, Dither::Diffusion] {
+        let p = params(0.2, dither);
+        let g = estimate(&m, &p).unwrap().grid;
+        let [nx, ny, nz] = g.dims;
+        let dir = tmp();
+        let out = dir.path().join("out");
+        export(&m, &p, &out).unwrap();
+        let tree = read_tree(&out);
+        let slices: Vec<&String> = tree.keys().filter(|k| k.starts_with("slice_")).collect();
+        assert_eq!(slices.len(), nz);
+        let mut inside_count = 0;
+        for (z, name) in slices.iter().enumerate() {
+            let png = decode(&tree[*name]);
+            assert_eq!((png.width, png.height), (nx, ny));
+            for row in 0..ny {
+                for x in 0..nx {
+                    // Row 0 is the largest y.
+                    let inside = m.distance(g.center(x, ny - 1 - row, z)) <= 0.0;
+                    let i = (row * nx + x) * 4;
+                    let want = if inside { RED } else { VOID };
+                    assert_eq!(
+                        png.data[i..i + 4],
+                        want,
+                        "{dither:?}: voxel ({x}, {}, {z})",
+                        ny - 1 - row
+                    );
+                    inside_count += usize::from(inside);
+                }
+            }
+        }
+        assert!(inside_count > 10_000, "{inside_count}");
+    }
+}
