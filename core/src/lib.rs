@@ -26,6 +26,7 @@
 
 pub mod bench;
 pub mod bounds;
+pub mod cells;
 pub mod expr;
 pub mod fastmath;
 pub mod heap;

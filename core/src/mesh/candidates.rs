@@ -23,13 +23,24 @@ use rayon::prelude::*;
 
 use super::TriangleMesh;
 use crate::bounds::Aabb;
+use crate::cells::CellLattice;
 
-/// Fewest cells along the longest side of the mesh box.
-const CELLS: f64 = 64.0;
+/// Fewest cells along the longest side of the mesh box. On the bunny
+/// (3,674 triangles about 1.5 mm across, 62 mm box), 128 rather than 64
+/// halves the lists (17 → 9 entries, 3.6 → 2.6 exact triangle tests per
+/// query) and evaluated points within 2 mm of the surface 13 to 23 % faster
+/// (`cargo bench -p volcad-core`), for 2 to 3 % more time in a bunny-lattice
+/// slice stack at 0.1 mm and the seat's 0.5 mm mesh export.
+const CELLS: f64 = 128.0;
 /// Most cells in one grid (5 bytes each plus the lists).
 const MAX_TOTAL: f64 = 4.0e6;
 /// Cells farther than this many cell sizes from the surface keep no list.
-const FAR: f64 = 1.5;
+/// With `PAD`, it keeps the reach of the lists (about 2.5 mm on the bunny)
+/// when the cells got finer: points a few voxels from the surface, inside
+/// or outside the mesh box, still skip the BVH.
+const FAR: f64 = 3.5;
+/// Cells of padding around the mesh box.
+const PAD: f64 = 4.0;
 /// Longest block list (2×2×2 cells) gathered; beyond it the cells keep none.
 const MAX_BLOCK: usize = 160;
 /// Longest list kept; cells that need more fall back to the BVH.
@@ -46,15 +57,14 @@ struct Candidate {
 /// range means "no list, ask the BVH".
 #[derive(Clone, Debug)]
 pub(crate) struct CandidateGrid {
-    min: DVec3,
-    cell: f64,
-    inv_cell: f64,
-    dims: [usize; 3],
+    cells: CellLattice,
     offsets: Vec<u32>,
     /// Per cell with a list: +1 or −1 when the whole cell is on that side,
     /// 0 when the surface may cross it (cells without a list: 0, unused).
     side: Vec<i8>,
     items: Vec<Candidate>,
+    /// `1e-12` cell sizes: absolute slack on `|p − c|`.
+    tiny: f64,
 }
 
 impl CandidateGrid {
@@ -80,15 +90,15 @@ impl CandidateGrid {
         let size = b.size();
         let mut cell = (extent / CELLS).min(typical).max(extent * 1e-6);
         let cells_for = |c: f64| {
-            let n = (size + DVec3::splat(4.0 * c)) / c;
+            let n = (size + DVec3::splat(2.0 * PAD * c)) / c;
             n.x.ceil() * n.y.ceil() * n.z.ceil()
         };
         while cells_for(cell) > MAX_TOTAL {
             cell *= 1.25;
         }
-        let min = b.min - DVec3::splat(2.0 * cell);
+        let min = b.min - DVec3::splat(PAD * cell);
         // Dimensions rounded up to even: cells are built in 2×2×2 blocks.
-        let n = ((b.max + DVec3::splat(2.0 * cell) - min) / cell / 2.0).ceil() * 2.0;
+        let n = ((b.max + DVec3::splat(PAD * cell) - min) / cell / 2.0).ceil() * 2.0;
         let dims = [n.x as usize, n.y as usize, n.z as usize];
         let r = 0.5 * cell * 3f64.sqrt();
         let count = dims[0] * dims[1] * dims[2];
@@ -187,13 +197,11 @@ impl CandidateGrid {
             side.push(s);
         }
         Some(CandidateGrid {
-            min,
-            cell,
-            inv_cell: 1.0 / cell,
-            dims,
+            cells: CellLattice::new(min, DVec3::splat(cell), dims),
             offsets,
             side,
             items,
+            tiny: 1e-12 * cell,
         })
     }
 
@@ -201,12 +209,12 @@ impl CandidateGrid {
     /// cell's side (0 when unknown); `None` when `p`'s cell keeps no list.
     #[inline]
     pub fn nearest(&self, mesh: &TriangleMesh, p: DVec3) -> Option<(usize, f64, i8)> {
-        let (i, [x, y, z]) = self.cell_of(p)?;
+        let (i, xyz) = self.cells.locate(p)?;
         let list = &self.items[self.offsets[i] as usize..self.offsets[i + 1] as usize];
         let first = list.first()?;
-        let c = self.min + (DVec3::new(x as f64, y as f64, z as f64) + 0.5) * self.cell;
+        let c = self.cells.centre(xyz);
         // |p − c| rounded up a little, so `dc − pc` stays a lower bound.
-        let pc = p.distance(c) * (1.0 + 1e-12) + 1e-12 * self.cell;
+        let pc = p.distance(c) * (1.0 + 1e-12) + self.tiny;
         let mut best = mesh.tris[first.slot as usize].distance_squared(p);
         let mut slot = first.slot;
         for e in &list[1..] {
@@ -229,28 +237,13 @@ impl CandidateGrid {
         Some((slot as usize, best, self.side[i]))
     }
 
-    /// The cell holding `p` (index and coordinates); `None` outside the
-    /// grid or for a non-finite `p`.
-    #[inline]
-    fn cell_of(&self, p: DVec3) -> Option<(usize, [usize; 3])> {
-        let g = (p - self.min) * self.inv_cell;
-        if !(g.x >= 0.0 && g.y >= 0.0 && g.z >= 0.0) {
-            return None;
-        }
-        let (x, y, z) = (g.x as usize, g.y as usize, g.z as usize);
-        if x >= self.dims[0] || y >= self.dims[1] || z >= self.dims[2] {
-            return None;
-        }
-        Some((x + self.dims[0] * (y + self.dims[1] * z), [x, y, z]))
-    }
-
     /// `+1` or `−1` when every point of `p`'s cell is on that side of the
     /// surface (set at build time from the exact distance at the centre,
     /// larger than the half diagonal); `None` when the surface may cross
     /// the cell or `p` is outside the grid.
     #[inline]
     pub fn side(&self, p: DVec3) -> Option<i8> {
-        let (i, _) = self.cell_of(p)?;
+        let (i, _) = self.cells.locate(p)?;
         let s = self.side[i];
         (s != 0).then_some(s)
     }

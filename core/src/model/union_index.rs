@@ -19,15 +19,15 @@
 use glam::DVec3;
 
 use crate::bounds::Aabb;
+use crate::cells::CellLattice;
 
 /// Grid + BVH over child boxes. Children with infinite boxes are kept in
 /// `always` and visited for every query.
 #[derive(Debug)]
 pub struct UnionIndex {
-    grid_box: Aabb,
-    dims: [usize; 3],
-    inv_cell: DVec3,
-    cell_size: DVec3,
+    cells: CellLattice,
+    /// Half the cells' diagonal, for [`UnionIndex::slack`].
+    half_diagonal: f64,
     /// CSR: children of cell c are `entries[offsets[c]..offsets[c+1]]`,
     /// sorted by lower bound over the cell, so a query can stop once the
     /// next bound is above what it already found. Bound and index sit side
@@ -199,10 +199,8 @@ impl UnionIndex {
         }
         let bvh = Bvh::build(boxes, &finite);
         Self {
-            grid_box,
-            dims,
-            inv_cell,
-            cell_size,
+            cells: CellLattice::new(grid_box.min, cell_size, dims),
+            half_diagonal: 0.5 * cell_size.length(),
             offsets,
             entries,
             margin,
@@ -214,22 +212,17 @@ impl UnionIndex {
     /// The candidates for point `p`.
     #[inline]
     pub fn candidates(&self, p: DVec3) -> Candidates<'_> {
-        if !self.grid_box.contains(p) {
+        // Points on the grid box's upper faces belong to no cell: the BVH
+        // answers them, exactly as well.
+        let Some((c, xyz)) = self.cells.locate(p) else {
             return Candidates::Outside;
-        }
-        // Non-negative inside the box, so truncation is floor.
-        let g = (p - self.grid_box.min) * self.inv_cell;
-        let x = (g.x as usize).min(self.dims[0] - 1);
-        let y = (g.y as usize).min(self.dims[1] - 1);
-        let z = (g.z as usize).min(self.dims[2] - 1);
-        let c = x + self.dims[0] * (y + self.dims[1] * z);
+        };
         let (a, b) = (self.offsets[c] as usize, self.offsets[c + 1] as usize);
         Candidates::Cell {
             entries: &self.entries[a..b],
             always: &self.always,
             margin: self.margin,
-            centre: self.grid_box.min
-                + (DVec3::new(x as f64, y as f64, z as f64) + 0.5) * self.cell_size,
+            centre: self.cells.centre(xyz),
         }
     }
 
@@ -239,7 +232,7 @@ impl UnionIndex {
     /// `lo + slack` (`d(p) ≥ d(c) − |p − c|`): a tighter stop for a query.
     #[inline]
     pub fn slack(&self, p: DVec3, centre: DVec3) -> f64 {
-        let r = 0.5 * self.cell_size.length();
+        let r = self.half_diagonal;
         (r - p.distance(centre)).max(0.0) - 1e-12 * r
     }
 
