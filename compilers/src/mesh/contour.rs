@@ -43,6 +43,7 @@ use volcad_core::sampler::Grid;
 
 use super::flat::{FlatKey, KeptCubes, Regions, flat_key};
 use super::indexed::IndexedMesh;
+use super::mixed::mixed_cubes;
 use super::vertex_keys::{BandMesh, KeyMap};
 use super::vertex_keys::{Tri, VRef};
 
@@ -646,33 +647,6 @@ impl Contourer {
             }
         }
     }
-}
-
-/// Cubes `i` of a row whose eight corners (columns `i` and `i + 1` of the
-/// four label rows around it) are not all one label: the only ones that
-/// can hold surface. Scans 64 cubes at a time with branch-free XORs the
-/// compiler vectorises, so solid and empty runs cost a fraction of a
-/// nanosecond a cube.
-fn mixed_cubes([a, b, c, d]: [&[u16]; 4]) -> impl Iterator<Item = usize> + '_ {
-    const CHUNK: usize = 64;
-    let cubes = a.len().saturating_sub(1);
-    (0..cubes).step_by(CHUNK).flat_map(move |i0| {
-        let n = CHUNK.min(cubes - i0);
-        let column = |x: usize| (a[x] ^ b[x]) | (a[x] ^ c[x]) | (a[x] ^ d[x]);
-        let mut bits = 0u64;
-        for t in 0..n {
-            let x = i0 + t;
-            let mixed = column(x) | column(x + 1) | (a[x] ^ a[x + 1]);
-            bits |= u64::from(mixed != 0) << t;
-        }
-        std::iter::from_fn(move || {
-            (bits != 0).then(|| {
-                let t = bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                i0 + t
-            })
-        })
-    })
 }
 
 /// Corners of Kuhn tet `perm`, positively oriented.

@@ -31,6 +31,7 @@ pub mod contour;
 mod field;
 mod flat;
 pub mod indexed;
+mod mixed;
 pub mod obj;
 pub mod segment;
 pub mod stl;
