@@ -365,8 +365,9 @@ impl Contourer {
                 if self.merge
                     && let Some(key) = flat_key(self.grid.voxel, self.iface, &cube)
                 {
-                    flats.at.push(([j, i], key, corner_mask(&cube, key.x)));
-                    flats.kept.push(&cube);
+                    let mask = corner_mask(&cube, key.x);
+                    flats.at.push(([j, i], key, mask));
+                    flats.kept.push(&cube, key, mask);
                     continue;
                 }
                 for perm in 0..6 {
