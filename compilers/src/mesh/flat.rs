@@ -97,11 +97,14 @@ pub(super) fn flat_key(voxel: DVec3, iface: Interface, cube: &Cube) -> Option<Fl
             return None;
         }
     }
+    // Per axis, the four corners with that axis' bit clear (ascending, so
+    // the sums are those of a loop over 0..8).
+    const LOW: [[usize; 4]; 3] = [[0, 2, 4, 6], [0, 1, 4, 5], [0, 1, 2, 3]];
     let mut mean = [0.0; 3];
     let mut diffs = [[0.0; 4]; 3];
     for (axis, (m, d)) in mean.iter_mut().zip(&mut diffs).enumerate() {
         let bit = 1usize << axis;
-        for (k, c) in (0..8).filter(|c| c & bit == 0).enumerate() {
+        for (k, &c) in LOW[axis].iter().enumerate() {
             d[k] = g[c | bit] - g[c];
             *m += d[k] / 4.0;
         }
@@ -119,12 +122,27 @@ pub(super) fn flat_key(voxel: DVec3, iface: Interface, cube: &Cube) -> Option<Fl
         return None;
     }
     let n = DVec3::new(mean[0] / voxel.x, mean[1] / voxel.y, mean[2] / voxel.z).normalize();
-    let q = (n * NORMAL_BINS).round();
+    let q = n * NORMAL_BINS;
     Some(FlatKey {
         x,
         y,
-        normal: [q.x as i32, q.y as i32, q.z as i32],
+        normal: [round(q.x), round(q.y), round(q.z)],
     })
+}
+
+/// `v.round() as i32` for `|v| ≤ 2³⁰` (halves away from zero), without
+/// the C library's `round` (a call per component without SSE4.1): the
+/// truncation is exact and `v − t` is exact for such `v`.
+fn round(v: f64) -> i32 {
+    let t = v as i32;
+    let f = v - f64::from(t);
+    if f >= 0.5 {
+        t + 1
+    } else if f <= -0.5 {
+        t - 1
+    } else {
+        t
+    }
 }
 
 /// A flat cube, kept for the fallback: its lowest corner and which of its
@@ -710,6 +728,23 @@ mod tests {
             })
             .count();
         assert!(shared > 0);
+    }
+
+    #[test]
+    fn round_matches_the_library_round() {
+        let mut rng = volcad_core::xorshift::XorShift::new(5);
+        let halves = (-40..=40).map(|k| f64::from(k) * 0.5);
+        let near = [
+            0.5,
+            -0.5,
+            1.5,
+            0.499_999_999_999_999_94,
+            -2.500_000_000_000_000_4,
+        ];
+        let random = (0..100_000).map(|_| (rng.next_f64() - 0.5) * 2100.0);
+        for v in halves.chain(near).chain(random) {
+            assert_eq!(super::round(v), v.round() as i32, "{v}");
+        }
     }
 
     #[test]
