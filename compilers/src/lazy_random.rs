@@ -92,6 +92,8 @@ impl Shares {
         )
     }
 
+    /// The pick from share bounds `lo`, `hi` (one pair a material) when
+    /// every share is certainly below or above `r`.
     #[inline(always)]
     fn count(lo: &[f64], hi: &[f64], r: f32) -> Option<u8> {
         let r = f64::from(r);

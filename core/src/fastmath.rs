@@ -64,6 +64,22 @@ pub fn floor(x: f64) -> f64 {
     }
 }
 
+/// `x.round() as i32` (halves away from zero) for `|x| ≤ 2³⁰`, without
+/// the C library's `round` (a call, not an instruction, without SSE4.1):
+/// the truncation is exact, and so is `x − t` for such `x`.
+#[inline(always)]
+pub fn round_i32(x: f64) -> i32 {
+    let t = x as i32;
+    let f = x - f64::from(t);
+    if f >= 0.5 {
+        t + 1
+    } else if f <= -0.5 {
+        t - 1
+    } else {
+        t
+    }
+}
+
 /// `floor` of each component.
 #[inline(always)]
 pub fn floor3(v: glam::DVec3) -> glam::DVec3 {
@@ -131,6 +147,17 @@ mod tests {
         for x in [1e-300, 1e-20, 1e-8, 0.1, 0.3, std::f64::consts::FRAC_PI_4] {
             let (s, c) = sin_cos(x);
             assert!(ulps(s, x.sin()) <= 1.0 && ulps(c, x.cos()) <= 1.0, "{x}");
+        }
+    }
+
+    #[test]
+    fn round_i32_is_the_c_librarys() {
+        let mut rng = crate::xorshift::XorShift::new(5);
+        let halves = (-40..=40).map(|k| f64::from(k) * 0.5);
+        let near = [0.499_999_999_999_999_94, -2.500_000_000_000_000_4, 1e-300];
+        let random = (0..100_000).map(|_| (rng.next_f64() - 0.5) * 2100.0);
+        for x in halves.chain(near).chain(random) {
+            assert_eq!(round_i32(x), x.round() as i32, "{x}");
         }
     }
 

@@ -47,6 +47,7 @@ use std::collections::HashMap;
 use glam::DVec3;
 use rayon::prelude::*;
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+use volcad_core::fastmath::round_i32;
 
 use super::contour::{Cube, Interface, cut_field, front_back};
 use super::indexed::IndexedMesh;
@@ -126,23 +127,8 @@ pub(super) fn flat_key(voxel: DVec3, iface: Interface, cube: &Cube) -> Option<Fl
     Some(FlatKey {
         x,
         y,
-        normal: [round(q.x), round(q.y), round(q.z)],
+        normal: [round_i32(q.x), round_i32(q.y), round_i32(q.z)],
     })
-}
-
-/// `v.round() as i32` for `|v| ≤ 2³⁰` (halves away from zero), without
-/// the C library's `round` (a call per component without SSE4.1): the
-/// truncation is exact and `v − t` is exact for such `v`.
-fn round(v: f64) -> i32 {
-    let t = v as i32;
-    let f = v - f64::from(t);
-    if f >= 0.5 {
-        t + 1
-    } else if f <= -0.5 {
-        t - 1
-    } else {
-        t
-    }
 }
 
 /// A flat cube, kept for the fallback: its lowest corner and which of its
@@ -728,23 +714,6 @@ mod tests {
             })
             .count();
         assert!(shared > 0);
-    }
-
-    #[test]
-    fn round_matches_the_library_round() {
-        let mut rng = volcad_core::xorshift::XorShift::new(5);
-        let halves = (-40..=40).map(|k| f64::from(k) * 0.5);
-        let near = [
-            0.5,
-            -0.5,
-            1.5,
-            0.499_999_999_999_999_94,
-            -2.500_000_000_000_000_4,
-        ];
-        let random = (0..100_000).map(|_| (rng.next_f64() - 0.5) * 2100.0);
-        for v in halves.chain(near).chain(random) {
-            assert_eq!(super::round(v), v.round() as i32, "{v}");
-        }
     }
 
     #[test]
