@@ -12,8 +12,10 @@ fn volcad(args: &[&str]) -> Output {
         .expect("run volcad")
 }
 
+/// One runtime folder for every run of these tests (a fixed name, so runs
+/// do not leave one each behind).
 fn runtime_dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("volcad-xdg-{}", std::process::id()));
+    let d = std::env::temp_dir().join("volcad-cli-tests-xdg");
     std::fs::create_dir_all(&d).unwrap();
     #[cfg(unix)]
     {
@@ -31,11 +33,13 @@ fn example(name: &str) -> String {
         .to_string()
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("volcad-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A scratch folder for one test, removed when the test ends (passed or
+/// failed).
+fn tmp(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("volcad-cli-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 fn ok(o: &Output) -> String {
@@ -104,7 +108,8 @@ fn eval_prints_distance_and_fractions_by_name() {
 
 #[test]
 fn sample_writes_one_column_per_material() {
-    let d = tmp("sample");
+    let scratch = tmp("sample");
+    let d = scratch.path();
     let pts = d.join("in.csv");
     std::fs::write(&pts, "x,y,z\n0,0,0\n7.5,0,0\n100,0,0\n").unwrap();
     let out = d.join("out.csv");
@@ -129,7 +134,8 @@ fn bad_input_is_a_clear_error() {
     let err = fails(&volcad(&["info", "/no/such/design.rhai"]));
     assert!(err.contains("cannot read /no/such/design.rhai"), "{err}");
 
-    let d = tmp("bad");
+    let scratch = tmp("bad");
+    let d = scratch.path();
     let bad = d.join("bad.rhai");
     std::fs::write(
         &bad,
@@ -258,7 +264,8 @@ fn bad_input_is_a_clear_error() {
 
 #[test]
 fn unbounded_design_refuses_to_export() {
-    let d = tmp("unbounded");
+    let scratch = tmp("unbounded");
+    let d = scratch.path();
     let s = d.join("tile.rhai");
     std::fs::write(&s, "Tile(4, 4, 4, Sphere(Vec3(0,0,0), 1, 1))").unwrap();
     let err = fails(&volcad(&[
@@ -285,7 +292,8 @@ fn files_in(dir: &Path) -> Vec<String> {
 
 #[test]
 fn export_png_mesh_and_fea() {
-    let d = tmp("export");
+    let scratch = tmp("export");
+    let d = scratch.path();
     let png = d.join("png");
     let out = ok(&volcad(&[
         "export",
@@ -448,7 +456,8 @@ fn bench_reports_evaluation_and_export_rates() {
 fn signals_cancel_exports_and_leave_nothing() {
     use std::time::{Duration, Instant};
     for signal in ["INT", "TERM", "HUP"] {
-        let d = tmp(&format!("signal_{signal}"));
+        let scratch = tmp(&format!("signal_{signal}"));
+        let d = scratch.path();
         let dest = d.join("stack");
         // Fine enough to run for many seconds: a debug build at 0.01 mm.
         let mut child = Command::new(env!("CARGO_BIN_EXE_volcad"))
@@ -461,7 +470,7 @@ fn signals_cancel_exports_and_leave_nothing() {
             .spawn()
             .unwrap();
         let staging = || {
-            std::fs::read_dir(&d).unwrap().flatten().any(|e| {
+            std::fs::read_dir(d).unwrap().flatten().any(|e| {
                 e.file_name()
                     .to_string_lossy()
                     .starts_with(".stack.partial-")

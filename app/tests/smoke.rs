@@ -17,9 +17,11 @@ fn studio_binary_renders_the_design_under_xvfb() {
         }
         panic!("xvfb-run is not installed: apt-get install xvfb xauth, or set VOLCAD_SKIP_XVFB=1");
     }
-    let dir = std::env::temp_dir().join(format!("volcad-smoke-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = tempfile::Builder::new()
+        .prefix("volcad-smoke-")
+        .tempdir()
+        .unwrap();
+    let dir = scratch.path();
     let runtime = dir.join("xdg");
     std::fs::create_dir_all(&runtime).unwrap();
     #[cfg(unix)]

@@ -394,15 +394,11 @@ where
 mod tests {
     use super::*;
 
-    fn tmp(name: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("volcad-job-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        d
-    }
-
     #[test]
     fn success_renames_and_writes_manifest() {
-        let dest = tmp("ok").join("out");
+        let scratch = tempfile::tempdir().unwrap();
+        let dir = scratch.path();
+        let dest = dir.join("out");
         let h = spawn(dest.clone(), "abc".into(), |ctx| {
             std::fs::write(ctx.staging().join("a.txt"), "x").unwrap();
             ctx.progress("writing", 1, 1, "files", 1.0);
@@ -427,7 +423,9 @@ mod tests {
 
     #[test]
     fn cancel_leaves_nothing() {
-        let dest = tmp("cancel").join("out");
+        let scratch = tempfile::tempdir().unwrap();
+        let dir = scratch.path();
+        let dest = dir.join("out");
         let h = spawn(dest.clone(), "abc".into(), |ctx| {
             std::fs::write(ctx.staging().join("a.txt"), "x").unwrap();
             loop {
@@ -446,7 +444,9 @@ mod tests {
 
     #[test]
     fn panic_is_an_error_and_leaves_nothing() {
-        let dest = tmp("panic").join("out");
+        let scratch = tempfile::tempdir().unwrap();
+        let dir = scratch.path();
+        let dest = dir.join("out");
         let h = spawn(dest.clone(), "abc".into(), |_| panic!("boom"));
         let e = h.join().unwrap_err().to_string();
         assert!(e.contains("boom"), "{e}");
@@ -455,7 +455,9 @@ mod tests {
 
     #[test]
     fn refuses_to_replace_foreign_folders() {
-        let dest = tmp("foreign").join("out");
+        let scratch = tempfile::tempdir().unwrap();
+        let dir = scratch.path();
+        let dest = dir.join("out");
         std::fs::create_dir_all(&dest).unwrap();
         std::fs::write(dest.join("precious.txt"), "x").unwrap();
         let h = spawn(dest.clone(), "abc".into(), |_| Ok(Summary::default()));
@@ -466,8 +468,8 @@ mod tests {
     #[cfg(unix)]
     #[test]
     fn staging_of_dead_processes_is_removed() {
-        let dir = tmp("stale");
-        std::fs::create_dir_all(&dir).unwrap();
+        let scratch = tempfile::tempdir().unwrap();
+        let dir = scratch.path();
         // A process that has ended: its id names no process now.
         let mut child = std::process::Command::new("true").spawn().unwrap();
         let dead = child.id();
@@ -489,8 +491,8 @@ mod tests {
 
     #[test]
     fn a_file_in_the_path_is_named() {
-        let dir = tmp("file_in_path");
-        std::fs::create_dir_all(&dir).unwrap();
+        let scratch = tempfile::tempdir().unwrap();
+        let dir = scratch.path();
         let file = dir.join("plain.txt");
         std::fs::write(&file, "x").unwrap();
         let h = spawn(file.join("out"), "abc".into(), |_| Ok(Summary::default()));

@@ -17,6 +17,9 @@ use std::process::Command;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
+mod common;
+
+use common::scratch;
 use volcad_compilers::fea::*;
 use volcad_compilers::job::{Summary, spawn};
 use volcad_core::Model;
@@ -36,12 +39,6 @@ const TOP_UZ: f64 = -0.1;
 fn model(src: &str) -> Arc<Model> {
     let d = run_script(src, "t.rhai", &ScriptOptions::default()).unwrap();
     Arc::new(Model::prepare(&d.root, d.materials.clone()).unwrap())
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("volcad-fea-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
 }
 
 fn export(model: &Arc<Model>, p: &FeaParams, dest: &Path) -> Summary {
@@ -198,7 +195,7 @@ fn bricks_of_the_graded_bar_run_in_calculix() {
         }),
         ..FeaParams::default()
     };
-    let dir = tmp("bricks");
+    let (_scratch, dir) = scratch("bricks");
     let s = export(&m, &p, &dir);
     assert_eq!(s.units, 750, "{s:?}");
     let counts: std::collections::HashMap<_, _> = s.counts.iter().cloned().collect();
@@ -215,7 +212,6 @@ fn bricks_of_the_graded_bar_run_in_calculix() {
     if run_ccx(&dir, "model") {
         check_bar_result(&dir, "C3D8R bar");
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -231,7 +227,7 @@ fn adaptive_tets_of_the_graded_bar_run_in_calculix() {
         }),
         ..FeaParams::default()
     };
-    let dir = tmp("tets");
+    let (_scratch, dir) = scratch("tets");
     let s = export(&m, &p, &dir);
     let (_, elems) = check_deck(&dir.join("model.inp"));
     assert_eq!(elems as u64, s.units);
@@ -294,7 +290,6 @@ fn adaptive_tets_of_the_graded_bar_run_in_calculix() {
     if run_ccx(&dir, "model") {
         check_bar_result(&dir, "C3D4 bar");
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -306,7 +301,7 @@ fn read_frd_of_the_uniaxial_brick_reference() {
     } else {
         PathBuf::from("/work/shared/data/seat/bricks_c3d8r_uniaxial.inp")
     };
-    let dir = tmp("uniaxial");
+    let (_scratch, dir) = scratch("uniaxial");
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::copy(&src, dir.join("uni.inp")).unwrap();
     if !run_ccx(&dir, "uni") {
@@ -336,7 +331,6 @@ fn read_frd_of_the_uniaxial_brick_reference() {
         csv.lines().nth(14).unwrap().starts_with("14,10,10,10,"),
         "{csv}"
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// The paper's loop with our own tools at every step but the solver:
@@ -345,7 +339,7 @@ fn read_frd_of_the_uniaxial_brick_reference() {
 /// design by the simulated displacement.
 #[test]
 fn round_trip_through_calculix_into_a_simulation_field() {
-    let dir = tmp("roundtrip");
+    let (_scratch, dir) = scratch("roundtrip");
     let m = model(BAR);
     let p = FeaParams {
         element: Element::C3D4,

@@ -3,10 +3,13 @@
 //! sizing expressions.
 
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
+mod common;
+
+use common::scratch;
 use volcad_compilers::fea::*;
 use volcad_compilers::job::spawn;
 use volcad_core::Model;
@@ -19,12 +22,6 @@ fn model(src: &str) -> Arc<Model> {
 
 fn mesh(m: &Model, p: &FeaParams) -> FeaMesh {
     build_mesh(m, p, &AtomicBool::new(false), &|_, _, _, _| {}).unwrap()
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("volcad-feamesh-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
 }
 
 fn export(
@@ -216,7 +213,7 @@ FGrade(["x/15+0.5", "-x/15+0.5"], [m.id("VeroCyan"), m.id("Agilus30")], true, Re
             sizing: Sizing::Expr("h +".into()),
             ..FeaParams::default()
         },
-        &tmp("badexpr"),
+        &scratch("badexpr").1,
     )
     .unwrap_err();
     assert!(e.to_string().contains("--sizing"), "{e}");
@@ -227,7 +224,7 @@ FGrade(["x/15+0.5", "-x/15+0.5"], [m.id("VeroCyan"), m.id("Agilus30")], true, Re
             max_cell: 1.0,
             ..FeaParams::default()
         },
-        &tmp("badcells"),
+        &scratch("badcells").1,
     )
     .unwrap_err();
     assert!(e.to_string().contains("--max-cell"), "{e}");
@@ -254,18 +251,17 @@ FGrade(["x/8+0.5", "-x/8+0.5"], [m.id("VeroCyan"), m.id("Agilus30")], true, Sphe
                 }),
                 ..FeaParams::default()
             };
-            let dir = tmp(&format!("det-{element:?}-{threads:?}"));
+            let (_scratch, dir) = scratch(&format!("det-{element:?}-{threads:?}"));
             export(&m, &p, &dir).unwrap();
             files.push(std::fs::read(dir.join("model.inp")).unwrap());
             files.push(std::fs::read(dir.join("manifest.json")).unwrap());
-            let _ = std::fs::remove_dir_all(&dir);
         }
         assert!(
             files[0..2] == files[2..4] && files[0..2] == files[4..6],
             "{element:?}: output differs between thread counts"
         );
         // Another seed draws other materials.
-        let dir = tmp("det-seed");
+        let (_scratch, dir) = scratch("det-seed");
         let p = FeaParams {
             element,
             voxel: 0.7,
@@ -276,7 +272,6 @@ FGrade(["x/8+0.5", "-x/8+0.5"], [m.id("VeroCyan"), m.id("Agilus30")], true, Sphe
         };
         export(&m, &p, &dir).unwrap();
         assert_ne!(std::fs::read(dir.join("model.inp")).unwrap(), files[0]);
-        let _ = std::fs::remove_dir_all(&dir);
     }
 }
 
@@ -288,7 +283,7 @@ fn missing_elastic_properties_name_the_material_and_table() {
 FGrade(["x/8+0.5", "-x/8+0.5"], [m.id("red"), m.id("liquid")], true, RectPrism(Vec3(0,0,0), Vec3(8,4,4), m.id("red")))"#,
     );
     for element in [Element::C3D4, Element::C3D8R] {
-        let dir = tmp("missing-e");
+        let (_scratch, dir) = scratch("missing-e");
         let e = export(
             &m,
             &FeaParams {
@@ -313,7 +308,7 @@ fn deck_layout_and_sets() {
         r#"let m = j750_materials();
 FGrade(["x/6+0.5", "-x/6+0.5"], [m.id("VeroCyan"), m.id("Agilus30")], true, RectPrism(Vec3(0,0,0), Vec3(6,4,3), m.id("VeroCyan")))"#,
     );
-    let dir = tmp("layout");
+    let (_scratch, dir) = scratch("layout");
     let s = export(
         &m,
         &FeaParams {
@@ -360,5 +355,4 @@ FGrade(["x/6+0.5", "-x/6+0.5"], [m.id("VeroCyan"), m.id("Agilus30")], true, Rect
     assert_eq!((set("NBOTTOM"), set("NTOP")), (117, 117));
     let manifest = std::fs::read_to_string(dir.join("manifest.json")).unwrap();
     assert!(manifest.contains("\"kind\": \"fea\"") && manifest.contains("model.inp"));
-    let _ = std::fs::remove_dir_all(&dir);
 }

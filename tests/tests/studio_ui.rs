@@ -6,7 +6,7 @@
 //! Mesa prints a harmless warning when `XDG_RUNTIME_DIR` is unset; set it to
 //! any 0700 folder to silence it.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::{Duration, Instant};
 
 use egui::accesskit::Role;
@@ -21,11 +21,13 @@ let bar = RectPrism(Vec3(0, 0, 0), Vec3(15, 10, 5), m.id("gray"));
 let graded = FGrade(["x/15+0.5", "-x/15+0.5"], [m.id("red"), m.id("blue")], true, bar);
 graded"#;
 
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("volcad-studio-ui-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("temp dir");
-    d
+/// A scratch folder for one test, removed when the test ends (passed or
+/// failed).
+fn temp_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("volcad-studio-ui-{name}-"))
+        .tempdir()
+        .expect("temp dir")
 }
 
 fn harness(opts: StudioOptions) -> Harness<'static, StudioApp> {
@@ -35,10 +37,10 @@ fn harness(opts: StudioOptions) -> Harness<'static, StudioApp> {
         .build_eframe(move |cc| StudioApp::new(cc, opts))
 }
 
-fn studio(text: &str, name: &str) -> (Harness<'static, StudioApp>, PathBuf) {
+fn studio(text: &str, name: &str) -> (Harness<'static, StudioApp>, tempfile::TempDir) {
     let dir = temp_dir(name);
     (
-        harness(StudioOptions::for_tests(dir.join("data"), text)),
+        harness(StudioOptions::for_tests(dir.path().join("data"), text)),
         dir,
     )
 }
@@ -206,7 +208,8 @@ fn find_tab_and_undo_in_the_editor() {
 
 #[test]
 fn autosave_writes_the_recovery_file_and_restart_offers_it() {
-    let (mut h, dir) = studio(BAR, "recovery");
+    let (mut h, scratch) = studio(BAR, "recovery");
+    let dir = scratch.path();
     wait_idle(&mut h);
     type_at_end(&mut h, " // unsaved edit");
     let rec = dir.join("data/recovery.rhai");
@@ -248,7 +251,8 @@ fn closing_with_unsaved_changes_asks_first() {
 /// Renders the studio with an example and saves `docs/images/studio.png`.
 #[test]
 fn screenshot_for_the_docs() {
-    let dir = temp_dir("docs-shot");
+    let scratch = temp_dir("docs-shot");
+    let dir = scratch.path();
     let mut opts = StudioOptions::for_tests(dir.join("data"), "");
     opts.initial_text = None;
     opts.example = Some("lattice_per_strut".into());
@@ -321,7 +325,8 @@ fn set_png_voxel(h: &mut Harness<'static, StudioApp>, mm: f64) {
 
 #[test]
 fn png_export_cancels_cleanly_and_completes_with_a_manifest() {
-    let (mut h, dir) = studio(BAR, "export");
+    let (mut h, scratch) = studio(BAR, "export");
+    let dir = scratch.path();
     wait_idle(&mut h);
 
     // A long export (94 million voxels), cancelled once it reports progress.
@@ -349,7 +354,7 @@ fn png_export_cancels_cleanly_and_completes_with_a_manifest() {
     });
     assert_eq!(job_state(h.state()), Some("cancelled"));
     assert!(!cancelled.exists(), "a cancelled export leaves nothing");
-    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+    let leftovers: Vec<_> = std::fs::read_dir(dir)
         .unwrap()
         .flatten()
         .filter(|e| e.file_name().to_string_lossy().contains("partial"))
@@ -400,7 +405,7 @@ fn percentile(v: &[f64], p: f64) -> f64 {
 #[test]
 #[ignore = "measurement; run in release with --ignored --nocapture"]
 fn frame_times_while_the_bunny_lattice_bakes() {
-    let dir = temp_dir("bunny");
+    let dir = temp_dir("bunny").keep();
     let opts = StudioOptions {
         example: Some("bunny_lattice".into()),
         initial_text: None,

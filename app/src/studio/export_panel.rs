@@ -559,8 +559,8 @@ mod tests {
 
     #[test]
     fn destinations_never_mix_with_other_files() {
-        let base = std::env::temp_dir().join(format!("volcad-dest-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&base);
+        let scratch = tempfile::tempdir().unwrap();
+        let base = scratch.path().join("dest");
         assert_eq!(
             destination(&base, "bar", Kind::Png),
             base,
@@ -577,7 +577,6 @@ mod tests {
         std::fs::create_dir_all(base.join("bar-png")).unwrap();
         assert_eq!(destination(&base, "bar", Kind::Mesh), base.join("bar-mesh"));
         assert_eq!(destination(&base, "bar", Kind::Png), base.join("bar-png-2"));
-        let _ = std::fs::remove_dir_all(&base);
     }
 
     #[test]

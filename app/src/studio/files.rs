@@ -350,8 +350,8 @@ mod tests {
 
     #[test]
     fn recovery_round_trip() {
-        let dir = std::env::temp_dir().join(format!("volcad-recovery-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
+        let scratch = tempfile::tempdir().unwrap();
+        let dir = scratch.path().join("recovery");
         let ctx = egui::Context::default();
         let mut r = Recovery::new(Some(dir.clone()), Duration::ZERO);
         assert!(r.load().is_none());
@@ -373,13 +373,12 @@ mod tests {
         assert_eq!(got.meta.path.as_deref(), Some(Path::new("/a/b.rhai")));
         r.clear();
         assert!(r.load().is_none());
-        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]
     fn save_as_makes_a_clean_document() {
-        let dir = std::env::temp_dir().join(format!("volcad-doc-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let scratch = tempfile::tempdir().unwrap();
+        let dir = scratch.path();
         let mut d = Document::untitled("untitled.rhai", "", None);
         assert!(d.is_dirty("abc"));
         let p = dir.join("part.rhai");
@@ -387,7 +386,6 @@ mod tests {
         assert!(!d.is_dirty("abc"));
         assert_eq!(d.name(), "part.rhai");
         assert_eq!(read_script(&p).unwrap(), "abc");
-        assert_eq!(d.base_dir.as_deref(), Some(dir.as_path()));
-        let _ = std::fs::remove_dir_all(&dir);
+        assert_eq!(d.base_dir.as_deref(), Some(dir));
     }
 }

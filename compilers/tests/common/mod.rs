@@ -4,7 +4,7 @@
 
 use std::collections::BTreeMap;
 use std::io::Cursor;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use volcad_compilers::job::{self, JobContext};
@@ -98,6 +98,14 @@ pub fn colour_counts(files: &BTreeMap<String, Vec<u8>>) -> BTreeMap<[u8; 4], u64
         }
     }
     counts
+}
+
+/// A path that does not exist yet (an export's destination) inside a
+/// scratch folder that is removed when the test ends, passed or failed.
+pub fn scratch(name: &str) -> (tempfile::TempDir, PathBuf) {
+    let t = tmp();
+    let d = t.path().join(name);
+    (t, d)
 }
 
 /// A fresh temporary folder (removed on drop).

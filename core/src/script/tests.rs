@@ -180,7 +180,8 @@ fn params_default_and_override() {
 fn files_need_a_folder_and_stay_inside_it() {
     let e = run("read_csv(\"a.csv\")").unwrap_err();
     assert!(e.message.contains("save the script first"), "{e}");
-    let dir = std::env::temp_dir().join(format!("volcad-script-{}", std::process::id()));
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
     std::fs::create_dir_all(dir.join("sub")).unwrap();
     std::fs::write(dir.join("sub/s.csv"), "x1,y1,name\n1,2,a\n3.5,4,b\n").unwrap();
     let opts = ScriptOptions {
