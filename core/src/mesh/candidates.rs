@@ -7,9 +7,9 @@
 //! nearest triangle `t*` satisfies `d(p, t*) ≤ d(p) ≤ u + r`, hence
 //! `d(c, t*) ≤ d(p, t*) + r ≤ u + 2r`. So the triangles with
 //! `d(c, t) ≤ u + 2r` include `t*` for every point of the cell. Kept sorted
-//! by `d(c, t)`, a query stops at the first `t` with
-//! `d(c, t) − |p − c| ≥ best` (a lower bound of `d(p, t)` and of every
-//! later one).
+//! by `d(c, t)` (stored rounded down), a query stops at the first `t` with
+//! `d(c, t) − |p − c|` above the best distance so far (a lower bound of
+//! `d(p, t)` and of every later one).
 //!
 //! The sign: when `u > r` no point of the cell is on the surface (the SDF
 //! is 1-Lipschitz), so the whole cell has the sign of `d(c)` and the query
@@ -53,15 +53,15 @@ struct Candidate {
     slot: u32,
 }
 
-/// The grid, packed so a query touches as few cache lines as possible
-/// (the lists of the bunny's 379 k surface cells are 30 MB as `Candidate`s,
-/// 15 MB packed; a query's time was mostly waiting for the cell's record
-/// and its first entry).
+/// The grid, packed: the lists of the bunny's 379 k surface cells are
+/// 30 MB as `Candidate`s and 15 MB packed (random-order queries, which
+/// miss the caches, 20 to 60 % faster), and the walk stops on an integer
+/// compare (Z-ordered queries about 8 % faster).
 ///
 /// `records[i]`: the start of cell `i`'s list in `items` (low 30 bits) and
-/// its side plus one (high 2 bits: 0 inside, 1 unknown, 2 outside); the
-/// list ends where cell `i + 1`'s starts. An empty list means "no list,
-/// ask the BVH".
+/// its side plus one (high 2 bits: 0 inside, 1 unknown, 2 outside; also
+/// kept for a cell whose list was too long to keep); the list ends where
+/// cell `i + 1`'s starts. An empty list means "no list, ask the BVH".
 ///
 /// `items`: one `u32` per candidate, the triangle slot in the low
 /// `slot_bits` bits and `q = ⌊d(c, t) / unit⌋` above them, so
