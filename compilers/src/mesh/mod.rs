@@ -82,6 +82,17 @@ const TRIANGLES_PER_FACE: f64 = 9.0;
 /// cube makes about 12 thousand at 0.1 mm and 24 thousand at 0.05 mm,
 /// where `sqrt(600 mm²)` is 245 and 490 voxels.
 const FLAT_TRIANGLES_PER_EDGE: f64 = 50.0;
+/// Bytes held until the end of the export per flat cube (a voxel of a
+/// planar face), besides its samples: its region's union-find entry and
+/// key, its kept corner, growth slack and the grouping at the end. The
+/// merged faces' triangles are few, but the bookkeeping grows with their
+/// area in voxels: the 10 mm cube (600 mm² of faces) peaks at 175 MB
+/// resident at 0.02 mm and 665 MB at 0.01 mm, about 110 bytes for each
+/// of the 4.5 million flat cubes added, 8 samples of 4 bytes among them
+/// (`/usr/bin/time -v volcad export mesh assets/examples/hello_cube.rhai
+/// --voxel 0.01`). Counted as 100 + 32, a fifth more, to err on the safe
+/// side (growth slack depends on where the arrays stand when they grow).
+const FLAT_CUBE_BYTES: f64 = 100.0;
 
 /// How the part is split.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -250,10 +261,16 @@ fn plan(model: &Model, p: &MeshParams) -> Result<Plan, ExportError> {
         + FLAT_TRIANGLES_PER_EDGE * (pr.flat_mm2 / face).sqrt() * more) as u64;
     // Meshes: 12 B per triangle, ~½ vertex per triangle at 12 B + map entry.
     let mesh_bytes = triangles * 12 + triangles / 2 * 40;
+    // Flat cubes are kept to the end: the box's faces, planar interfaces
+    // (guessed like the triangles) and, to err on the safe side, every
+    // other face of the surface, which may be planar too. Each keeps 8
+    // samples of `stride` interface values (or of the distance).
+    let flat_cubes = (pr.flat_mm2 + pr.surface_mm2) * more / face;
+    let flat_bytes = (flat_cubes * (FLAT_CUBE_BYTES + 32.0 * stride.max(1) as f64)) as u64;
     // Planes: one slab being contoured, the next being labelled, and the
     // contourer's previous plane.
     let planes = ((2 * slab_layers + 1) * layer * (2 + 4 + 4 * stride)) as u64;
-    let memory_bytes = (slab_layers * per_layer) as u64 + planes + mesh_bytes;
+    let memory_bytes = (slab_layers * per_layer) as u64 + planes + mesh_bytes + flat_bytes;
     check_memory(
         memory_bytes,
         &format!("meshing {nx} × {ny} × {nz} voxels (about {triangles} triangles)"),
