@@ -102,6 +102,53 @@ pub fn check_memory(needed: u64, what: &str) -> Result<(), ExportError> {
     Ok(())
 }
 
+/// Stops an export whose memory outgrows what was available when it
+/// started, with an error, before the kernel's out-of-memory killer stops
+/// the whole process (which leaves the staging folder behind and, in the
+/// studio, loses the session). The estimates behind [`check_memory`] can
+/// miss: the size probe does not see parts or interfaces much thinner than
+/// its cells. Reads the heap that [`volcad_core::heap::CountingAllocator`]
+/// counts; without it (a library user's program) there is no guard.
+pub struct MemoryGuard {
+    base: usize,
+    limit: u64,
+}
+
+impl MemoryGuard {
+    /// A guard allowing the heap to grow by four fifths of the memory
+    /// available now, or `None` when either is unknown.
+    pub fn for_export() -> Option<MemoryGuard> {
+        MemoryGuard::with_limit(available_memory()? / 5 * 4)
+    }
+
+    /// A guard allowing the heap to grow by `limit` bytes from now, or
+    /// `None` without a counting allocator.
+    pub fn with_limit(limit: u64) -> Option<MemoryGuard> {
+        Some(MemoryGuard {
+            base: volcad_core::heap::live_bytes()?,
+            limit,
+        })
+    }
+
+    /// An error naming `--voxel` once the heap has grown past the limit;
+    /// `what` says how far the export got (asked only then).
+    pub fn check(&self, what: impl FnOnce() -> String) -> Result<(), ExportError> {
+        let grown = volcad_core::heap::live_bytes().map_or(0, |l| l.saturating_sub(self.base));
+        if grown as u64 > self.limit {
+            return Err(ExportError::param(
+                "--voxel",
+                format!(
+                    "stopped {}: the export holds {} of memory, more than the {} that was available when it started (the estimate was too low for this design); use a larger voxel size",
+                    what(),
+                    human_bytes(grown as u64),
+                    human_bytes(self.limit)
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// Refuse when about `needed` bytes of output will not fit on the disk that
 /// holds `dir`. The error names `--out`.
 pub fn check_disk(needed: u64, dir: &Path) -> Result<(), ExportError> {

@@ -11,13 +11,18 @@ use std::time::Duration;
 use common::model;
 use glam::DVec3;
 use volcad_compilers::mesh::{MeshParams, estimate_mesh, segment_meshes};
+use volcad_compilers::resources::MemoryGuard;
 use volcad_core::heap::{CountingAllocator, live_bytes};
 
 #[global_allocator]
 static HEAP: CountingAllocator = CountingAllocator;
 
+/// The tests read the one process-wide heap count: one at a time.
+static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 #[test]
 fn the_estimate_covers_the_flat_faces_kept_to_the_end() {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     // A box is all flat faces. Their voxels are kept (to be merged into
     // few triangles at the end), so what the export holds grows with their
     // area in voxels, not with a slab: at 0.001 mm the graded bar's faces
@@ -54,4 +59,25 @@ fn the_estimate_covers_the_flat_faces_kept_to_the_end() {
         peak <= estimate,
         "peak {peak} bytes above the estimate of {estimate}"
     );
+}
+
+#[test]
+fn the_guard_stops_an_export_that_outgrows_its_limit() {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    // Estimates can miss (the size probe does not see parts thinner than
+    // its cells); the mesh export checks the heap after every slab.
+    let g = MemoryGuard::with_limit(8 << 20).expect("the counting allocator is installed");
+    assert!(g.check(|| "at the start".into()).is_ok());
+    let big = std::hint::black_box(vec![1u8; 16 << 20]);
+    let e = g
+        .check(|| "meshing after layer 4 of 10".into())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("--voxel: stopped meshing after layer 4 of 10"),
+        "{e}"
+    );
+    assert!(e.contains("use a larger voxel size"), "{e}");
+    drop(big);
+    assert!(g.check(|| "later".into()).is_ok());
 }

@@ -57,7 +57,7 @@ use crate::design::{grid_for, palette};
 use crate::job::{ExportError, JobContext, Summary};
 use crate::png_io::folder_name;
 use crate::probe::probe;
-use crate::resources::{check_disk, check_memory, human_bytes, run_with_threads};
+use crate::resources::{MemoryGuard, check_disk, check_memory, human_bytes, run_with_threads};
 use contour::{Contourer, Plane};
 use segment::{Classifier, Tally};
 
@@ -371,6 +371,7 @@ fn build(
                 .collect::<Vec<_>>(),
         )
     };
+    let guard = MemoryGuard::for_export();
     let mut z0 = 0;
     let mut z1 = pl.slab_layers.min(nz);
     let mut ready = labelled(&mut slab, z0, z1, Vec::new())?;
@@ -398,6 +399,9 @@ fn build(
             },
         );
         progress(z1, nz);
+        if let Some(g) = &guard {
+            g.check(|| format!("meshing after layer {z1} of {nz}"))?;
+        }
         ready = sampled?.unwrap_or_default();
         spare = retired;
         z0 = z1;
