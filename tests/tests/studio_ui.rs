@@ -37,12 +37,12 @@ fn harness(opts: StudioOptions) -> Harness<'static, StudioApp> {
         .build_eframe(move |cc| StudioApp::new(cc, opts))
 }
 
-fn studio(text: &str, name: &str) -> (Harness<'static, StudioApp>, tempfile::TempDir) {
+/// The scratch folder comes first: bound as `let (dir, h)`, the studio is
+/// dropped first (waiting for its autosave), then the folder is removed.
+fn studio(text: &str, name: &str) -> (tempfile::TempDir, Harness<'static, StudioApp>) {
     let dir = temp_dir(name);
-    (
-        harness(StudioOptions::for_tests(dir.path().join("data"), text)),
-        dir,
-    )
+    let h = harness(StudioOptions::for_tests(dir.path().join("data"), text));
+    (dir, h)
 }
 
 /// Step frames until `cond` holds (60 s at most).
@@ -91,7 +91,7 @@ fn type_at_end(h: &mut Harness<'static, StudioApp>, text: &str) {
 
 #[test]
 fn typing_changes_the_design() {
-    let (mut h, _dir) = studio(BAR, "typing");
+    let (_dir, mut h) = studio(BAR, "typing");
     wait_idle(&mut h);
     assert_eq!(bbox_x(h.state()), Some(15.0));
     h.get_by_label_contains("bbox 15.00 × 10.00 × 5.00 mm");
@@ -121,7 +121,7 @@ fn typing_changes_the_design() {
 
 #[test]
 fn syntax_error_is_listed_at_its_line_and_the_preview_is_kept() {
-    let (mut h, _dir) = studio(BAR, "error");
+    let (_dir, mut h) = studio(BAR, "error");
     wait_idle(&mut h);
     let before = h.state().model().cloned().expect("a model");
     type_at_end(&mut h, "; let x = ;");
@@ -164,7 +164,7 @@ fn parameter_slider_reruns_with_the_value() {
     let script = r#"let m = default_materials();
 let w = param("width", 15.0, 5.0, 30.0);
 RectPrism(Vec3(0, 0, 0), Vec3(w, 10, 5), m.id("gray"))"#;
-    let (mut h, _dir) = studio(script, "param");
+    let (_dir, mut h) = studio(script, "param");
     wait_idle(&mut h);
     assert_eq!(bbox_x(h.state()), Some(15.0));
     h.get_by_role_and_label(Role::Slider, "width")
@@ -179,7 +179,7 @@ RectPrism(Vec3(0, 0, 0), Vec3(w, 10, 5), m.id("gray"))"#;
 
 #[test]
 fn find_tab_and_undo_in_the_editor() {
-    let (mut h, _dir) = studio(BAR, "editor");
+    let (_dir, mut h) = studio(BAR, "editor");
     wait_idle(&mut h);
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::F);
     h.step();
@@ -208,7 +208,7 @@ fn find_tab_and_undo_in_the_editor() {
 
 #[test]
 fn autosave_writes_the_recovery_file_and_restart_offers_it() {
-    let (mut h, scratch) = studio(BAR, "recovery");
+    let (scratch, mut h) = studio(BAR, "recovery");
     let dir = scratch.path();
     wait_idle(&mut h);
     type_at_end(&mut h, " // unsaved edit");
@@ -231,7 +231,7 @@ fn autosave_writes_the_recovery_file_and_restart_offers_it() {
 
 #[test]
 fn closing_with_unsaved_changes_asks_first() {
-    let (mut h, _dir) = studio(BAR, "close");
+    let (_dir, mut h) = studio(BAR, "close");
     wait_idle(&mut h);
     type_at_end(&mut h, " ");
     if let Some(v) = h.input_mut().viewports.get_mut(&egui::ViewportId::ROOT) {
@@ -325,7 +325,7 @@ fn set_png_voxel(h: &mut Harness<'static, StudioApp>, mm: f64) {
 
 #[test]
 fn png_export_cancels_cleanly_and_completes_with_a_manifest() {
-    let (mut h, scratch) = studio(BAR, "export");
+    let (scratch, mut h) = studio(BAR, "export");
     let dir = scratch.path();
     wait_idle(&mut h);
 

@@ -214,11 +214,18 @@ pub struct Recovered {
 }
 
 /// The autosave of unsaved text.
+///
+/// One write at a time: the next write, [`Recovery::clear`] and dropping
+/// wait for the one in flight (a few milliseconds; writes start at most
+/// once per interval). Otherwise an older text could land after a newer
+/// one, or a write still in flight when the file was saved could bring
+/// back a recovery file for text that is already saved.
 pub struct Recovery {
     dir: Option<PathBuf>,
     interval: Duration,
     last_write: Option<Instant>,
     last_text: Option<String>,
+    writing: Option<std::thread::JoinHandle<()>>,
 }
 
 impl Recovery {
@@ -229,6 +236,14 @@ impl Recovery {
             interval,
             last_write: None,
             last_text: None,
+            writing: None,
+        }
+    }
+
+    /// Wait for the write in flight, if any.
+    fn wait(&mut self) {
+        if let Some(w) = self.writing.take() {
+            let _ = w.join();
         }
     }
 
@@ -285,7 +300,8 @@ impl Recovery {
         };
         let text = text.to_owned();
         let dir = self.dir.clone();
-        let _ = std::thread::Builder::new()
+        self.wait();
+        self.writing = std::thread::Builder::new()
             .name("volcad-autosave".into())
             .spawn(move || {
                 let result = dir
@@ -301,16 +317,24 @@ impl Recovery {
                 if let Err(e) = result {
                     eprintln!("volcad-studio: autosave to {} failed: {e}", tp.display());
                 }
-            });
+            })
+            .ok();
         true
     }
 
     /// Remove the recovery files (after save, or when the user discards).
     pub fn clear(&mut self) {
+        self.wait();
         self.last_text = None;
         for p in [self.text_path(), self.meta_path()].into_iter().flatten() {
             let _ = std::fs::remove_file(p);
         }
+    }
+}
+
+impl Drop for Recovery {
+    fn drop(&mut self) {
+        self.wait();
     }
 }
 
