@@ -400,6 +400,22 @@ mod tests {
     }
 
     #[test]
+    fn clear_waits_for_the_write_in_flight() {
+        // Saving right after an autosave started: the write must not bring
+        // the recovery file back once it is cleared (without the wait this
+        // fails in the first rounds).
+        let scratch = tempfile::tempdir().unwrap();
+        let ctx = egui::Context::default();
+        for i in 0..20 {
+            let mut r = Recovery::new(Some(scratch.path().join(format!("r{i}"))), Duration::ZERO);
+            assert!(r.tick(&ctx, "unsaved", true, None));
+            r.clear();
+            std::thread::sleep(Duration::from_millis(5));
+            assert!(r.load().is_none(), "round {i}");
+        }
+    }
+
+    #[test]
     fn save_as_makes_a_clean_document() {
         let scratch = tempfile::tempdir().unwrap();
         let dir = scratch.path();
