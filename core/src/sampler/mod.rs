@@ -32,58 +32,10 @@ use crate::interval::Interval;
 use crate::model::{MAX_MATERIALS, Model};
 
 mod grid;
+mod slab;
 pub use grid::{Grid, GridError};
-
-/// A few z layers of samples, owned by the caller and reused between calls.
-#[derive(Clone, Debug, Default)]
-pub struct Slab {
-    /// First layer held.
-    pub z0: usize,
-    /// Layers held.
-    pub layers: usize,
-    /// Signed distance per voxel, index `(z − z0)·nx·ny + y·nx + x`.
-    pub dist: Vec<f32>,
-    /// Fractions per voxel, `k` consecutive values in model material order
-    /// (empty when fractions were not asked for). Zero outside. `NaN` in a
-    /// solid tile whose fractions vary, when the sampler was made
-    /// [`Sampler::with_lazy_fractions`]: the consumer evaluates them.
-    pub fracs: Vec<f32>,
-    /// Fractions per voxel (`Model::materials().len()`).
-    pub k: usize,
-    /// With [`Sampler::with_solid_rects`]: rectangles of solid voxels that
-    /// share one fraction vector, by layer then row block. Their voxels'
-    /// entries in `fracs` are not written (they hold whatever the buffer
-    /// held); their fractions are `rect_fracs[at..at + k]`.
-    pub rects: Vec<SolidRect>,
-    /// Fraction vectors of `rects`, `k` values each.
-    pub rect_fracs: Vec<f32>,
-}
-
-/// Voxels `[x0, x0 + w) × [y0, y0 + h)` of layer `z`, all inside the part
-/// and all with the fractions at `Slab::rect_fracs[at..at + k]`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct SolidRect {
-    /// Global layer.
-    pub z: usize,
-    /// First column.
-    pub x0: usize,
-    /// First row.
-    pub y0: usize,
-    /// Columns.
-    pub w: usize,
-    /// Rows.
-    pub h: usize,
-    /// Offset of its fractions in `Slab::rect_fracs`.
-    pub at: usize,
-}
-
-impl Slab {
-    /// Fractions of voxel `v` (index within the slab).
-    #[inline]
-    pub fn fracs_of(&self, v: usize) -> &[f32] {
-        &self.fracs[v * self.k..(v + 1) * self.k]
-    }
-}
+use slab::{Rect, Rows, merge_rects, row_blocks, x_tiles};
+pub use slab::{Slab, SolidRect, fill_pattern};
 
 /// Counts of how voxels were obtained (for reports and benchmarks).
 #[derive(Debug, Default)]
@@ -98,109 +50,6 @@ pub struct SampleStats {
     /// Evaluated inside voxels whose fractions were not evaluated: shared
     /// over a tile where they are fixed or proved constant.
     pub shared: AtomicU64,
-}
-
-/// Repeat `one` (a voxel's fractions, or a mesh label's interface values)
-/// over `run`. The usual few materials get a fixed-size copy the compiler
-/// turns into plain stores; a copy of run-time length was a library call
-/// per voxel (a tenth of a graded mesh export). An empty `one` writes
-/// nothing.
-pub fn fill_pattern(run: &mut [f32], one: &[f32]) {
-    fn fixed<const K: usize>(run: &mut [f32], one: &[f32]) {
-        let mut p = [0.0; K];
-        p.copy_from_slice(one);
-        for v in run.chunks_exact_mut(K) {
-            v.copy_from_slice(&p);
-        }
-    }
-    match one.len() {
-        0 => {}
-        1 => run.fill(one[0]),
-        2 => fixed::<2>(run, one),
-        3 => fixed::<3>(run, one),
-        4 => fixed::<4>(run, one),
-        k => {
-            for v in run.chunks_exact_mut(k) {
-                v.copy_from_slice(one);
-            }
-        }
-    }
-}
-
-/// Voxels `[x0, x0 + w) × [y0, y0 + h)` of layer `z`.
-#[derive(Clone, Copy)]
-struct Rect {
-    z: usize,
-    x0: usize,
-    y0: usize,
-    w: usize,
-    h: usize,
-}
-
-/// Column ranges `(x0, w)` of the tiles across a row of `nx` voxels.
-fn x_tiles(nx: usize) -> impl Iterator<Item = (usize, usize)> {
-    (0..nx).step_by(TILE).map(move |x0| (x0, TILE.min(nx - x0)))
-}
-
-/// Each layer's rows of `dist` and `fracs` (`nx × ny` a layer, `k`
-/// fractions a voxel) cut into blocks of TILE rows, layer by layer: the
-/// sampler's tasks, with the layer's index in the slab.
-fn row_blocks<'b>(
-    dist: &'b mut [f32],
-    fracs: &'b mut [f32],
-    nx: usize,
-    ny: usize,
-    k: usize,
-) -> Vec<(usize, Rows<'b>)> {
-    let (layer, block) = (nx * ny, nx * TILE);
-    let mut out = Vec::new();
-    // No fractions (k = 0): every task gets an empty slice.
-    let next = |it: &mut std::slice::ChunksMut<'b, f32>| it.next().filter(|_| k > 0);
-    let mut frac_layers = fracs.chunks_mut((layer * k).max(1));
-    for (l, dl) in dist.chunks_mut(layer).enumerate() {
-        let fl = next(&mut frac_layers).unwrap_or_default();
-        let mut frac_blocks = fl.chunks_mut((block * k).max(1));
-        for (bi, d) in dl.chunks_mut(block).enumerate() {
-            let f = next(&mut frac_blocks).unwrap_or_default();
-            let rows = Rows {
-                row0: bi * TILE,
-                dist: d,
-                fracs: f,
-                k,
-                rects: Vec::new(),
-                rect_fracs: Vec::new(),
-            };
-            out.push((l, rows));
-        }
-    }
-    out
-}
-
-/// The tasks' rectangles into `rects` and `fracs`, in task order (layer, then row
-/// block: the same on any thread count), with offsets into one array.
-fn merge_rects(done: Vec<Rows>, rects: &mut Vec<SolidRect>, fracs: &mut Vec<f32>) {
-    rects.clear();
-    fracs.clear();
-    for out in done {
-        let base = fracs.len();
-        rects.extend(out.rects.into_iter().map(|r| SolidRect {
-            at: r.at + base,
-            ..r
-        }));
-        fracs.extend_from_slice(&out.rect_fracs);
-    }
-}
-
-/// A task's buffers: rows from `row0` of one layer, `k` fractions a voxel.
-struct Rows<'b> {
-    row0: usize,
-    dist: &'b mut [f32],
-    fracs: &'b mut [f32],
-    k: usize,
-    /// Solid rectangles found (with [`Sampler::with_solid_rects`]), with
-    /// their fractions `k` apiece (`at` counts from this task's first).
-    rects: Vec<SolidRect>,
-    rect_fracs: Vec<f32>,
 }
 
 /// A consumer's test on fraction bounds: true when every fraction vector

@@ -12,6 +12,7 @@
 mod bulk;
 mod file_cache;
 mod files_api;
+mod leaves_api;
 mod nodes_api;
 mod values;
 
@@ -405,7 +406,7 @@ fn build_engine(ctx: &RunContext, opts: &ScriptOptions) -> Engine {
     register_vec3(&mut engine);
     register_materials(&mut engine, ctx);
     register_lattice_types(&mut engine);
-    nodes_api::register_leaves(&mut engine);
+    leaves_api::register_leaves(&mut engine);
     nodes_api::register_composites(&mut engine);
     nodes_api::register_methods(&mut engine);
     files_api::register(&mut engine, ctx);
