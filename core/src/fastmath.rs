@@ -1,5 +1,5 @@
-//! Inlined replacements for two C-library calls in hot loops: `sin_cos`
-//! and `floor`. On the x86-64 baseline (no SSE4.1 rounding instruction)
+//! Inlined replacements for two C-library calls in hot loops, `sin_cos`
+//! and `floor`, and a cheaper `f64::min` for running minima. On the x86-64 baseline (no SSE4.1 rounding instruction)
 //! `f64::floor` is a call, and `sin_cos` always is; both showed at the top
 //! of evaluation profiles (`cargo bench -p volcad-core --bench eval`):
 //! `sin_cos` was 43 % of the gyroid, `floor` 12 % of the tiled lattices.
@@ -16,6 +16,11 @@
 //! three pairs of a gyroid point overlap in the pipeline. Accuracy: within
 //! 1 ulp of the C library's values (0.5 ulp of 1 measured) for
 //! `|x| ≤ REDUCE_MAX`; larger or non-finite arguments go to the C library.
+//!
+//! # `min_plain`
+//! `f64::min` returns the other operand when either is NaN, which takes
+//! four more instructions than one `minsd`. A running minimum that starts
+//! at +∞ never holds a NaN, so it may use the single compare.
 //!
 //! # `floor`
 //! Truncation through an integer conversion (one SSE2 instruction each
@@ -114,6 +119,16 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     let b = if swap { s } else { c };
     let neg = |v: f64, bit: i64| f64::from_bits(v.to_bits() ^ (((bit & 1) as u64) << 63));
     (neg(a, q >> 1), neg(b, (q + 1) >> 1))
+}
+
+/// `min(a, b)` for `a` never NaN: `b` when it is smaller, else `a` (a NaN
+/// `b` is ignored, as `f64::min` does). One `minsd`: `f64::min` also
+/// handles a NaN `a`, which costs four more instructions, on the path of
+/// every strut a lattice point tests. A running minimum that starts at +∞
+/// never holds a NaN.
+#[inline(always)]
+pub fn min_plain(a: f64, b: f64) -> f64 {
+    if b < a { b } else { a }
 }
 
 #[cfg(test)]
@@ -227,6 +242,25 @@ mod tests {
                 s.to_bits() == rs.to_bits() && c.to_bits() == rc.to_bits(),
                 "{x}"
             );
+        }
+    }
+
+    #[test]
+    fn min_plain_is_f64_min_for_a_number_first() {
+        let values = [
+            -3.5,
+            -0.0,
+            0.0,
+            1e-300,
+            2.0,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+        ];
+        for a in values.into_iter().filter(|a| !a.is_nan()) {
+            for b in values {
+                assert_eq!(min_plain(a, b), a.min(b), "min_plain({a}, {b})");
+            }
         }
     }
 }

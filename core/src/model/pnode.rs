@@ -293,12 +293,12 @@ impl PNode {
                 match grid.as_ref().and_then(|g| g.candidates(p)) {
                     Some(list) => {
                         for &k in list {
-                            d2 = d2.min(struts[k as usize].axis_dist2(p));
+                            d2 = crate::fastmath::min_plain(d2, struts[k as usize].axis_dist2(p));
                         }
                     }
                     None => {
                         for s in struts {
-                            d2 = d2.min(s.axis_dist2(p));
+                            d2 = crate::fastmath::min_plain(d2, s.axis_dist2(p));
                         }
                     }
                 }
