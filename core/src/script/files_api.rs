@@ -69,9 +69,22 @@ pub(super) fn register(engine: &mut Engine, ctx: &RunContext) {
                 .iter()
                 .enumerate()
                 .map(|(i, s)| {
-                    Expr::compile(s, &vars)
-                        .map(Arc::new)
-                        .or_else(|e| fail(p, format!("SimulationField: expression {}: {e}", i + 1)))
+                    Expr::compile(s, &vars).map(Arc::new).or_else(|e| {
+                        let mut msg = format!("SimulationField: expression {}: {e}", i + 1);
+                        if e.message.starts_with("unknown variable 'len'") {
+                            let missing: Vec<&str> = ["dx", "dy", "dz"]
+                                .into_iter()
+                                .filter(|c| !names.iter().any(|n| n == c))
+                                .collect();
+                            msg.push_str(&format!(
+                                "; `len` is the length of (dx, dy, dz), and {} has no column{} {}",
+                                csv_path.display(),
+                                if missing.len() > 1 { "s" } else { "" },
+                                missing.join(", ")
+                            ));
+                        }
+                        fail(p, msg)
+                    })
                 })
                 .collect::<RResult<Vec<_>>>()?;
             {

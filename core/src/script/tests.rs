@@ -202,6 +202,52 @@ fn files_need_a_folder_and_stay_inside_it() {
 }
 
 #[test]
+fn len_without_displacement_columns_says_which_are_missing() {
+    // Abaqus-style columns (u1, u2, u3) instead of dx, dy, dz: `len` does
+    // not exist, and the error says why.
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    std::fs::write(
+        dir.join("t.inp"),
+        "*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 0\n4, 0, 0, 1\n*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("t.csv"),
+        "node_id,x,y,z,u1,u2,dz\n1,0,0,0,0,0,0\n2,1,0,0,0,0,0\n3,0,1,0,0,0,0\n4,0,0,1,0,0,0\n",
+    )
+    .unwrap();
+    let opts = ScriptOptions {
+        base_dir: Some(dir.to_path_buf()),
+        ..ScriptOptions::default()
+    };
+    let e = run_script(
+        "SimulationField(\"t.inp\", \"t.csv\", [\"len\"], [1])",
+        "t",
+        &opts,
+    )
+    .unwrap_err();
+    assert!(
+        e.message.contains("unknown variable 'len'")
+            && e.message.contains("`len` is the length of (dx, dy, dz)")
+            && e.message.contains("t.csv has no columns dx, dy"),
+        "{e}"
+    );
+    // With the columns there, `len` is known.
+    std::fs::write(
+        dir.join("t.csv"),
+        "node_id,x,y,z,dx,dy,dz\n1,0,0,0,0,0,0\n2,1,0,0,0,0,0\n3,0,1,0,0,0,0\n4,0,0,1,0,0,0\n",
+    )
+    .unwrap();
+    run_script(
+        "SimulationField(\"t.inp\", \"t.csv\", [\"len\"], [1])",
+        "t",
+        &opts,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+}
+
+#[test]
 fn material_id_not_in_table() {
     let e = run("let m = j750_materials();\nSphere(Vec3(0,0,0), 1, 40)").unwrap_err();
     assert_eq!(e.line, Some(2), "{e}");

@@ -91,7 +91,7 @@ pub enum SimFieldError {
     },
     /// A tetrahedron with (almost) zero volume: barycentric weights would be
     /// meaningless.
-    #[error("{}:{line}: element {element} is degenerate: volume {volume:e} (typical {typical:e})", .path.display())]
+    #[error("{}:{line}: element {element} is degenerate: volume {} (typical {})", .path.display(), volume_text(.volume), volume_text(.typical))]
     DegenerateTet {
         /// The `.inp` file.
         path: PathBuf,
@@ -263,7 +263,11 @@ impl SimField {
                 volume,
                 typical,
             } => SimFieldError::Parts {
-                msg: format!("tet {tet} is degenerate: volume {volume:e} (typical {typical:e})"),
+                msg: format!(
+                    "tet {tet} is degenerate: volume {} (typical {})",
+                    volume_text(&volume),
+                    volume_text(&typical)
+                ),
             },
             BuildError::Other(msg) => SimFieldError::Parts { msg },
         })
@@ -575,5 +579,20 @@ fn check_coordinates(nodes: &[DVec3], coords: &[Option<Vec<f64>>; 3], warnings: 
         warnings.push(format!(
             "CSV coordinates differ from the mesh nodes at {count} nodes (up to {worst:.4}); rows may belong to another mesh or node order"
         ));
+    }
+}
+
+/// A tetrahedron's volume for an error message: four significant digits in
+/// plain notation where that reads well (`13.14 mm³`), scientific for the
+/// tiny volumes of near-degenerate elements (`2.500e-12 mm³`), `0 mm³`.
+fn volume_text(v: &f64) -> String {
+    let a = v.abs();
+    if a == 0.0 {
+        "0 mm³".to_string()
+    } else if (1e-3..1e6).contains(&a) {
+        let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
+        format!("{v:.decimals$} mm³")
+    } else {
+        format!("{v:.3e} mm³")
     }
 }

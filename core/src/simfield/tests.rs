@@ -205,7 +205,11 @@ fn from_parts_rejects_bad_input() {
     assert!(e.to_string().contains("1 values for 5 nodes"), "{e}");
     let e =
         SimField::from_parts(nodes.clone(), vec![[0, 1, 2, 3], [0, 1, 2, 0]], vec![]).unwrap_err();
-    assert!(e.to_string().contains("tet 1 is degenerate"), "{e}");
+    assert!(
+        e.to_string()
+            .contains("tet 1 is degenerate: volume 0 mm³ (typical "),
+        "{e}"
+    );
     let e = SimField::from_parts(nodes, vec![], vec![]).unwrap_err();
     assert!(matches!(e, SimFieldError::Parts { .. }));
 }
@@ -404,4 +408,15 @@ fn perf_seat_sample() {
             out[3]
         });
     }
+}
+
+#[test]
+fn degenerate_volumes_read_as_millimetres_cubed() {
+    use super::volume_text;
+    assert_eq!(volume_text(&0.0), "0 mm³");
+    assert_eq!(volume_text(&13.135351889496327), "13.14 mm³");
+    assert_eq!(volume_text(&0.0025), "0.002500 mm³");
+    assert_eq!(volume_text(&123456.7), "123457 mm³");
+    assert_eq!(volume_text(&2.5e-12), "2.500e-12 mm³");
+    assert_eq!(volume_text(&-0.5), "-0.5000 mm³");
 }
