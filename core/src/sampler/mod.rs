@@ -34,7 +34,7 @@ use crate::model::{MAX_MATERIALS, Model};
 mod grid;
 mod slab;
 pub use grid::{Grid, GridError};
-use slab::{Rect, Rows, merge_rects, row_blocks, x_tiles};
+use slab::{Counts, Rect, Rows, merge_rects, row_blocks, x_tiles};
 pub use slab::{Slab, SolidRect, fill_pattern};
 
 /// Counts of how voxels were obtained (for reports and benchmarks).
@@ -50,6 +50,24 @@ pub struct SampleStats {
     /// Evaluated inside voxels whose fractions were not evaluated: shared
     /// over a tile where they are fixed or proved constant.
     pub shared: AtomicU64,
+}
+
+impl SampleStats {
+    /// Adds the tasks' counts of one slab.
+    fn add<'r, 'b: 'r>(&self, tasks: impl IntoIterator<Item = &'r Rows<'b>>) {
+        let mut sum = Counts::default();
+        for c in tasks.into_iter().map(|t| t.counts) {
+            sum.evaluated += c.evaluated;
+            sum.skipped += c.skipped;
+            sum.solid_blocks += c.solid_blocks;
+            sum.shared += c.shared;
+        }
+        self.evaluated.fetch_add(sum.evaluated, Ordering::Relaxed);
+        self.skipped.fetch_add(sum.skipped, Ordering::Relaxed);
+        self.solid_blocks
+            .fetch_add(sum.solid_blocks, Ordering::Relaxed);
+        self.shared.fetch_add(sum.shared, Ordering::Relaxed);
+    }
 }
 
 /// A consumer's test on fraction bounds: true when every fraction vector
@@ -143,6 +161,8 @@ const TILE: usize = 32;
 /// consumer: beyond it most of its voxels would be evaluated anyway.
 const LAZY_WIDTH: f64 = 0.5;
 const LEAF: usize = 4;
+/// Open tiles counted by `try_constant` before its answer is kept.
+const LEARN: u64 = 4096;
 
 impl<'a> Sampler<'a> {
     /// A sampler of `model` on `grid`; `with_fracs` also fills fractions.
@@ -261,6 +281,7 @@ impl<'a> Sampler<'a> {
                 Ok(out)
             })
             .collect::<Result<_, _>>()?;
+        self.stats.add(&done);
         merge_rects(done, &mut slab.rects, &mut slab.rect_fracs);
         Ok(())
     }
@@ -297,9 +318,11 @@ impl<'a> Sampler<'a> {
             .collect::<Result<_, _>>()?;
         // Back to layer-major order, the order `sample_layers` gives.
         let mut done: Vec<_> = done.into_iter().map(|d| d.into_iter()).collect();
-        let by_layer = (0..slab.layers)
-            .flat_map(|_| done.iter_mut().filter_map(|t| t.next()).collect::<Vec<_>>());
-        merge_rects(by_layer.collect(), &mut slab.rects, &mut slab.rect_fracs);
+        let by_layer: Vec<Rows> = (0..slab.layers)
+            .flat_map(|_| done.iter_mut().filter_map(|t| t.next()).collect::<Vec<_>>())
+            .collect();
+        self.stats.add(&by_layer);
+        merge_rects(by_layer, &mut slab.rects, &mut slab.rect_fracs);
         Ok(())
     }
 
@@ -331,8 +354,7 @@ impl<'a> Sampler<'a> {
             _ => return false,
         };
         if one.is_some() {
-            let n = (w * h * outs.len()) as u64;
-            self.stats.solid_blocks.fetch_add(n, Ordering::Relaxed);
+            outs[0].counts.solid_blocks += (w * h * outs.len()) as u64;
         }
         for (z, out) in (z0..).zip(outs.iter_mut()) {
             let how = match &one {
@@ -462,11 +484,9 @@ impl<'a> Sampler<'a> {
                 }
             }
         }
-        self.stats
-            .evaluated
-            .fetch_add((w * h) as u64, Ordering::Relaxed);
-        if spared > 0 && !lazy {
-            self.stats.shared.fetch_add(spared, Ordering::Relaxed);
+        out.counts.evaluated += (w * h) as u64;
+        if !lazy {
+            out.counts.shared += spared;
         }
     }
     /// What the bounds say about the voxel centres in `b` (`k` fractions).
@@ -533,9 +553,15 @@ impl<'a> Sampler<'a> {
         if asked >= 64 && yes * 8 < asked {
             return false;
         }
-        self.constant_asked.fetch_add(1, Ordering::Relaxed);
+        // Counted for the first `LEARN` asks only: the answer is settled by
+        // then, and both threads writing these counters for every open
+        // tile kept their cache line moving between the cores.
+        let learning = asked < LEARN;
+        if learning {
+            self.constant_asked.fetch_add(1, Ordering::Relaxed);
+        }
         let constant = self.model.constant_fractions(b);
-        if constant {
+        if constant && learning {
             self.constant_yes.fetch_add(1, Ordering::Relaxed);
         }
         constant
@@ -597,9 +623,7 @@ impl<'a> Sampler<'a> {
                 }
             }
         }
-        self.stats
-            .skipped
-            .fetch_add((w * h) as u64, Ordering::Relaxed);
+        out.counts.skipped += (w * h) as u64;
     }
 
     /// Refine a tile as four quarters.

@@ -124,6 +124,7 @@ pub(super) fn row_blocks<'b>(
                 k,
                 rects: Vec::new(),
                 rect_fracs: Vec::new(),
+                counts: Counts::default(),
             };
             out.push((l, rows));
         }
@@ -156,4 +157,20 @@ pub(super) struct Rows<'b> {
     /// their fractions `k` apiece (`at` counts from this task's first).
     pub rects: Vec<SolidRect>,
     pub rect_fracs: Vec<f32>,
+    /// What this task did, added to the sampler's statistics once the
+    /// slab is done.
+    pub counts: Counts,
+}
+
+/// A task's share of [`super::SampleStats`], counted without atomics: the
+/// counters are shared by every thread, and adding to them per tile (a
+/// few dozen voxels) kept their cache line moving between the cores,
+/// next to fields every voxel reads. Slice stacks of the gyroid and the
+/// FCC lattice ran 2 to 3 % slower for it.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Counts {
+    pub evaluated: u64,
+    pub skipped: u64,
+    pub solid_blocks: u64,
+    pub shared: u64,
 }
