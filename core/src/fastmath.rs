@@ -1,8 +1,9 @@
 //! Inlined replacements for two C-library calls in hot loops, `sin_cos`
-//! and `floor`, and a cheaper `f64::min` for running minima. On the x86-64 baseline (no SSE4.1 rounding instruction)
-//! `f64::floor` is a call, and `sin_cos` always is; both showed at the top
-//! of evaluation profiles (`cargo bench -p volcad-core --bench eval`):
-//! `sin_cos` was 43 % of the gyroid, `floor` 12 % of the tiled lattices.
+//! and `floor`, and a cheaper `f64::min` for running minima. On the x86-64
+//! baseline (no SSE4.1 rounding instruction) `f64::floor` is a call, and
+//! `sin_cos` always is; both showed at the top of evaluation profiles
+//! (`cargo bench -p volcad-core --bench eval`): `sin_cos` was 43 % of the
+//! gyroid, `floor` 12 % of the tiled lattices.
 //! Both give the same bits on every machine and thread count (plain IEEE
 //! operations, no FMA contraction), which the C library does not promise
 //! across platforms.
