@@ -394,11 +394,17 @@ where
 mod tests {
     use super::*;
 
+    /// An export destination that does not exist yet, in a scratch folder
+    /// removed when the test ends (passed or failed).
+    fn destination() -> (tempfile::TempDir, PathBuf) {
+        let scratch = tempfile::tempdir().unwrap();
+        let dest = scratch.path().join("out");
+        (scratch, dest)
+    }
+
     #[test]
     fn success_renames_and_writes_manifest() {
-        let scratch = tempfile::tempdir().unwrap();
-        let dir = scratch.path();
-        let dest = dir.join("out");
+        let (_scratch, dest) = destination();
         let h = spawn(dest.clone(), "abc".into(), |ctx| {
             std::fs::write(ctx.staging().join("a.txt"), "x").unwrap();
             ctx.progress("writing", 1, 1, "files", 1.0);
@@ -423,9 +429,7 @@ mod tests {
 
     #[test]
     fn cancel_leaves_nothing() {
-        let scratch = tempfile::tempdir().unwrap();
-        let dir = scratch.path();
-        let dest = dir.join("out");
+        let (_scratch, dest) = destination();
         let h = spawn(dest.clone(), "abc".into(), |ctx| {
             std::fs::write(ctx.staging().join("a.txt"), "x").unwrap();
             loop {
@@ -444,9 +448,7 @@ mod tests {
 
     #[test]
     fn panic_is_an_error_and_leaves_nothing() {
-        let scratch = tempfile::tempdir().unwrap();
-        let dir = scratch.path();
-        let dest = dir.join("out");
+        let (_scratch, dest) = destination();
         let h = spawn(dest.clone(), "abc".into(), |_| panic!("boom"));
         let e = h.join().unwrap_err().to_string();
         assert!(e.contains("boom"), "{e}");
@@ -455,9 +457,7 @@ mod tests {
 
     #[test]
     fn refuses_to_replace_foreign_folders() {
-        let scratch = tempfile::tempdir().unwrap();
-        let dir = scratch.path();
-        let dest = dir.join("out");
+        let (_scratch, dest) = destination();
         std::fs::create_dir_all(&dest).unwrap();
         std::fs::write(dest.join("precious.txt"), "x").unwrap();
         let h = spawn(dest.clone(), "abc".into(), |_| Ok(Summary::default()));

@@ -212,21 +212,17 @@ fn len_without_displacement_columns_says_which_are_missing() {
         "*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 0\n4, 0, 0, 1\n*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n",
     )
     .unwrap();
-    std::fs::write(
-        dir.join("t.csv"),
-        "node_id,x,y,z,u1,u2,dz\n1,0,0,0,0,0,0\n2,1,0,0,0,0,0\n3,0,1,0,0,0,0\n4,0,0,1,0,0,0\n",
-    )
-    .unwrap();
-    let opts = ScriptOptions {
-        base_dir: Some(dir.to_path_buf()),
-        ..ScriptOptions::default()
+    let rows = "1,0,0,0,0,0,0\n2,1,0,0,0,0,0\n3,0,1,0,0,0,0\n4,0,0,1,0,0,0\n";
+    let opts = ScriptOptions::for_file(&dir.join("t.rhai"));
+    let field = |header: &str| {
+        std::fs::write(dir.join("t.csv"), format!("{header}\n{rows}")).unwrap();
+        run_script(
+            "SimulationField(\"t.inp\", \"t.csv\", [\"len\"], [1])",
+            "t",
+            &opts,
+        )
     };
-    let e = run_script(
-        "SimulationField(\"t.inp\", \"t.csv\", [\"len\"], [1])",
-        "t",
-        &opts,
-    )
-    .unwrap_err();
+    let e = field("node_id,x,y,z,u1,u2,dz").unwrap_err();
     assert!(
         e.message.contains("unknown variable 'len'")
             && e.message.contains("`len` is the length of (dx, dy, dz)")
@@ -234,17 +230,7 @@ fn len_without_displacement_columns_says_which_are_missing() {
         "{e}"
     );
     // With the columns there, `len` is known.
-    std::fs::write(
-        dir.join("t.csv"),
-        "node_id,x,y,z,dx,dy,dz\n1,0,0,0,0,0,0\n2,1,0,0,0,0,0\n3,0,1,0,0,0,0\n4,0,0,1,0,0,0\n",
-    )
-    .unwrap();
-    run_script(
-        "SimulationField(\"t.inp\", \"t.csv\", [\"len\"], [1])",
-        "t",
-        &opts,
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
+    field("node_id,x,y,z,dx,dy,dz").unwrap_or_else(|e| panic!("{e}"));
 }
 
 #[test]
