@@ -22,6 +22,7 @@
 
 pub(crate) mod bvh;
 mod candidates;
+mod certificate;
 mod coarse;
 mod distance;
 mod load;

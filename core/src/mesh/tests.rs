@@ -180,8 +180,11 @@ fn near_surface(rng: &mut Rng, v: &[DVec3], tris: &[[u32; 3]], reach: f64) -> DV
 
 #[test]
 fn candidate_grid_matches_the_bvh() {
-    // The per-cell lists must give the same nearest distance (bit for bit)
-    // and the same side as the full BVH search, near and on the surface.
+    // The per-cell lists must give the nearest distance of the full BVH
+    // search and the same side, near and on the surface. Bit for bit but
+    // for ties: a neighbour that the certificate bits skip may tie with the
+    // answer to within rounding, or be nearer by at most their tolerance
+    // (10⁻¹² of the mesh box; see `certificate`).
     let m = bunny();
     let g = m
         .candidates
@@ -190,7 +193,7 @@ fn candidate_grid_matches_the_bvh() {
     let mut rng = Rng::new(5);
     let region = m.bbox().expand(3.0);
     let (v, tris) = (m.vertices().to_vec(), m.triangles().to_vec());
-    let (mut used, mut near) = (0, 0);
+    let (mut used, mut near, mut differ) = (0, 0, 0);
     for i in 0..20000 {
         // Half uniform in the box, half within 1 mm of a random surface point.
         let p = if i % 2 == 0 {
@@ -204,7 +207,12 @@ fn candidate_grid_matches_the_bvh() {
         };
         used += 1;
         let (bvh_slot, bvh_d2) = m.nearest_any(p).expect("finite point");
-        assert_eq!(d2, bvh_d2, "point {i} {p}: slots {slot} vs {bvh_slot}");
+        let gap = (d2.sqrt() - bvh_d2.sqrt()).abs();
+        assert!(
+            gap <= 1e-10,
+            "point {i} {p}: {d2} vs {bvh_d2}, slots {slot} vs {bvh_slot}"
+        );
+        differ += usize::from(d2 != bvh_d2);
         if d2 > 0.0 {
             let s = if side != 0 {
                 f64::from(side)
@@ -216,6 +224,8 @@ fn candidate_grid_matches_the_bvh() {
     }
     // The lists serve (at least) the points near the surface.
     assert!(used >= near, "{used} of {near}");
+    // Rounding ties only: a handful of points, not a pattern.
+    assert!(differ * 1000 < used, "{differ} of {used} differ");
 }
 
 #[test]

@@ -80,36 +80,45 @@ impl Tri {
     /// Squared distance from `p` to the triangle (hot path of the BVH query).
     #[inline(always)]
     pub fn distance_squared(&self, p: DVec3) -> f64 {
+        self.distance_squared_feature(p).0
+    }
+
+    /// Squared distance from `p` to the triangle, and the feature that holds
+    /// the nearest point (Ericson's region; a flat triangle answers
+    /// `Feature::Edge(0)` whatever its nearest feature, since its face has no
+    /// normal to stand over).
+    #[inline(always)]
+    pub fn distance_squared_feature(&self, p: DVec3) -> (f64, Feature) {
         if self.flat {
-            return self.closest_flat(p).0.distance_squared(p);
+            return (self.closest_flat(p).0.distance_squared(p), Feature::Edge(0));
         }
         let ap = p - self.a;
         let d1 = self.ab.dot(ap);
         let d2 = self.ac.dot(ap);
         if d1 <= 0.0 && d2 <= 0.0 {
-            return ap.dot(ap);
+            return (ap.dot(ap), Feature::Vertex(0));
         }
         let d3 = d1 - self.ab2;
         let d4 = d2 - self.abac;
         if d3 >= 0.0 && d4 <= d3 {
             let bp = ap - self.ab;
-            return bp.dot(bp);
+            return (bp.dot(bp), Feature::Vertex(1));
         }
         let vc = d1 * d4 - d3 * d2;
         if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
             let q = ap - self.ab * (d1 / self.ab2);
-            return q.dot(q);
+            return (q.dot(q), Feature::Edge(0));
         }
         let d5 = d1 - self.abac;
         let d6 = d2 - self.ac2;
         if d6 >= 0.0 && d5 <= d6 {
             let cp = ap - self.ac;
-            return cp.dot(cp);
+            return (cp.dot(cp), Feature::Vertex(2));
         }
         let vb = d5 * d2 - d1 * d6;
         if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
             let q = ap - self.ac * (d2 / self.ac2);
-            return q.dot(q);
+            return (q.dot(q), Feature::Edge(2));
         }
         let va = d3 * d6 - d5 * d4;
         let e43 = d4 - d3;
@@ -117,10 +126,10 @@ impl Tri {
         if va <= 0.0 && e43 >= 0.0 && e56 >= 0.0 {
             let w = e43 / (e43 + e56);
             let q = ap - self.ab - (self.ac - self.ab) * w;
-            return q.dot(q);
+            return (q.dot(q), Feature::Edge(1));
         }
         let h = self.n.dot(ap);
-        h * h
+        (h * h, Feature::Face)
     }
 
     /// Closest point on the triangle to `p` and the feature that holds it.
