@@ -35,11 +35,20 @@ struct Case {
     mesh_voxel: f64,
     by: SegmentBy,
     segments: usize,
+    /// pyvcad 2.3.4's slice-stack rate on the same design and voxel size,
+    /// measured on this kind of machine (OPENVCAD.md §9), M voxels/s.
+    pyvcad_png: Option<f64>,
 }
 
 fn load(file: &str) -> Arc<Model> {
+    load_from("examples", file)
+}
+
+/// A design of `assets/<dir>`.
+fn load_from(dir: &str, file: &str) -> Arc<Model> {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../assets/examples")
+        .join("../assets")
+        .join(dir)
         .join(file);
     Arc::new(model_of_file(&path).expect("example"))
 }
@@ -155,6 +164,7 @@ fn main() {
             mesh_voxel: 0.05,
             by: SegmentBy::Dominant,
             segments: 1,
+            pyvcad_png: None,
         },
         Case {
             name: "graded_bar",
@@ -163,6 +173,7 @@ fn main() {
             mesh_voxel: 0.05,
             by: SegmentBy::Material(1),
             segments: 4,
+            pyvcad_png: None,
         },
         Case {
             name: "bcc_sphere",
@@ -171,6 +182,7 @@ fn main() {
             mesh_voxel: 0.05,
             by: SegmentBy::Dominant,
             segments: 1,
+            pyvcad_png: None,
         },
         Case {
             name: "bunny_lattice",
@@ -179,6 +191,26 @@ fn main() {
             mesh_voxel: 0.2,
             by: SegmentBy::Dominant,
             segments: 1,
+            pyvcad_png: None,
+        },
+        // pyvcad's own measured designs at its 200³ grids (assets/bench).
+        Case {
+            name: "pyvcad_sphere",
+            model: || load_from("bench", "pyvcad_sphere.rhai"),
+            png_voxel: 0.1,
+            mesh_voxel: 0.1,
+            by: SegmentBy::Dominant,
+            segments: 1,
+            pyvcad_png: Some(5.4),
+        },
+        Case {
+            name: "pyvcad_bcc_box",
+            model: || load_from("bench", "pyvcad_bcc_box.rhai"),
+            png_voxel: 0.05,
+            mesh_voxel: 0.05,
+            by: SegmentBy::Dominant,
+            segments: 1,
+            pyvcad_png: Some(2.5),
         },
     ];
     for c in cases {
@@ -211,14 +243,19 @@ fn main() {
                 .ok()
                 .and_then(|s| s.parse().ok())
                 .unwrap_or(0);
+            let rate = voxels as f64 / secs / 1e6;
+            let versus = c
+                .pyvcad_png
+                .map(|r| format!("; {:.0}× pyvcad's {r} M/s", rate / r))
+                .unwrap_or_default();
             println!(
-                "png  {:<14} {:<9} {:>6} mm {:>12} voxels {:>8.3} s {:>8.1} M voxels/s  (sample {:.0} M/s, sample+choose {:.0} M/s; {} files, {:.1} MB)",
+                "png  {:<14} {:<9} {:>6} mm {:>12} voxels {:>8.3} s {:>8.1} M voxels/s  (sample {:.0} M/s, sample+choose {:.0} M/s; {} files, {:.1} MB{versus})",
                 c.name,
                 dither.name(),
                 c.png_voxel,
                 voxels,
                 secs,
-                voxels as f64 / secs / 1e6,
+                rate,
                 voxels as f64 / sample / 1e6,
                 voxels as f64 / choose / 1e6,
                 s.files.len(),

@@ -1,12 +1,13 @@
 //! Points per second near the surface (within 2 mm) for every example and
 //! the 3,286-strut bunny lattice. `cargo bench -p volcad-core`.
 //!
-//! Plain timers (no criterion): one warm-up pass, then the best of three.
+//! Plain timers (no criterion): `bench::median_points_per_second`, the
+//! median of up to five passes after a warm-up, as `volcad bench` reports.
 
 use std::path::PathBuf;
 
 use volcad_core::Model;
-use volcad_core::bench::{near_surface_points, points_per_second, z_order};
+use volcad_core::bench::{median_points_per_second, near_surface_points, z_order};
 use volcad_core::script::{ScriptOptions, run_script};
 
 fn main() {
@@ -40,20 +41,16 @@ fn main() {
         let script = t.elapsed().as_secs_f64();
         let m = Model::prepare(&d.root, d.materials.clone()).unwrap();
         let pts = near_surface_points(&m, 1_000_000, 2.0, 7);
-        points_per_second(&m, &pts[..pts.len().min(100_000)]);
-        let best = (0..3)
-            .map(|_| points_per_second(&m, &pts))
-            .fold(0.0, f64::max);
+        let budget = std::time::Duration::from_secs(2);
+        let random = median_points_per_second(&m, &pts, 5, budget);
         let pts = z_order(&m, &pts);
-        let ordered = (0..3)
-            .map(|_| points_per_second(&m, &pts))
-            .fold(0.0, f64::max);
+        let ordered = median_points_per_second(&m, &pts, 5, budget);
         println!(
             "{name:<26} {:>7} {:>12.3} {:>12.4} {:>16.3e} {:>16.3e}",
             m.node_count(),
             script,
             m.prepare_time().as_secs_f64(),
-            best,
+            random,
             ordered
         );
     }

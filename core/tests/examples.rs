@@ -8,8 +8,15 @@ use volcad_core::Model;
 use volcad_core::script::{ScriptOptions, run_script};
 
 fn example(name: &str) -> Model {
+    design("examples", name)
+}
+
+/// A design of `assets/<dir>` (`examples`, or `bench`: pyvcad's measured
+/// designs, for like-for-like throughput).
+fn design(dir: &str, name: &str) -> Model {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../assets/examples")
+        .join("../assets")
+        .join(dir)
         .join(name);
     let src = std::fs::read_to_string(&path).unwrap();
     let d =
@@ -25,17 +32,41 @@ fn frac(m: &Model, p: DVec3, name: &str) -> f64 {
 
 #[test]
 fn every_example_is_tested() {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets/examples");
     let me = include_str!("examples.rs");
-    for e in std::fs::read_dir(dir).unwrap() {
-        let name = e.unwrap().file_name().to_string_lossy().to_string();
-        if name.ends_with(".rhai") {
-            assert!(
-                me.contains(&format!("\"{name}\"")),
-                "{name} has no test here"
-            );
+    for dir in ["examples", "bench"] {
+        let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("../assets")
+            .join(dir);
+        for e in std::fs::read_dir(dir).unwrap() {
+            let name = e.unwrap().file_name().to_string_lossy().to_string();
+            if name.ends_with(".rhai") {
+                assert!(
+                    me.contains(&format!("\"{name}\"")),
+                    "{name} has no test here"
+                );
+            }
         }
     }
+}
+
+/// pyvcad's lattice (OPENVCAD.md §12, d4): the distances pyvcad computed.
+#[test]
+fn pyvcad_bcc_box() {
+    let m = design("bench", "pyvcad_bcc_box.rhai");
+    assert_eq!(m.bbox().size(), DVec3::splat(10.0));
+    let d = |x, y, z| m.distance(DVec3::new(x, y, z));
+    assert!((d(1.0, 1.0, 1.0) + 0.2).abs() < 1e-7);
+    assert!((d(0.5, 0.5, 0.5) + 0.2).abs() < 1e-7);
+    assert!((d(1.3, 1.0, 0.7) - 0.044948965311050415).abs() < 1e-7);
+    assert_eq!(frac(&m, DVec3::ONE, "red"), 1.0);
+}
+
+#[test]
+fn pyvcad_sphere() {
+    let m = design("bench", "pyvcad_sphere.rhai");
+    assert_eq!(m.bbox().size(), DVec3::splat(20.0));
+    assert!((m.distance(DVec3::ZERO) + 10.0).abs() < 1e-12);
+    assert_eq!(frac(&m, DVec3::ZERO, "red"), 1.0);
 }
 
 #[test]
