@@ -5,4 +5,5 @@
 //! * [`cli`]: the headless `volcad` command line.
 
 pub mod cli;
+pub mod cpu;
 pub mod studio;

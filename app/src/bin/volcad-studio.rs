@@ -39,6 +39,7 @@ struct Args {
 }
 
 fn main() -> anyhow::Result<()> {
+    volcad_studio::cpu::check().map_err(anyhow::Error::msg)?;
     let args = Args::parse();
     let automated = args.screenshot.is_some() || args.quit_after_frames.is_some();
     let opts = StudioOptions {

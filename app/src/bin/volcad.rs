@@ -9,6 +9,10 @@ use clap::Parser;
 static HEAP: volcad_core::heap::CountingAllocator = volcad_core::heap::CountingAllocator;
 
 fn main() {
+    if let Err(e) = volcad_studio::cpu::check() {
+        eprintln!("error: {e}");
+        std::process::exit(1);
+    }
     let cli = volcad_studio::cli::Cli::parse();
     if let Err(e) = volcad_studio::cli::run(cli) {
         eprintln!("error: {e:#}");
