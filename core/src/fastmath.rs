@@ -24,9 +24,15 @@
 //! at +∞ never holds a NaN, so it may use the single compare.
 //!
 //! # `floor`
-//! Truncation through an integer conversion (one SSE2 instruction each
+//! With SSE4.1 (the x86-64-v2 builds that `.cargo/config.toml` makes, and
+//! other architectures) `f64::floor` is one instruction (`roundsd`), used
+//! as it is: against the truncating version below, tiled lattices
+//! evaluated 26 to 28 % faster in Z-order and 58 to 71 % in random order,
+//! where that version's branches are unpredictable. Without SSE4.1:
+//! truncation through an integer conversion (one SSE2 instruction each
 //! way), minus one where that rounded up; exactly `f64::floor`, signed
-//! zeros, infinities and NaN included (tested).
+//! zeros, infinities and NaN included (tested, both paths on every
+//! build).
 
 // The constants are fdlibm's, digit for digit as published (more digits
 // than an f64 holds; each rounds to the intended double).
@@ -59,6 +65,23 @@ const C6: f64 = -1.135_964_755_778_819_482_65e-11;
 /// `floor(x)`, bit for bit as `f64::floor`.
 #[inline(always)]
 pub fn floor(x: f64) -> f64 {
+    // With SSE4.1 (x86-64-v2 builds) `f64::floor` is one `roundsd`.
+    #[cfg(any(target_feature = "sse4.1", not(target_arch = "x86_64")))]
+    {
+        x.floor()
+    }
+    #[cfg(all(target_arch = "x86_64", not(target_feature = "sse4.1")))]
+    floor_truncating(x)
+}
+
+/// `floor` without SSE4.1's rounding instruction (where `f64::floor` is a
+/// call into the C library).
+#[inline(always)]
+#[cfg_attr(
+    any(target_feature = "sse4.1", not(target_arch = "x86_64")),
+    allow(dead_code)
+)]
+fn floor_truncating(x: f64) -> f64 {
     // 2⁵²: from there on every f64 is an integer (and NaN fails the test).
     if x.abs() < 4_503_599_627_370_496.0 {
         let t = x as i64 as f64;
@@ -211,14 +234,17 @@ mod tests {
             values.push(f64::from_bits(state)); // every exponent and sign
             values.push((state >> 11) as f64 / (1u64 << 40) as f64 - 4096.0);
         }
+        // Both paths, whichever one this build's `floor` takes.
         for x in values {
-            let (a, b) = (floor(x), x.floor());
-            assert!(
-                a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
-                "{x:e}"
-            );
+            let b = x.floor();
+            for a in [floor(x), floor_truncating(x)] {
+                assert!(
+                    a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
+                    "{x:e}"
+                );
+            }
         }
-        assert!(floor(f64::NAN).is_nan());
+        assert!(floor(f64::NAN).is_nan() && floor_truncating(f64::NAN).is_nan());
     }
 
     #[test]
