@@ -75,9 +75,10 @@ pub struct BenchArgs {
 }
 
 /// `volcad bench`: points per second near the surface for each design
-/// (the median of up to five passes, random and Z-ordered), then voxels per second of its slice stack (random dither) and of its
-/// segmented meshes (dominant material, STL + OBJ + 3MF), each written to
-/// a temporary folder that is removed.
+/// (the median of up to five passes, random and Z-ordered), then voxels
+/// per second of its slice stack (random dither) and of its segmented
+/// meshes (dominant material, STL + OBJ + 3MF), each written to a
+/// temporary folder that is removed.
 pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
     let designs = if args.designs.is_empty() {
         let dir = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/examples"));
