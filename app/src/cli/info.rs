@@ -3,6 +3,8 @@
 use glam::DVec3;
 use std::path::PathBuf;
 
+use volcad_core::bench::{median_points_per_second, near_surface_points, z_order};
+
 use super::DesignArgs;
 use super::design::load_design;
 
@@ -114,7 +116,6 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
                 continue;
             }
         };
-        use volcad_core::bench::{median_points_per_second, near_surface_points, z_order};
         let pts = near_surface_points(&l.model, args.points, 2.0, 7);
         // Median of up to five passes, about a second of them per figure.
         let budget = std::time::Duration::from_secs(1);
