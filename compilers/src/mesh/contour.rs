@@ -41,7 +41,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use volcad_core::sampler::Grid;
 
-use super::flat::{FlatKey, KeptCubes, Regions, flat_key};
+use super::flat::{FlatKey, KeptCubes, Regions, SampleAt, flat_key};
 use super::indexed::IndexedMesh;
 use super::mixed::mixed_cubes;
 use super::vertex_keys::{BandMesh, KeyMap};
@@ -152,10 +152,10 @@ struct BandFlats {
 }
 
 impl BandFlats {
-    fn with_capacity(cubes: usize, stride: usize) -> Self {
+    fn with_capacity(cubes: usize) -> Self {
         BandFlats {
             at: Vec::with_capacity(cubes),
-            kept: KeptCubes::with_capacity(cubes, stride),
+            kept: KeptCubes::with_capacity(cubes),
         }
     }
 }
@@ -226,7 +226,6 @@ impl Contourer {
     }
 
     /// Merge flat regions but contour each with its fallback (tests).
-    #[cfg(test)]
     pub(super) fn with_fallback_only(mut self) -> Self {
         self.regions.triangulate = false;
         self
@@ -312,16 +311,19 @@ impl Contourer {
         })
     }
 
-    /// The meshes, label 1 first (flat regions triangulated now).
-    pub fn finish(mut self) -> Vec<IndexedMesh> {
+    /// The meshes, label 1 first (flat regions triangulated now; a region
+    /// that falls back to marching tetrahedra takes its cubes' samples
+    /// again from `samples`).
+    pub fn finish(mut self, samples: &SampleAt) -> Vec<IndexedMesh> {
         let regions = std::mem::replace(&mut self.regions, Regions::new(0));
         let mut meshes = std::mem::take(&mut self.meshes);
-        regions.finish(&mut meshes, &|cube, out| {
+        let contour = |cube: &Cube, out: &mut Vec<Tri>| {
             let mut scratch = Scratch::default();
             for perm in 0..6 {
                 self.tet(cube, perm, &mut scratch, out);
             }
-        });
+        };
+        regions.finish(&mut meshes, &contour, samples);
         meshes
     }
 
@@ -351,7 +353,7 @@ impl Contourer {
     ) -> (Vec<Tri>, BandFlats) {
         let nx = self.grid.dims[0];
         let mut out = Vec::with_capacity(tris);
-        let mut flats = BandFlats::with_capacity(flat, self.iface.stride());
+        let mut flats = BandFlats::with_capacity(flat);
         let mut scratch = Scratch::default();
         for j in js {
             let rows = [
@@ -367,7 +369,7 @@ impl Contourer {
                 {
                     let mask = corner_mask(&cube, key.x);
                     flats.at.push(([j, i], key, mask));
-                    flats.kept.push(&cube, key, mask);
+                    flats.kept.push(cube.base, mask);
                     continue;
                 }
                 for perm in 0..6 {

@@ -33,7 +33,9 @@ pub(super) fn contour_field(mut c: Contourer, grid: &Grid, values: &[f32]) -> In
             },
         );
     }
-    c.finish().pop().unwrap_or_default()
+    c.finish(&|[i, j, k], _| values[(k * ny + j) * nx + i])
+        .pop()
+        .unwrap_or_default()
 }
 
 /// Labels of plane `z` from `f`, with the grid's outer layer void.

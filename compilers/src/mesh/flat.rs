@@ -39,8 +39,10 @@
 //! is checked: no duplicate points, no crossing outline edges, and the
 //! inside faces' area equal to the outline's (shoelace formula) within
 //! 10⁻⁹. A region that fails any check is contoured cube by cube with
-//! marching tetrahedra from the samples it kept, so the output is never
-//! worse than without merging.
+//! marching tetrahedra, so the output is never worse than without
+//! merging. Its cubes' labels were kept, not their samples: the fallback
+//! takes those again ([`SampleAt`]); its outline points keep the positions
+//! its neighbours share, so it stays closed whatever the samples.
 
 use std::collections::HashMap;
 
@@ -139,83 +141,45 @@ struct Kept {
     mask: u8,
 }
 
-/// Flat cubes' samples, kept for the fallback: gathered per band of rows
-/// in parallel and handed to [`Regions`] whole. Regions keep the bands as
-/// they come: one growing array of every flat cube's samples (tens of MB) was
-/// copied by `realloc` each time it grew, in the sequential joining pass.
+/// Flat cubes kept for the fallback, gathered per band of rows in
+/// parallel and handed to [`Regions`] whole (one growing array was copied
+/// by `realloc` each time it grew, in the sequential joining pass).
 ///
-/// Only what the fallback's marching tetrahedra read is kept. A flat cube
-/// has two labels, so every edge it cuts is cut from the distances (`y`
-/// void) or from the interface values (both labels solid), never both
-/// (see `cut_field`): the cube keeps those 8 or `8 · stride` numbers and
-/// its label mask, 48 bytes a cube with one value a sample instead of 104
-/// with every sample. On the graded bar at 0.0422 mm the kept samples were
-/// 40 MB of fresh memory, faulted in page by page.
+/// A cube keeps its corner and its labels, not its samples: the fallback
+/// is rare (a region whose triangulation fails a check) and takes them
+/// again through [`SampleAt`]. Keeping them cost 48 bytes a cube with one
+/// value a sample, 112 with three: about 25 MB of fresh memory on the
+/// graded bar at 0.0422 mm, faulted in page by page, and a tenth of its
+/// export time (a sixth of the cube's).
 #[derive(Default)]
 pub(super) struct KeptCubes {
     cubes: Vec<Kept>,
-    /// `width` numbers a cube: distances, or interface values by corner.
-    samples: Vec<f32>,
-    width: usize,
 }
 
 impl KeptCubes {
-    /// Room for `cubes` cubes of `stride` interface values a sample.
-    pub fn with_capacity(cubes: usize, stride: usize) -> Self {
-        let width = 8 * stride.max(1);
+    /// Room for `cubes` cubes.
+    pub fn with_capacity(cubes: usize) -> Self {
         KeptCubes {
             cubes: Vec::with_capacity(cubes),
-            samples: Vec::with_capacity(cubes * width),
-            width,
         }
     }
 
-    /// Keep what the fallback needs of flat cube `cube` with key `key`,
-    /// whose corners labelled `key.x` are `mask`.
-    pub fn push(&mut self, cube: &Cube, key: FlatKey, mask: u8) {
+    /// Keep the flat cube with lowest corner `base` whose corners labelled
+    /// with its key's `x` are `mask`.
+    pub fn push(&mut self, base: [usize; 3], mask: u8) {
         self.cubes.push(Kept {
-            base: cube.base.map(|v| v as u32),
+            base: base.map(|v| v as u32),
             mask,
         });
-        let end = self.samples.len() + self.width;
-        if key.y == 0 {
-            self.samples.extend_from_slice(&cube.dist);
-        } else {
-            for v in &cube.value {
-                self.samples.extend_from_slice(v);
-            }
-        }
-        self.samples.resize(end, 0.0);
-    }
-
-    /// The cube at `i` (from 0 in this band) as a [`Cube`], with zeros
-    /// for the numbers its cuts do not read.
-    fn cube(&self, i: usize, key: FlatKey, stride: usize) -> Cube<'_> {
-        let kept = &self.cubes[i];
-        let s = &self.samples[i * self.width..(i + 1) * self.width];
-        let label = std::array::from_fn(|c| {
-            if kept.mask >> c & 1 == 1 {
-                key.x
-            } else {
-                key.y
-            }
-        });
-        let (dist, value) = if key.y == 0 {
-            (std::array::from_fn(|c| s[c]), [&[][..]; 8])
-        } else {
-            (
-                [0.0; 8],
-                std::array::from_fn(|c| &s[c * stride..(c + 1) * stride]),
-            )
-        };
-        Cube {
-            base: kept.base.map(|v| v as usize),
-            label,
-            dist,
-            value,
-        }
     }
 }
+
+/// A sample taken again for the fallback: the distance at grid sample
+/// `[i, j, k]`, with its interface values written into the slice (the
+/// contourer's stride of them, zero where the sample is void). Where the
+/// planes' numbers were evaluated sample by sample these are the same
+/// numbers, so the fallback gives marching tetrahedra's mesh exactly.
+pub(super) type SampleAt<'a> = dyn Fn([usize; 3], &mut [f32]) -> f32 + 'a;
 
 /// An outline edge: the flat cube that added it, its vertex keys and
 /// their indices in label `x`'s and `y`'s meshes (`y` unused when void).
@@ -284,11 +248,34 @@ impl Regions {
         first
     }
 
-    /// The kept samples of cube `id`.
-    fn kept_cube(&self, id: u32) -> Cube<'_> {
+    /// Kept cube `id` with its samples taken again into `buf`.
+    fn kept_cube<'b>(&self, id: u32, samples: &SampleAt, buf: &'b mut Vec<f32>) -> Cube<'b> {
         let band = self.kept.partition_point(|(first, _)| *first <= id) - 1;
         let (first, kept) = &self.kept[band];
-        kept.cube((id - first) as usize, self.keys[id as usize], self.stride)
+        let kept = kept.cubes[(id - first) as usize];
+        let key = self.keys[id as usize];
+        let base = kept.base.map(|v| v as usize);
+        let s = self.stride;
+        buf.clear();
+        buf.resize(8 * s, 0.0);
+        let mut dist = [0.0; 8];
+        for (c, d) in dist.iter_mut().enumerate() {
+            let at = std::array::from_fn(|a| base[a] + (c >> a & 1));
+            *d = samples(at, &mut buf[c * s..(c + 1) * s]);
+        }
+        let buf = &**buf;
+        Cube {
+            base,
+            label: std::array::from_fn(|c| {
+                if kept.mask >> c & 1 == 1 {
+                    key.x
+                } else {
+                    key.y
+                }
+            }),
+            dist,
+            value: std::array::from_fn(|c| &buf[c * s..(c + 1) * s]),
+        }
     }
 
     fn find(&mut self, mut a: u32) -> u32 {
@@ -323,8 +310,9 @@ impl Regions {
     }
 
     /// Triangulate every region into `meshes` (label `l` in `meshes[l − 1]`),
-    /// falling back to `contour` for regions that fail the checks.
-    pub fn finish(mut self, meshes: &mut [IndexedMesh], contour: &CubeContour) {
+    /// falling back to `contour` over samples taken again from `samples`
+    /// for regions that fail the checks.
+    pub fn finish(mut self, meshes: &mut [IndexedMesh], contour: &CubeContour, samples: &SampleAt) {
         let n = self.parent.len();
         let mut slot = vec![u32::MAX; n];
         let mut regions: Vec<Region> = Vec::new();
@@ -374,7 +362,7 @@ impl Regions {
                     }
                     meshes[x].triangles.extend(t);
                 }
-                None => self.fallback(r, meshes, contour, &mut scratch),
+                None => self.fallback(r, meshes, contour, samples, &mut scratch),
             }
         }
     }
@@ -386,6 +374,7 @@ impl Regions {
         r: &Region,
         meshes: &mut [IndexedMesh],
         contour: &CubeContour,
+        samples: &SampleAt,
         tris: &mut Vec<Tri>,
     ) {
         let (x, y) = (r.key.x, r.key.y);
@@ -398,8 +387,9 @@ impl Regions {
                 }
             }
         }
+        let mut buf = Vec::new();
         for &c in &r.cubes {
-            let cube = self.kept_cube(c);
+            let cube = self.kept_cube(c, samples, &mut buf);
             tris.clear();
             contour(&cube, tris);
             for t in tris.iter() {
@@ -531,7 +521,7 @@ mod tests {
 
     use super::super::contour::{Contourer, Interface, Plane};
     use super::super::field::{border_void, contour_field};
-    use super::super::indexed::IndexedMesh;
+    use super::super::indexed::{IndexedMesh, tri_set};
 
     /// A 24³ grid of 0.5 mm voxels sampling `f`.
     fn sample(f: impl Fn(DVec3) -> f64) -> (Grid, Vec<f32>) {
@@ -560,21 +550,6 @@ mod tests {
             contour_field(c().with_flat_merge(false), &g, &v),
             contour_field(c().with_fallback_only(), &g, &v),
         ]
-    }
-
-    /// Triangles by vertex positions, each rotated to start at its least.
-    fn tri_set(m: &IndexedMesh) -> Vec<[[u32; 3]; 3]> {
-        let mut out: Vec<_> = m
-            .triangles
-            .iter()
-            .map(|t| {
-                let p = t.map(|i| m.vertices[i as usize].map(f32::to_bits));
-                let r = (0..3).min_by_key(|i| p[*i]).unwrap_or(0);
-                [p[r], p[(r + 1) % 3], p[(r + 2) % 3]]
-            })
-            .collect();
-        out.sort_unstable();
-        out
     }
 
     fn box_sdf(p: DVec3, half: DVec3) -> f64 {
@@ -680,7 +655,15 @@ mod tests {
                     },
                 );
             }
-            c.finish()
+            // Samples again, as the planes had them.
+            c.finish(&|[i, j, k], out| {
+                let f = value(g.center(i, j, k));
+                match iface {
+                    Interface::Dominant { .. } => out.copy_from_slice(&[f, 1.0 - f]),
+                    _ => out[0] = f,
+                }
+                dist[(k * nx * ny) + j * nx + i]
+            })
         };
         let c = || Contourer::new(g, 2, iface);
         let [merged, plain, fallback] = [

@@ -182,6 +182,24 @@ impl IndexedMesh {
     }
 }
 
+/// Triangles by vertex positions (bits), each rotated to start at its
+/// least, sorted: two meshes with the same triangles at the same points
+/// compare equal whatever their vertex order (tests).
+#[cfg(test)]
+pub(super) fn tri_set(m: &IndexedMesh) -> Vec<[[u32; 3]; 3]> {
+    let mut out: Vec<_> = m
+        .triangles
+        .iter()
+        .map(|t| {
+            let p = t.map(|i| m.vertices[i as usize].map(f32::to_bits));
+            let r = (0..3).min_by_key(|i| p[*i]).unwrap_or(0);
+            [p[r], p[(r + 1) % 3], p[(r + 2) % 3]]
+        })
+        .collect();
+    out.sort_unstable();
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -83,16 +83,17 @@ const TRIANGLES_PER_FACE: f64 = 9.0;
 /// where `sqrt(600 mm²)` is 245 and 490 voxels.
 const FLAT_TRIANGLES_PER_EDGE: f64 = 50.0;
 /// Bytes held until the end of the export per flat cube (a voxel of a
-/// planar face), besides its samples: its region's union-find entry and
-/// key, its kept corner, growth slack and the grouping at the end. The
-/// merged faces' triangles are few, but the bookkeeping grows with their
-/// area in voxels: the 10 mm cube (600 mm² of faces) peaks at 175 MB
-/// resident at 0.02 mm and 665 MB at 0.01 mm, about 110 bytes for each
-/// of the 4.5 million flat cubes added, 8 samples of 4 bytes among them
+/// planar face): its region's union-find entry and key, its kept corner
+/// and labels, growth slack and the grouping at the end (its samples are
+/// not kept; see `flat.rs`). The merged faces' triangles are few, but the
+/// bookkeeping grows with their area in voxels: the 10 mm cube (600 mm² of
+/// faces) peaks at 118 MB resident at 0.02 mm and 434 MB at 0.01 mm, about
+/// 70 to 77 bytes for each flat cube added besides the slabs and planes
 /// (`/usr/bin/time -v volcad export mesh assets/examples/hello_cube.rhai
-/// --voxel 0.01`). Counted as 100 + 32, a fifth more, to err on the safe
-/// side (growth slack depends on where the arrays stand when they grow).
-const FLAT_CUBE_BYTES: f64 = 100.0;
+/// --voxel 0.01`; 670 MB when the cubes kept their samples). Counted as
+/// 90, a sixth more, to err on the safe side (growth slack depends on
+/// where the arrays stand when they grow).
+const FLAT_CUBE_BYTES: f64 = 90.0;
 
 /// How the part is split.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -202,6 +203,22 @@ struct Plan {
     /// Let the sampler fill label-uniform solid tiles with one evaluation
     /// (off only in tests, to show it changes nothing).
     uniform_tiles: bool,
+    /// How flat regions are contoured: merged, except in tests.
+    flat: Flat,
+}
+
+/// How flat regions are contoured ([`Flat::Merge`], except in tests that
+/// compare the ways).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Flat {
+    /// Merged (see `flat.rs`).
+    Merge,
+    /// Not merged: plain marching tetrahedra.
+    #[cfg_attr(not(test), allow(dead_code))]
+    Off,
+    /// Merged, and every region contoured by its fallback.
+    #[cfg_attr(not(test), allow(dead_code))]
+    FallbackOnly,
 }
 
 fn plan(model: &Model, p: &MeshParams) -> Result<Plan, ExportError> {
@@ -263,10 +280,9 @@ fn plan(model: &Model, p: &MeshParams) -> Result<Plan, ExportError> {
     let mesh_bytes = triangles * 12 + triangles / 2 * 40;
     // Flat cubes are kept to the end: the box's faces, planar interfaces
     // (guessed like the triangles) and, to err on the safe side, every
-    // other face of the surface, which may be planar too. Each keeps 8
-    // samples of `stride` interface values (or of the distance).
+    // other face of the surface, which may be planar too.
     let flat_cubes = (pr.flat_mm2 + pr.surface_mm2) * more / face;
-    let flat_bytes = (flat_cubes * (FLAT_CUBE_BYTES + 32.0 * stride.max(1) as f64)) as u64;
+    let flat_bytes = (flat_cubes * FLAT_CUBE_BYTES) as u64;
     // Planes: one slab being contoured, the next being labelled, and the
     // contourer's previous plane.
     let planes = ((2 * slab_layers + 1) * layer * (2 + 4 + 4 * stride)) as u64;
@@ -294,6 +310,7 @@ fn plan(model: &Model, p: &MeshParams) -> Result<Plan, ExportError> {
         slab_layers,
         estimate,
         uniform_tiles: true,
+        flat: Flat::Merge,
     })
 }
 
@@ -351,6 +368,11 @@ fn build(
     }
     let mut contourer =
         Contourer::new(pl.grid, pl.classifier.segments(), pl.classifier.interface());
+    contourer = match pl.flat {
+        Flat::Merge => contourer,
+        Flat::Off => contourer.with_flat_merge(false),
+        Flat::FallbackOnly => contourer.with_fallback_only(),
+    };
     let mut tally = Tally::new(pl.classifier.segments());
     let mut slab = Slab::default();
     // Sample and label one slab of planes, into retired planes' buffers.
@@ -410,7 +432,7 @@ fn build(
     let names = segment_names(model, p, &pl.classifier);
     let n = pl.classifier.segments();
     contourer
-        .finish()
+        .finish(&|[i, j, k], value| pl.classifier.sample(model, pl.grid.center(i, j, k), value))
         .into_iter()
         .enumerate()
         .map(|(s, mesh)| {

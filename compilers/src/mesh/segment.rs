@@ -13,8 +13,11 @@
 //!
 //! Labels are `segment + 1` (0 = void), as [`super::contour`] takes them.
 
+use glam::DVec3;
 use rayon::prelude::*;
+use volcad_core::Model;
 use volcad_core::interval::Interval;
+use volcad_core::model::MAX_MATERIALS;
 use volcad_core::sampler::{Slab, SolidRect, fill_pattern};
 
 use super::contour::{Interface, Plane};
@@ -143,6 +146,26 @@ impl Classifier {
                 (best as u16 + 1, value[best])
             }
         }
+    }
+
+    /// Distance and interface values (into `value`, zero when void) of the
+    /// sample at `p` of `model`: evaluated as the sampler evaluates a voxel
+    /// it does not skip, and classified as [`Self::plane_into`] classifies
+    /// it. The flat regions' fallback takes its samples again through this
+    /// (see `super::flat::SampleAt`).
+    pub fn sample(&self, model: &Model, p: DVec3, value: &mut [f32]) -> f32 {
+        value.fill(0.0);
+        let k = model.materials().len();
+        if k == 0 {
+            return model.distance(p) as f32;
+        }
+        let mut f = [0.0; MAX_MATERIALS];
+        let d = model.eval_into(p, &mut f[..k]) as f32;
+        if d <= 0.0 {
+            let f: [f32; MAX_MATERIALS] = std::array::from_fn(|i| f[i] as f32);
+            self.classify(&f[..k], value);
+        }
+        d
     }
 
     /// Labels, values and tallies of the voxels `xs` of one row, one by one

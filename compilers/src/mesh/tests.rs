@@ -22,12 +22,17 @@ fn both(m: &Model, p: &MeshParams) -> [Vec<SegmentMesh>; 2] {
     })
 }
 
+/// The paper's bar (15 × 10 × 5 mm), graded red to blue along x.
+fn graded_bar() -> Model {
+    model(
+        r#"FGrade(["x/15+0.5", "-x/15+0.5"], [m.id("red"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(15,10,5), m.id("gray")))"#,
+    )
+}
+
 #[test]
 fn triangle_estimates_are_within_twice_the_count() {
     let cube = model(r#"RectPrism(Vec3(0,0,0), Vec3(10,10,10), m.id("red"))"#);
-    let bar = model(
-        r#"FGrade(["x/15+0.5", "-x/15+0.5"], [m.id("red"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(15,10,5), m.id("gray")))"#,
-    );
+    let bar = graded_bar();
     let ball = model(r#"Sphere(Vec3(0,0,0), 5, m.id("red"))"#);
     let red = bar.table().id("red").expect("red");
     let cancel = AtomicBool::new(false);
@@ -56,9 +61,7 @@ fn triangle_estimates_are_within_twice_the_count() {
 
 #[test]
 fn uniform_tiles_give_the_same_meshes() {
-    let bar = model(
-        r#"FGrade(["x/15+0.5", "-x/15+0.5"], [m.id("red"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(15,10,5), m.id("gray")))"#,
-    );
+    let bar = graded_bar();
     let tilted = model(
         r#"Rotate(20, 35, 10, Vec3(0,0,0), FGrade(["x/8+0.5", "0.3", "-y/8+0.5"], [m.id("red"), m.id("green"), m.id("blue")], true, Sphere(Vec3(0,0,0), 4, m.id("gray"))))"#,
     );
@@ -94,11 +97,57 @@ fn uniform_tiles_give_the_same_meshes() {
     }
 }
 
+/// The flat regions' fallback takes its samples again from the design
+/// (`Classifier::sample`): every region through it gives plain marching
+/// tetrahedra's triangles at the same points, so those samples are the
+/// planes' numbers, for distances, fraction ranges and dominant materials.
+#[test]
+fn the_fallback_samples_again_what_the_planes_held() {
+    let bar = graded_bar();
+    let tilted = model(
+        r#"Rotate(20, 35, 10, Vec3(0,0,0), FGrade(["x/8+0.5", "0.3", "-y/8+0.5"], [m.id("red"), m.id("green"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(6,5,4), m.id("gray"))))"#,
+    );
+    let red = bar.table().id("red").expect("red");
+    let cancel = AtomicBool::new(false);
+    for (name, m, by, segments) in [
+        ("bar", &bar, SegmentBy::Dominant, 1),
+        ("bar in 4", &bar, SegmentBy::Material(red), 4),
+        ("tilted box", &tilted, SegmentBy::Dominant, 1),
+    ] {
+        let p = MeshParams {
+            voxel: DVec3::splat(0.2),
+            by,
+            segments,
+            ..MeshParams::default()
+        };
+        let [merged, plain, fallback] = [Flat::Merge, Flat::Off, Flat::FallbackOnly].map(|flat| {
+            let mut pl = plan(m, &p).expect("plan");
+            pl.flat = flat;
+            build(m, &p, &pl, &cancel, &|_, _| {}).expect("build")
+        });
+        for ((a, b), c) in fallback.iter().zip(&plain).zip(&merged) {
+            assert!(a.mesh.is_watertight(), "{name} {}", a.name);
+            assert!(!b.mesh.triangles.is_empty(), "{name} {}", b.name);
+            // Regions merged, so the fallback had regions to take.
+            assert!(
+                c.mesh.triangles.len() < b.mesh.triangles.len(),
+                "{name} {}: {} triangles merged, {} not",
+                c.name,
+                c.mesh.triangles.len(),
+                b.mesh.triangles.len()
+            );
+            assert!(
+                indexed::tri_set(&a.mesh) == indexed::tri_set(&b.mesh),
+                "{name} {}: the fallback differs from marching tetrahedra",
+                a.name
+            );
+        }
+    }
+}
+
 #[test]
 fn uniform_tiles_are_used_and_agree_on_labels() {
-    let bar = model(
-        r#"FGrade(["x/15+0.5", "-x/15+0.5"], [m.id("red"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(15,10,5), m.id("gray")))"#,
-    );
+    let bar = graded_bar();
     let p = MeshParams {
         voxel: DVec3::splat(0.1),
         segments: 4,
