@@ -152,10 +152,10 @@ struct BandFlats {
 }
 
 impl BandFlats {
-    fn with_capacity(cubes: usize) -> Self {
+    fn with_capacity(cubes: usize, dims: [usize; 3]) -> Self {
         BandFlats {
             at: Vec::with_capacity(cubes),
-            kept: KeptCubes::with_capacity(cubes),
+            kept: KeptCubes::with_capacity(cubes, dims),
         }
     }
 }
@@ -353,7 +353,7 @@ impl Contourer {
     ) -> (Vec<Tri>, BandFlats) {
         let nx = self.grid.dims[0];
         let mut out = Vec::with_capacity(tris);
-        let mut flats = BandFlats::with_capacity(flat);
+        let mut flats = BandFlats::with_capacity(flat, self.grid.dims);
         let mut scratch = Scratch::default();
         for j in js {
             let rows = [
@@ -408,7 +408,7 @@ impl Contourer {
         for &(c, mask) in &list {
             let (i, j) = (c % cw, c / cw);
             let id = cur[c];
-            let key = self.regions.key(id);
+            let key = self.regions.key_id(id);
             let mut cube = None;
             for (axis, side) in [(0, 0), (0, 1), (1, 0), (1, 1), (2, 0)] {
                 if !face_cut(mask, axis, side) {
@@ -422,7 +422,7 @@ impl Contourer {
                     (2, 0) => self.prev_flat[c],
                     _ => NOT_FLAT,
                 };
-                if nb != NOT_FLAT && self.regions.key(nb) == key {
+                if nb != NOT_FLAT && self.regions.key_id(nb) == key {
                     if side == 0 {
                         self.regions.union(id, nb);
                     }
@@ -437,7 +437,7 @@ impl Contourer {
         for &(c, mask) in &below {
             let id = self.prev_flat[c];
             if !face_cut(mask, 2, 1)
-                || (cur[c] != NOT_FLAT && self.regions.key(cur[c]) == self.regions.key(id))
+                || (cur[c] != NOT_FLAT && self.regions.key_id(cur[c]) == self.regions.key_id(id))
             {
                 continue;
             }

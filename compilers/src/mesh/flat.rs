@@ -133,44 +133,53 @@ pub(super) fn flat_key(voxel: DVec3, iface: Interface, cube: &Cube) -> Option<Fl
     })
 }
 
-/// A flat cube, kept for the fallback: its lowest corner and which of its
-/// corners carry the key's label `x` (the others carry `y`).
-#[derive(Clone, Copy)]
-struct Kept {
-    base: [u32; 3],
-    mask: u8,
-}
-
 /// Flat cubes kept for the fallback, gathered per band of rows in
 /// parallel and handed to [`Regions`] whole (one growing array was copied
 /// by `realloc` each time it grew, in the sequential joining pass).
 ///
-/// A cube keeps its corner and its labels, not its samples: the fallback
-/// is rare (a region whose triangulation fails a check) and takes them
-/// again through [`SampleAt`]. Keeping them cost 48 bytes a cube with one
-/// value a sample, 112 with three: about 25 MB of fresh memory on the
-/// graded bar at 0.0422 mm, faulted in page by page, and a tenth of its
-/// export time (a sixth of the cube's).
+/// A cube keeps its place and its labels in 8 bytes (its lowest corner's
+/// index in the grid, below 2⁴⁴ voxels, shifted over a mask of the corners
+/// carrying its key's label `x`), not its samples: the fallback is rare
+/// (a region whose triangulation fails a check) and takes them again
+/// through [`SampleAt`]. Keeping them cost 48 bytes a cube with one value
+/// a sample, 112 with three: about 25 MB of fresh memory on the graded bar
+/// at 0.0422 mm, faulted in page by page, and a tenth of its export time
+/// (a sixth of the cube's).
 #[derive(Default)]
 pub(super) struct KeptCubes {
-    cubes: Vec<Kept>,
+    cubes: Vec<u64>,
+    /// The grid's samples along x and y.
+    nx: usize,
+    ny: usize,
 }
 
 impl KeptCubes {
-    /// Room for `cubes` cubes.
-    pub fn with_capacity(cubes: usize) -> Self {
+    /// Room for `cubes` cubes of a grid of `dims` samples.
+    pub fn with_capacity(cubes: usize, [nx, ny, _]: [usize; 3]) -> Self {
         KeptCubes {
             cubes: Vec::with_capacity(cubes),
+            nx,
+            ny,
         }
     }
 
     /// Keep the flat cube with lowest corner `base` whose corners labelled
     /// with its key's `x` are `mask`.
-    pub fn push(&mut self, base: [usize; 3], mask: u8) {
-        self.cubes.push(Kept {
-            base: base.map(|v| v as u32),
-            mask,
-        });
+    pub fn push(&mut self, [i, j, k]: [usize; 3], mask: u8) {
+        let at = ((k * self.ny + j) * self.nx + i) as u64;
+        self.cubes.push(at << 8 | u64::from(mask));
+    }
+
+    /// Cube `n`'s lowest corner and mask.
+    fn get(&self, n: usize) -> ([usize; 3], u8) {
+        let packed = self.cubes[n];
+        let at = (packed >> 8) as usize;
+        let base = [
+            at % self.nx,
+            at / self.nx % self.ny,
+            at / (self.nx * self.ny),
+        ];
+        (base, packed as u8)
     }
 }
 
@@ -198,6 +207,9 @@ struct Region {
     edges: Vec<u32>,
 }
 
+/// A [`FlatKey`] interned by [`Regions`]: equal ids, equal keys.
+pub(super) type KeyId = u32;
+
 /// Marching tetrahedra for one cube (the fallback).
 pub(super) type CubeContour<'a> = dyn Fn(&Cube, &mut Vec<Tri>) + 'a;
 
@@ -207,7 +219,12 @@ pub(super) type CubeContour<'a> = dyn Fn(&Cube, &mut Vec<Tri>) + 'a;
 /// a pointer update.
 pub(super) struct Regions {
     parent: Vec<u32>,
-    keys: Vec<FlatKey>,
+    /// Each cube's key, interned: 4 bytes instead of 16 a cube, and one
+    /// integer compare where neighbours are matched.
+    keys: Vec<KeyId>,
+    /// The distinct keys, by id, and their ids.
+    table: Vec<FlatKey>,
+    ids: HashMap<FlatKey, KeyId>,
     /// Kept cubes by band, with the id of each band's first cube.
     kept: Vec<(u32, KeptCubes)>,
     edges: Vec<Edge>,
@@ -222,6 +239,8 @@ impl Regions {
         Self {
             parent: Vec::new(),
             keys: Vec::new(),
+            table: Vec::new(),
+            ids: HashMap::new(),
             kept: Vec::new(),
             edges: Vec::new(),
             stride,
@@ -233,9 +252,23 @@ impl Regions {
     /// same order); returns the first id (the others follow).
     pub fn add_band(&mut self, keys: impl Iterator<Item = FlatKey>, kept: KeptCubes) -> u32 {
         let first = self.parent.len() as u32;
+        // Runs of cubes share a key: look it up once a run.
+        let mut last: Option<(FlatKey, KeyId)> = None;
         for key in keys {
+            let id = match last {
+                Some((k, id)) if k == key => id,
+                _ => {
+                    let next = self.table.len() as KeyId;
+                    let id = *self.ids.entry(key).or_insert(next);
+                    if id == next {
+                        self.table.push(key);
+                    }
+                    last = Some((key, id));
+                    id
+                }
+            };
             self.parent.push(self.parent.len() as u32);
-            self.keys.push(key);
+            self.keys.push(id);
         }
         debug_assert_eq!(
             self.parent.len() - first as usize,
@@ -252,9 +285,8 @@ impl Regions {
     fn kept_cube<'b>(&self, id: u32, samples: &SampleAt, buf: &'b mut Vec<f32>) -> Cube<'b> {
         let band = self.kept.partition_point(|(first, _)| *first <= id) - 1;
         let (first, kept) = &self.kept[band];
-        let kept = kept.cubes[(id - first) as usize];
-        let key = self.keys[id as usize];
-        let base = kept.base.map(|v| v as usize);
+        let (base, mask) = kept.get((id - first) as usize);
+        let key = self.key(id);
         let s = self.stride;
         buf.clear();
         buf.resize(8 * s, 0.0);
@@ -266,13 +298,7 @@ impl Regions {
         let buf = &**buf;
         Cube {
             base,
-            label: std::array::from_fn(|c| {
-                if kept.mask >> c & 1 == 1 {
-                    key.x
-                } else {
-                    key.y
-                }
-            }),
+            label: std::array::from_fn(|c| if mask >> c & 1 == 1 { key.x } else { key.y }),
             dist,
             value: std::array::from_fn(|c| &buf[c * s..(c + 1) * s]),
         }
@@ -289,6 +315,11 @@ impl Regions {
 
     /// The key of cube `id` (the same for its whole region).
     pub fn key(&self, id: u32) -> FlatKey {
+        self.table[self.keys[id as usize] as usize]
+    }
+
+    /// The interned key of cube `id`: equal for equal keys.
+    pub fn key_id(&self, id: u32) -> KeyId {
         self.keys[id as usize]
     }
 
@@ -321,7 +352,7 @@ impl Regions {
             if slot[r] == u32::MAX {
                 slot[r] = regions.len() as u32;
                 regions.push(Region {
-                    key: self.keys[r],
+                    key: self.key(r as u32),
                     cubes: Vec::new(),
                     edges: Vec::new(),
                 });
@@ -522,6 +553,7 @@ mod tests {
     use super::super::contour::{Contourer, Interface, Plane};
     use super::super::field::{border_void, contour_field};
     use super::super::indexed::{IndexedMesh, tri_set};
+    use super::{FlatKey, KeptCubes, KeyId, Regions};
 
     /// A 24³ grid of 0.5 mm voxels sampling `f`.
     fn sample(f: impl Fn(DVec3) -> f64) -> (Grid, Vec<f32>) {
@@ -704,6 +736,32 @@ mod tests {
         // Two interface values a sample, both kept for the fallback; the
         // checks are in `two_segments`.
         two_segments(Interface::Dominant { k: 2 });
+    }
+
+    #[test]
+    fn keys_are_interned_in_order_of_first_use() {
+        let key = |x, normal| FlatKey { x, y: 0, normal };
+        let (a, b, c) = (
+            key(1, [0, 0, 1024]),
+            key(1, [0, 0, -1024]),
+            key(2, [0, 0, 1024]),
+        );
+        let mut r = Regions::new(0);
+        let kept = |n| {
+            let mut k = KeptCubes::with_capacity(n, [4, 4, 4]);
+            (0..n).for_each(|i| k.push([i % 3, 1, 2], i as u8));
+            k
+        };
+        assert_eq!(r.add_band([a, a, b, a].into_iter(), kept(4)), 0);
+        assert_eq!(r.add_band([c, b].into_iter(), kept(2)), 4);
+        let ids: Vec<KeyId> = (0..6).map(|i| r.key_id(i)).collect();
+        assert_eq!(ids, [0, 0, 1, 0, 2, 1]);
+        let keys: Vec<FlatKey> = (0..6).map(|i| r.key(i)).collect();
+        assert_eq!(keys, [a, a, b, a, c, b]);
+        // Kept places and masks come back as pushed.
+        let k = kept(4);
+        assert_eq!(k.get(2), ([2, 1, 2], 2));
+        assert_eq!(k.get(3), ([0, 1, 2], 3));
     }
 
     #[test]

@@ -83,17 +83,17 @@ const TRIANGLES_PER_FACE: f64 = 9.0;
 /// where `sqrt(600 mm²)` is 245 and 490 voxels.
 const FLAT_TRIANGLES_PER_EDGE: f64 = 50.0;
 /// Bytes held until the end of the export per flat cube (a voxel of a
-/// planar face): its region's union-find entry and key, its kept corner
-/// and labels, growth slack and the grouping at the end (its samples are
-/// not kept; see `flat.rs`). The merged faces' triangles are few, but the
-/// bookkeeping grows with their area in voxels: the 10 mm cube (600 mm² of
-/// faces) peaks at 118 MB resident at 0.02 mm and 434 MB at 0.01 mm, about
-/// 70 to 77 bytes for each flat cube added besides the slabs and planes
-/// (`/usr/bin/time -v volcad export mesh assets/examples/hello_cube.rhai
-/// --voxel 0.01`; 670 MB when the cubes kept their samples). Counted as
-/// 90, a sixth more, to err on the safe side (growth slack depends on
-/// where the arrays stand when they grow).
-const FLAT_CUBE_BYTES: f64 = 90.0;
+/// planar face): its region's union-find entry, its interned key, its
+/// kept place and labels (8 bytes), growth slack and the grouping at the
+/// end (its samples are not kept; see `flat.rs`). The merged faces'
+/// triangles are few, but the bookkeeping grows with their area in
+/// voxels: the 10 mm cube (600 mm² of faces) peaks at 90 MB resident at
+/// 0.02 mm and 303 MB at 0.01 mm, about 40 to 53 bytes for each flat cube
+/// added besides the slabs and planes (`/usr/bin/time -v volcad export
+/// mesh assets/examples/hello_cube.rhai --voxel 0.01`; 670 MB when cubes
+/// kept their samples and 16-byte keys). Counted as 60 to err on the safe
+/// side (growth slack depends on where the arrays stand when they grow).
+const FLAT_CUBE_BYTES: f64 = 60.0;
 
 /// How the part is split.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
