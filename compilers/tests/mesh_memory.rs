@@ -53,7 +53,7 @@ fn the_estimate_covers_the_flat_faces_kept_to_the_end() {
     watch.join().unwrap();
     let peak = peak.load(Ordering::Relaxed);
     assert_eq!(meshes.iter().filter(|s| !s.mesh.is_empty()).count(), 1);
-    // 375 thousand flat cubes: about 21 MB at the peak (some 45 bytes a
+    // 375 thousand flat cubes: about 20 MB at the peak (some 40 bytes a
     // cube), well above the slabs and planes (about 8 MB).
     assert!(peak > 12 << 20, "peak {peak} bytes");
     assert!(

@@ -202,7 +202,8 @@ struct Edge {
 /// One region at triangulation time.
 struct Region {
     key: FlatKey,
-    /// Its cubes (ids) and outline edges (indices into `Regions::edges`).
+    /// Its outline edges (indices into `Regions::edges`), and its cubes
+    /// (ids) when it falls back.
     cubes: Vec<u32>,
     edges: Vec<u32>,
 }
@@ -344,24 +345,27 @@ impl Regions {
     /// falling back to `contour` over samples taken again from `samples`
     /// for regions that fail the checks.
     pub fn finish(mut self, meshes: &mut [IndexedMesh], contour: &CubeContour, samples: &SampleAt) {
-        let n = self.parent.len();
-        let mut slot = vec![u32::MAX; n];
-        let mut regions: Vec<Region> = Vec::new();
-        for id in 0..n as u32 {
-            let r = self.find(id) as usize;
-            if slot[r] == u32::MAX {
-                slot[r] = regions.len() as u32;
-                regions.push(Region {
-                    key: self.key(r as u32),
-                    cubes: Vec::new(),
-                    edges: Vec::new(),
-                });
-            }
-            regions[slot[r] as usize].cubes.push(id);
-        }
+        // A region's root is its lowest id, so the roots in ascending order
+        // list the regions in order of their first cube, without a pass
+        // that finds every cube's root: only edges need theirs, and cubes
+        // only in a region that falls back (gathered below).
+        let n = self.parent.len() as u32;
+        let roots: Vec<u32> = (0..n)
+            .filter(|&id| self.parent[id as usize] == id)
+            .collect();
+        let mut regions: Vec<Region> = roots
+            .iter()
+            .map(|&r| Region {
+                key: self.key(r),
+                cubes: Vec::new(),
+                edges: Vec::new(),
+            })
+            .collect();
         for e in 0..self.edges.len() {
-            let r = self.find(self.edges[e].cube) as usize;
-            regions[slot[r] as usize].edges.push(e as u32);
+            let r = self.find(self.edges[e].cube);
+            if let Ok(s) = roots.binary_search(&r) {
+                regions[s].edges.push(e as u32);
+            }
         }
         let tris: Vec<Option<Vec<[u32; 3]>>> = {
             let meshes = &*meshes;
@@ -376,6 +380,16 @@ impl Regions {
                 })
                 .collect()
         };
+        if tris.iter().any(Option::is_none) {
+            for id in 0..n {
+                let r = self.find(id);
+                if let Ok(s) = roots.binary_search(&r)
+                    && tris[s].is_none()
+                {
+                    regions[s].cubes.push(id);
+                }
+            }
+        }
         let mut scratch = Vec::new();
         for (r, t) in regions.iter().zip(tris) {
             let (x, y) = (r.key.x as usize - 1, r.key.y as usize);

@@ -84,16 +84,17 @@ const TRIANGLES_PER_FACE: f64 = 9.0;
 const FLAT_TRIANGLES_PER_EDGE: f64 = 50.0;
 /// Bytes held until the end of the export per flat cube (a voxel of a
 /// planar face): its region's union-find entry, its interned key, its
-/// kept place and labels (8 bytes), growth slack and the grouping at the
-/// end (its samples are not kept; see `flat.rs`). The merged faces'
-/// triangles are few, but the bookkeeping grows with their area in
-/// voxels: the 10 mm cube (600 mm² of faces) peaks at 90 MB resident at
-/// 0.02 mm and 303 MB at 0.01 mm, about 40 to 53 bytes for each flat cube
-/// added besides the slabs and planes (`/usr/bin/time -v volcad export
-/// mesh assets/examples/hello_cube.rhai --voxel 0.01`; 670 MB when cubes
-/// kept their samples and 16-byte keys). Counted as 60 to err on the safe
-/// side (growth slack depends on where the arrays stand when they grow).
-const FLAT_CUBE_BYTES: f64 = 60.0;
+/// kept place and labels (8 bytes) and growth slack (its samples are not
+/// kept, and regions list their cubes only to fall back; see `flat.rs`).
+/// The merged faces' triangles are few, but the bookkeeping grows with
+/// their area in voxels: the 10 mm cube (600 mm² of faces) peaks at 77 MB
+/// resident at 0.02 mm and 269 MB at 0.01 mm, about 33 to 41 bytes for
+/// each flat cube added besides the slabs and planes (`/usr/bin/time -v
+/// volcad export mesh assets/examples/hello_cube.rhai --voxel 0.01`; 670
+/// MB when cubes kept their samples and 16-byte keys). Counted as 50 to
+/// err on the safe side (growth slack depends on where the arrays stand
+/// when they grow).
+const FLAT_CUBE_BYTES: f64 = 50.0;
 
 /// How the part is split.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
