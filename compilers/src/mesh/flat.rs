@@ -141,10 +141,10 @@ pub(super) fn flat_key(voxel: DVec3, iface: Interface, cube: &Cube) -> Option<Fl
 /// index in the grid, below 2⁴⁴ voxels, shifted over a mask of the corners
 /// carrying its key's label `x`), not its samples: the fallback is rare
 /// (a region whose triangulation fails a check) and takes them again
-/// through [`SampleAt`]. Keeping them cost 48 bytes a cube with one value
-/// a sample, 112 with three: about 25 MB of fresh memory on the graded bar
-/// at 0.0422 mm, faulted in page by page, and a tenth of its export time
-/// (a sixth of the cube's).
+/// through [`SampleAt`]. Keeping them cost 32 bytes a cube with one value
+/// a sample, 96 with three: tens of MB of fresh memory, faulted in page by
+/// page; without them a 10 M-voxel export of the cube ran 19 % faster and
+/// the graded bar's 7 % (alternating medians, docs/PERFORMANCE.md).
 #[derive(Default)]
 pub(super) struct KeptCubes {
     cubes: Vec<u64>,
