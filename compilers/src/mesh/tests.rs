@@ -12,14 +12,27 @@ pub(crate) fn model(src: &str) -> Model {
     model_of(&src, "t.rhai", &ScriptOptions::default()).expect("design")
 }
 
+/// Segment meshes of `m` through a plan that `adjust` changes first (the
+/// switches tests compare).
+fn built(m: &Model, p: &MeshParams, adjust: impl Fn(&mut Plan)) -> Vec<SegmentMesh> {
+    let mut pl = plan(m, p).expect("plan");
+    adjust(&mut pl);
+    build(m, p, &pl, &AtomicBool::new(false), &|_, _| {}).expect("build")
+}
+
 /// Meshes and voxel counts with and without label-uniform tiles.
 fn both(m: &Model, p: &MeshParams) -> [Vec<SegmentMesh>; 2] {
-    let cancel = AtomicBool::new(false);
-    [true, false].map(|uniform_tiles| {
-        let mut pl = plan(m, p).expect("plan");
-        pl.uniform_tiles = uniform_tiles;
-        build(m, p, &pl, &cancel, &|_, _| {}).expect("build")
-    })
+    [true, false].map(|uniform| built(m, p, |pl| pl.uniform_tiles = uniform))
+}
+
+/// Parameters of a `segments`-segment export by `by` at `voxel` mm.
+fn params(voxel: f64, by: SegmentBy, segments: usize) -> MeshParams {
+    MeshParams {
+        voxel: DVec3::splat(voxel),
+        by,
+        segments,
+        ..MeshParams::default()
+    }
 }
 
 /// The paper's bar (15 × 10 × 5 mm), graded red to blue along x.
@@ -42,12 +55,7 @@ fn triangle_estimates_are_within_twice_the_count() {
         ("bar in 4", &bar, SegmentBy::Material(red), 4),
         ("sphere", &ball, SegmentBy::Dominant, 1),
     ] {
-        let p = MeshParams {
-            voxel: DVec3::splat(0.1),
-            by,
-            segments,
-            ..MeshParams::default()
-        };
+        let p = params(0.1, by, segments);
         let est = estimate_mesh(m, &p).expect("estimate").triangles as f64;
         let made: usize = segment_meshes(m, &p, &cancel, |_, _| {})
             .expect("meshes")
@@ -80,12 +88,7 @@ fn uniform_tiles_give_the_same_meshes() {
         (&tilted, SegmentBy::Dominant, 1, 0.1),
     ];
     for (m, by, segments, voxel) in cases {
-        let p = MeshParams {
-            voxel: DVec3::splat(voxel),
-            segments,
-            by,
-            ..MeshParams::default()
-        };
+        let p = params(voxel, by, segments);
         let [fast, plain] = both(m, &p);
         assert_eq!(fast.len(), plain.len());
         let nonempty = plain.iter().filter(|s| !s.mesh.triangles.is_empty());
@@ -108,23 +111,14 @@ fn the_fallback_samples_again_what_the_planes_held() {
         r#"Rotate(20, 35, 10, Vec3(0,0,0), FGrade(["x/8+0.5", "0.3", "-y/8+0.5"], [m.id("red"), m.id("green"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(6,5,4), m.id("gray"))))"#,
     );
     let red = bar.table().id("red").expect("red");
-    let cancel = AtomicBool::new(false);
     for (name, m, by, segments) in [
         ("bar", &bar, SegmentBy::Dominant, 1),
         ("bar in 4", &bar, SegmentBy::Material(red), 4),
         ("tilted box", &tilted, SegmentBy::Dominant, 1),
     ] {
-        let p = MeshParams {
-            voxel: DVec3::splat(0.2),
-            by,
-            segments,
-            ..MeshParams::default()
-        };
-        let [merged, plain, fallback] = [Flat::Merge, Flat::Off, Flat::FallbackOnly].map(|flat| {
-            let mut pl = plan(m, &p).expect("plan");
-            pl.flat = flat;
-            build(m, &p, &pl, &cancel, &|_, _| {}).expect("build")
-        });
+        let p = params(0.2, by, segments);
+        let [merged, plain, fallback] = [Flat::Merge, Flat::Off, Flat::FallbackOnly]
+            .map(|flat| built(m, &p, |pl| pl.flat = flat));
         for ((a, b), c) in fallback.iter().zip(&plain).zip(&merged) {
             assert!(a.mesh.is_watertight(), "{name} {}", a.name);
             assert!(!b.mesh.triangles.is_empty(), "{name} {}", b.name);
@@ -148,12 +142,11 @@ fn the_fallback_samples_again_what_the_planes_held() {
 #[test]
 fn uniform_tiles_are_used_and_agree_on_labels() {
     let bar = graded_bar();
-    let p = MeshParams {
-        voxel: DVec3::splat(0.1),
-        segments: 4,
-        by: SegmentBy::Material(bar.table().id("red").expect("red")),
-        ..MeshParams::default()
-    };
+    let p = params(
+        0.1,
+        SegmentBy::Material(bar.table().id("red").expect("red")),
+        4,
+    );
     let pl = plan(&bar, &p).expect("plan");
     let dims = pl.grid.dims;
     let test = |b: &[volcad_core::interval::Interval]| pl.classifier.uniform(b);
