@@ -8,6 +8,16 @@
 //! ≥ 2⁶³ cases), three of them per query. Here the range test is done in
 //! floating point first (`0 ≤ g < dims`, false for NaN), after which the
 //! `u32` casts are exact and cheap.
+//!
+//! Why blocks: a cell's linear index puts the 4³ cells of a block side by
+//! side (x fastest within the block, blocks x fastest), so the per-cell
+//! records of a block share four cache lines and their lists are one
+//! stretch of memory. Queries come in space-filling order (samplers sweep
+//! small boxes, the bench and the baker go in Z-order), and with rows
+//! (`x + nx·(y + ny·z)`) a walk around a point's neighbourhood touched a new
+//! cache line for every step in y or z. See [`CellLattice::index`]. On the
+//! bunny lattice (`volcad bench`, Z-ordered points, four alternating pairs)
+//! 16.8–16.9 → 17.0–17.2 M points/s; other designs within noise.
 
 use glam::DVec3;
 
@@ -20,7 +30,14 @@ pub struct CellLattice {
     /// `dims` as floats: the exclusive upper end of a valid coordinate.
     limit: DVec3,
     dims: [usize; 3],
+    /// Blocks along x, and blocks in one xy layer.
+    blocks_x: usize,
+    blocks_xy: usize,
 }
+
+/// Cells along each side of a block (a power of two).
+const BLOCK: usize = 4;
+const BLOCK_SHIFT: u32 = BLOCK.trailing_zeros();
 
 impl CellLattice {
     /// `dims` must each be at least 1 and below 2³²; `cell` positive.
@@ -32,11 +49,32 @@ impl CellLattice {
             inv_cell: DVec3::ONE / cell,
             limit: DVec3::new(dims[0] as f64, dims[1] as f64, dims[2] as f64),
             dims,
+            blocks_x: dims[0].div_ceil(BLOCK),
+            blocks_xy: dims[0].div_ceil(BLOCK) * dims[1].div_ceil(BLOCK),
         }
     }
 
+    /// Storage slots an array indexed by [`CellLattice::index`] needs: the
+    /// cells of whole blocks, so at most `(d + 3)` per `d` along each axis.
+    /// The slots of cells beyond `dims` are never located.
+    pub fn slots(&self) -> usize {
+        self.blocks_xy * self.dims[2].div_ceil(BLOCK) * BLOCK.pow(3)
+    }
+
+    /// The storage slot of cell `c`: its block's number (x fastest) times
+    /// 64, plus its place in the block (x fastest). Unique, below `slots()`.
+    #[inline(always)]
+    pub fn index(&self, c: [usize; 3]) -> usize {
+        let block = (c[0] >> BLOCK_SHIFT)
+            + self.blocks_x * (c[1] >> BLOCK_SHIFT)
+            + self.blocks_xy * (c[2] >> BLOCK_SHIFT);
+        let m = BLOCK - 1;
+        let local = (c[0] & m) | (c[1] & m) << BLOCK_SHIFT | (c[2] & m) << (2 * BLOCK_SHIFT);
+        block << (3 * BLOCK_SHIFT) | local
+    }
+
     /// The cell holding `p` (`min + k·cell ≤ p < min + (k+1)·cell` up to
-    /// rounding): its linear index (x fastest) and its coordinates. `None`
+    /// rounding): its slot ([`CellLattice::index`]) and its coordinates. `None`
     /// outside the lattice or for a non-finite `p`.
     #[inline(always)]
     pub fn locate(&self, p: DVec3) -> Option<(usize, [usize; 3])> {
@@ -56,7 +94,7 @@ impl CellLattice {
             g.y as u32 as usize,
             g.z as u32 as usize,
         );
-        Some((x + self.dims[0] * (y + self.dims[1] * z), [x, y, z]))
+        Some((self.index([x, y, z]), [x, y, z]))
     }
 
     /// Centre of cell `c`.
@@ -97,7 +135,7 @@ mod tests {
                 Some((i, [x, y, z])) => {
                     assert!(inside, "{p}");
                     assert_eq!([x as f64, y as f64, z as f64], [g.x, g.y, g.z]);
-                    assert_eq!(i, x + 4 * (y + 8 * z));
+                    assert_eq!(i, l.index([x, y, z]));
                     let c = l.centre([x, y, z]);
                     assert!(
                         (p - c)
@@ -113,5 +151,26 @@ mod tests {
         assert_eq!(l.locate(DVec3::new(f64::INFINITY, 2.5, 1.0)), None);
         // The upper faces belong to no cell.
         assert_eq!(l.locate(DVec3::new(1.0, 2.5, 1.0)), None);
+    }
+
+    #[test]
+    fn slots_are_unique_blocked_and_within_bounds() {
+        for dims in [[1, 1, 1], [4, 8, 3], [5, 9, 13], [16, 4, 4]] {
+            let l = CellLattice::new(DVec3::ZERO, DVec3::ONE, dims);
+            let mut seen = vec![false; l.slots()];
+            for z in 0..dims[2] {
+                for y in 0..dims[1] {
+                    for x in 0..dims[0] {
+                        let i = l.index([x, y, z]);
+                        assert!(!seen[i], "{dims:?} {x} {y} {z}");
+                        seen[i] = true;
+                        // The 4³ cells of a block are 64 consecutive slots.
+                        assert_eq!(i / 64, l.index([x & !3, y & !3, z & !3]) / 64);
+                    }
+                }
+            }
+            let padded: usize = dims.iter().map(|d| d.div_ceil(4) * 4).product();
+            assert_eq!(l.slots(), padded);
+        }
     }
 }

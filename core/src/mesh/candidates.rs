@@ -146,7 +146,8 @@ impl CandidateGrid {
         let n = ((b.max + DVec3::splat(PAD * cell) - min) / cell / 2.0).ceil() * 2.0;
         let dims = [n.x as usize, n.y as usize, n.z as usize];
         let r = 0.5 * cell * 3f64.sqrt();
-        let count = dims[0] * dims[1] * dims[2];
+        let lattice = CellLattice::new(min, DVec3::splat(cell), dims);
+        let count = lattice.slots();
         let slack = |v: f64| v * (1.0 + 1e-9) + 1e-12 * extent;
         let bdims = [dims[0] / 2, dims[1] / 2, dims[2] / 2];
         // Per block: one BVH range query for all eight cells. A cell's list
@@ -228,7 +229,7 @@ impl CandidateGrid {
             );
             for (k, l) in block.into_iter().enumerate() {
                 let (x, y, z) = (2 * bx + (k & 1), 2 * by + (k >> 1 & 1), 2 * bz + (k >> 2));
-                lists[x + dims[0] * (y + dims[1] * z)] = l;
+                lists[lattice.index([x, y, z])] = l;
             }
         }
         let total: usize = lists.iter().map(|l| l.1.len()).sum();
@@ -305,7 +306,7 @@ impl CandidateGrid {
             }
         });
         Some(CandidateGrid {
-            cells: CellLattice::new(min, DVec3::splat(cell), dims),
+            cells: lattice,
             records,
             items,
             slot_bits,

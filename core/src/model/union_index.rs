@@ -106,7 +106,8 @@ impl UnionIndex {
         // lists are sorted by lower bound, so long lists cost little.
         let margin = 2.0 * cell_size.max_element();
         let inv_cell = DVec3::ONE / cell_size;
-        let ncells = dims[0] * dims[1] * dims[2];
+        let lattice = CellLattice::new(grid_box.min, cell_size, dims);
+        let ncells = lattice.slots();
         let cell_range = |b: &Aabb| {
             let lo = ((b.min - grid_box.min) * inv_cell).floor();
             let hi = ((b.max - grid_box.min) * inv_cell).floor();
@@ -162,10 +163,7 @@ impl UnionIndex {
                                             } else {
                                                 lo32
                                             };
-                                            cells.push((
-                                                (x + dims[0] * (y + dims[1] * z)) as u32,
-                                                lo32,
-                                            ));
+                                            cells.push((lattice.index([x, y, z]) as u32, lo32));
                                         }
                                     }
                                 }
@@ -199,7 +197,7 @@ impl UnionIndex {
         }
         let bvh = Bvh::build(boxes, &finite);
         Self {
-            cells: CellLattice::new(grid_box.min, cell_size, dims),
+            cells: lattice,
             half_diagonal: 0.5 * cell_size.length(),
             offsets,
             entries,
