@@ -30,15 +30,8 @@
 //! meshes stay closed. Points inside the region are dropped.
 //!
 //! # Triangulation
-//! The outline is projected along the normal's largest axis and
-//! triangulated by a constrained Delaunay triangulation (spade, exact
-//! predicates), which keeps every outline point (collinear ones included;
-//! dropping one would leave a T-junction). Faces inside the outline are
-//! found by flood fill from the hull, flipping at each outline edge, and
-//! oriented like the outline (the label `x`'s outward side). The region
-//! is checked: no duplicate points, no crossing outline edges, and the
-//! inside faces' area equal to the outline's (shoelace formula) within
-//! 10⁻⁹. A region that fails any check is contoured cube by cube with
+//! Each region's outline is triangulated in [`super::outline`]. A region
+//! whose triangulation fails one of its checks is contoured cube by cube with
 //! marching tetrahedra, so the output is never worse than without
 //! merging. Its cubes' labels were kept, not their samples: the fallback
 //! takes those again ([`SampleAt`]); its outline points keep the positions
@@ -48,11 +41,11 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 use rayon::prelude::*;
-use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 use volcad_core::fastmath::round_i32;
 
 use super::contour::{Cube, Interface, cut_field, front_back};
 use super::indexed::IndexedMesh;
+use super::outline::triangulate;
 use super::vertex_keys::Tri;
 
 /// Largest deviation of an edge difference from its axis mean, relative to
@@ -61,8 +54,6 @@ use super::vertex_keys::Tri;
 const FLAT_TOL: f64 = 1e-3;
 /// Normal quantisation per component.
 const NORMAL_BINS: f64 = 1024.0;
-/// Relative area mismatch that rejects a region's triangulation.
-const AREA_TOL: f64 = 1e-9;
 
 /// What makes flat cubes one region.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -375,7 +366,13 @@ impl Regions {
                 .map(|r| {
                     let verts = &meshes[r.key.x as usize - 1].vertices;
                     self.triangulate
-                        .then(|| triangulate(r, edges, verts))
+                        .then(|| {
+                            triangulate(
+                                r.key.normal,
+                                r.edges.iter().map(|e| edges[*e as usize].xi),
+                                verts,
+                            )
+                        })
                         .flatten()
                 })
                 .collect()
@@ -449,112 +446,6 @@ impl Regions {
             }
         }
     }
-}
-
-/// The region's triangles as indices in `x`'s mesh, oriented like its
-/// outline, or `None` when a check fails (see the module docs).
-fn triangulate(r: &Region, all: &[Edge], verts: &[[f32; 3]]) -> Option<Vec<[u32; 3]>> {
-    // Project along the normal's largest component (quantised is enough).
-    let n = r.key.normal.map(i32::abs);
-    let drop = if n[0] >= n[1] && n[0] >= n[2] {
-        0
-    } else if n[1] >= n[2] {
-        1
-    } else {
-        2
-    };
-    let (u, v) = ((drop + 1) % 3, (drop + 2) % 3);
-    let mut local: HashMap<u32, usize> = HashMap::with_capacity(r.edges.len());
-    let mut global = Vec::with_capacity(r.edges.len());
-    let mut pts = Vec::with_capacity(r.edges.len());
-    let mut edges = Vec::with_capacity(r.edges.len());
-    for e in r.edges.iter().map(|e| all[*e as usize].xi) {
-        edges.push(e.map(|g| {
-            *local.entry(g).or_insert_with(|| {
-                let p = verts[g as usize];
-                pts.push(Point2::new(f64::from(p[u]), f64::from(p[v])));
-                global.push(g);
-                global.len() - 1
-            })
-        }));
-    }
-    // Each outline edge once, in one direction.
-    let mut seen: HashMap<[usize; 2], ()> = HashMap::with_capacity(edges.len());
-    for e in &edges {
-        if e[0] == e[1] || seen.insert([e[0].min(e[1]), e[0].max(e[1])], ()).is_some() {
-            return None;
-        }
-    }
-    let area2: f64 = edges
-        .iter()
-        .map(|[a, b]| pts[*a].x * pts[*b].y - pts[*b].x * pts[*a].y)
-        .sum();
-    let count = pts.len();
-    let mut conflict = false;
-    let cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::try_bulk_load_cdt(
-        pts.clone(),
-        edges.clone(),
-        |_| conflict = true,
-    )
-    .ok()?;
-    if conflict || cdt.num_vertices() != count || cdt.num_constraints() != edges.len() {
-        return None;
-    }
-    // Parity of outline crossings from the hull: 1 = inside.
-    const UNSET: u8 = 2;
-    let mut parity = vec![UNSET; cdt.num_inner_faces() + 1];
-    let mut stack = Vec::new();
-    for f in cdt.inner_faces() {
-        for e in f.adjacent_edges() {
-            if e.rev().face().is_outer() {
-                let p = u8::from(cdt.is_constraint_edge(e.as_undirected().fix()));
-                let slot = &mut parity[f.fix().index()];
-                if *slot == UNSET {
-                    *slot = p;
-                    stack.push(f.fix());
-                } else if *slot != p {
-                    return None;
-                }
-            }
-        }
-    }
-    while let Some(f) = stack.pop() {
-        let pf = parity[f.index()];
-        for e in cdt.face(f).adjacent_edges() {
-            if let Some(nb) = e.rev().face().as_inner() {
-                let p = pf ^ u8::from(cdt.is_constraint_edge(e.as_undirected().fix()));
-                let slot = &mut parity[nb.fix().index()];
-                if *slot == UNSET {
-                    *slot = p;
-                    stack.push(nb.fix());
-                } else if *slot != p {
-                    return None;
-                }
-            }
-        }
-    }
-    let mut out = Vec::new();
-    let mut sum2 = 0.0;
-    for f in cdt.inner_faces() {
-        match parity[f.fix().index()] {
-            1 => {}
-            0 => continue,
-            _ => return None,
-        }
-        let [a, b, c] = f.vertices().map(|h| h.fix().index());
-        let (pa, pb, pc) = (pts[a], pts[b], pts[c]);
-        let s = (pb.x - pa.x) * (pc.y - pa.y) - (pb.y - pa.y) * (pc.x - pa.x);
-        sum2 += s.abs();
-        out.push(if (s > 0.0) == (area2 > 0.0) {
-            [global[a], global[b], global[c]]
-        } else {
-            [global[a], global[c], global[b]]
-        });
-    }
-    if out.is_empty() || (sum2 - area2.abs()).abs() > AREA_TOL * area2.abs() {
-        return None;
-    }
-    Some(out)
 }
 
 #[cfg(test)]

@@ -33,6 +33,7 @@ mod flat;
 pub mod indexed;
 mod mixed;
 pub mod obj;
+mod outline;
 pub mod segment;
 pub mod stl;
 mod text_blocks;
