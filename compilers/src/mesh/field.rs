@@ -2,8 +2,9 @@
 
 use volcad_core::sampler::Grid;
 
-use super::contour::{Contourer, Interface, Plane};
+use super::contour::{Contourer, Plane};
 use super::indexed::IndexedMesh;
+use super::interface::Interface;
 
 /// Mesh the region `{v ≤ 0}` of a field sampled at the centres of `grid`
 /// (`values` x fastest, then y, then z): marching cubes, each cube split

@@ -43,8 +43,9 @@ use glam::DVec3;
 use rayon::prelude::*;
 use volcad_core::fastmath::round_i32;
 
-use super::contour::{Cube, Interface, cut_field, front_back};
+use super::contour::Cube;
 use super::indexed::IndexedMesh;
+use super::interface::{Interface, cut_field, front_back};
 use super::outline::triangulate;
 use super::vertex_keys::Tri;
 
@@ -455,9 +456,10 @@ mod tests {
     use glam::DVec3;
     use volcad_core::sampler::Grid;
 
-    use super::super::contour::{Contourer, Interface, Plane};
+    use super::super::contour::{Contourer, Plane};
     use super::super::field::{border_void, contour_field};
     use super::super::indexed::{IndexedMesh, tri_set};
+    use super::super::interface::Interface;
     use super::{FlatKey, KeptCubes, KeyId, Regions};
 
     /// A 24³ grid of 0.5 mm voxels sampling `f`.

@@ -31,6 +31,7 @@ pub mod contour;
 mod field;
 mod flat;
 pub mod indexed;
+mod interface;
 mod mixed;
 pub mod obj;
 mod outline;

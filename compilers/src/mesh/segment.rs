@@ -20,7 +20,8 @@ use volcad_core::interval::Interval;
 use volcad_core::model::MAX_MATERIALS;
 use volcad_core::sampler::{Slab, SolidRect, fill_pattern};
 
-use super::contour::{Interface, Plane};
+use super::contour::Plane;
+use super::interface::Interface;
 use crate::dither::{BOUND_MARGIN as EPS, MIN_TOTAL};
 
 /// How voxels are put into segments.
