@@ -151,6 +151,14 @@ fn seat_linear_field_is_exact_and_inside_agrees_with_distance() {
     assert!(!f.sample(DVec3::NAN, &mut out));
 }
 
+#[test]
+fn every_cell_near_tetrahedra_starts_a_walk() {
+    // Cells the boundary crosses with their centre outside used to keep no
+    // start, and their points inside the mesh searched the BVH.
+    let f = SimField::load(&seat("seat.inp"), &seat("seat_displacement.csv")).unwrap();
+    assert_eq!(f.locator.unstarted_cells(), 0);
+}
+
 /// Two tetrahedra sharing the face (1, 2, 3); the second one is inverted.
 fn two_tets() -> (Vec<DVec3>, Vec<[u32; 4]>) {
     let nodes = vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z, DVec3::ONE];
