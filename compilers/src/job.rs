@@ -129,6 +129,13 @@ impl JobContext {
         &self.staging
     }
 
+    /// The folder that will hold the destination (the staging folder's
+    /// parent): what messages about its disk name, since the staging
+    /// folder's name means nothing to the user.
+    pub fn folder(&self) -> &Path {
+        self.staging.parent().unwrap_or(&self.staging)
+    }
+
     /// Err(Cancelled) once cancel was asked for.
     pub fn check_cancel(&self) -> Result<(), ExportError> {
         if self.cancel.load(Ordering::Relaxed) {
@@ -351,7 +358,15 @@ where
     if staging.exists() {
         let _ = std::fs::remove_dir_all(&staging);
     }
-    std::fs::create_dir_all(&staging).map_err(|e| ExportError::io(&staging, e))?;
+    // The staging folder's name means nothing to the user: say which
+    // folder refused the export.
+    std::fs::create_dir_all(&staging).map_err(|e| {
+        ExportError::Other(format!(
+            "{}: cannot write {} in this folder: {e}",
+            parent.display(),
+            dest.display()
+        ))
+    })?;
     let ctx = JobContext {
         staging: staging.clone(),
         cancel,
@@ -387,7 +402,17 @@ where
     if out.is_err() {
         let _ = std::fs::remove_dir_all(&staging);
     }
-    out
+    // A file that failed in the staging folder is named as it would have
+    // been in the destination.
+    out.map_err(|e| match e {
+        ExportError::Io { path, err } => ExportError::Io {
+            path: path
+                .strip_prefix(&staging)
+                .map_or(path.clone(), |rel| dest.join(rel)),
+            err,
+        },
+        e => e,
+    })
 }
 
 #[cfg(test)]
@@ -487,6 +512,34 @@ mod tests {
         assert!(!stale.exists());
         assert!(alive.exists() && other.exists());
         assert!(dir.join("out/manifest.json").exists());
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_folder_that_refuses_the_export_is_named() {
+        // /proc takes no new folders, not even from root.
+        let h = spawn(PathBuf::from("/proc/volcad-out"), "abc".into(), |_| {
+            Ok(Summary::default())
+        });
+        let e = h.join().unwrap_err().to_string();
+        assert!(
+            e.starts_with("/proc: cannot write /proc/volcad-out in this folder"),
+            "{e}"
+        );
+        assert!(!e.contains(".partial"), "{e}");
+    }
+
+    #[test]
+    fn write_errors_name_the_destination_not_the_staging_folder() {
+        let (_scratch, dest) = destination();
+        let h = spawn(dest.clone(), "abc".into(), |ctx| {
+            let path = ctx.staging().join("slice_00001.png");
+            Err(ExportError::io(&path, std::io::Error::other("disk full")))
+        });
+        let e = h.join().unwrap_err().to_string();
+        let expected = format!("{}: disk full", dest.join("slice_00001.png").display());
+        assert_eq!(e, expected);
+        assert!(!dest.exists());
     }
 
     #[test]

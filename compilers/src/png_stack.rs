@@ -206,7 +206,7 @@ pub fn export_png_stack(
     ctx: &JobContext,
 ) -> Result<Summary, ExportError> {
     let est = estimate(model, p)?;
-    check_disk(est.disk_bytes, ctx.staging())?;
+    check_disk(est.disk_bytes, ctx.folder(), "a larger voxel size")?;
     run_with_threads(p.threads, || write_stack(model, p, &est, ctx))
 }
 

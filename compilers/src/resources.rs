@@ -150,15 +150,16 @@ impl MemoryGuard {
 }
 
 /// Refuse when about `needed` bytes of output will not fit on the disk that
-/// holds `dir`. The error names `--out`.
-pub fn check_disk(needed: u64, dir: &Path) -> Result<(), ExportError> {
+/// holds `dir`. The error names `--out`, and `coarser` (what makes the
+/// output smaller: "a larger voxel size").
+pub fn check_disk(needed: u64, dir: &Path, coarser: &str) -> Result<(), ExportError> {
     if let Some(free) = available_disk(dir)
         && needed > free
     {
         return Err(ExportError::param(
             "--out",
             format!(
-                "the output needs about {} but only {} is free on the disk of {}; free space, choose another folder or use a larger voxel size",
+                "the output needs about {} but only {} is free on the disk of {}; free space, choose another folder or use {coarser}",
                 human_bytes(needed),
                 human_bytes(free),
                 dir.display()
@@ -206,7 +207,7 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("--voxel: one layer needs"), "{e}");
-        let e = check_disk(u64::MAX / 2, &std::env::temp_dir())
+        let e = check_disk(u64::MAX / 2, &std::env::temp_dir(), "a larger voxel size")
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("--out: the output needs about"), "{e}");

@@ -276,6 +276,33 @@ FGrade(["x/8+0.5", "-x/8+0.5"], [m.id("VeroCyan"), m.id("Agilus30")], true, Sphe
 }
 
 #[test]
+fn the_disk_check_asks_for_less_than_the_file_takes() {
+    // The export refuses a disk with less room than this estimate, so it
+    // must stay below the real size (and near enough to mean something).
+    let m = model(
+        r#"let m = j750_materials();
+FGrade(["x/8+0.5", "-x/8+0.5"], [m.id("VeroCyan"), m.id("Agilus30")], true, Sphere(Vec3(0,0,0), 4, m.id("VeroCyan")))"#,
+    );
+    for element in [Element::C3D4, Element::C3D8R] {
+        let p = FeaParams {
+            element,
+            voxel: 0.7,
+            min_cell: 0.6,
+            max_cell: 2.0,
+            ..FeaParams::default()
+        };
+        let estimate = mesh(&m, &p).inp_bytes_at_least();
+        let (_scratch, dir) = scratch(&format!("disk-{element:?}"));
+        export(&m, &p, &dir).unwrap();
+        let size = std::fs::metadata(dir.join("model.inp")).unwrap().len();
+        assert!(
+            estimate <= size && 3 * estimate > size,
+            "{element:?}: estimate {estimate}, file {size}"
+        );
+    }
+}
+
+#[test]
 fn missing_elastic_properties_name_the_material_and_table() {
     // pyvcad's default table has no E/ν for "liquid".
     let m = model(

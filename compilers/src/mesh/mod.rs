@@ -480,7 +480,7 @@ pub fn export_meshes(
     ctx: &JobContext,
 ) -> Result<Summary, ExportError> {
     let pl = plan(model, p)?;
-    check_disk(pl.estimate.disk_bytes, ctx.staging())?;
+    check_disk(pl.estimate.disk_bytes, ctx.folder(), "a larger voxel size")?;
     run_with_threads(p.threads, || {
         let nz = pl.grid.dims[2];
         let segs = build(model, p, &pl, ctx.cancel_flag(), &|done, total| {
