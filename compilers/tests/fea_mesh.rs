@@ -230,26 +230,38 @@ FGrade(["x/15+0.5", "-x/15+0.5"], [m.id("VeroCyan"), m.id("Agilus30")], true, Re
     assert!(e.to_string().contains("--max-cell"), "{e}");
 }
 
-#[test]
-fn same_bytes_on_any_thread_count() {
-    let m = model(
+/// A sphere of radius 4 graded along x between two J750 materials.
+fn graded_sphere() -> Arc<Model> {
+    model(
         r#"let m = j750_materials();
 FGrade(["x/8+0.5", "-x/8+0.5"], [m.id("VeroCyan"), m.id("Agilus30")], true, Sphere(Vec3(0,0,0), 4, m.id("VeroCyan")))"#,
-    );
+    )
+}
+
+/// Elements of 0.7 mm (bricks) or 0.6 to 2 mm (tetrahedra).
+fn sized(element: Element) -> FeaParams {
+    FeaParams {
+        element,
+        voxel: 0.7,
+        min_cell: 0.6,
+        max_cell: 2.0,
+        ..FeaParams::default()
+    }
+}
+
+#[test]
+fn same_bytes_on_any_thread_count() {
+    let m = graded_sphere();
     for element in [Element::C3D4, Element::C3D8R] {
         let mut files = Vec::new();
         for threads in [Some(1), Some(3), None] {
             let p = FeaParams {
-                element,
-                voxel: 0.7,
-                min_cell: 0.6,
-                max_cell: 2.0,
                 seed: 5,
                 threads,
                 step: Some(StepParams {
                     top_displacement: -0.5,
                 }),
-                ..FeaParams::default()
+                ..sized(element)
             };
             let (_scratch, dir) = scratch(&format!("det-{element:?}-{threads:?}"));
             export(&m, &p, &dir).unwrap();
@@ -263,12 +275,8 @@ FGrade(["x/8+0.5", "-x/8+0.5"], [m.id("VeroCyan"), m.id("Agilus30")], true, Sphe
         // Another seed draws other materials.
         let (_scratch, dir) = scratch("det-seed");
         let p = FeaParams {
-            element,
-            voxel: 0.7,
-            min_cell: 0.6,
-            max_cell: 2.0,
             seed: 6,
-            ..FeaParams::default()
+            ..sized(element)
         };
         export(&m, &p, &dir).unwrap();
         assert_ne!(std::fs::read(dir.join("model.inp")).unwrap(), files[0]);
@@ -279,18 +287,9 @@ FGrade(["x/8+0.5", "-x/8+0.5"], [m.id("VeroCyan"), m.id("Agilus30")], true, Sphe
 fn the_disk_check_asks_for_less_than_the_file_takes() {
     // The export refuses a disk with less room than this estimate, so it
     // must stay below the real size (and near enough to mean something).
-    let m = model(
-        r#"let m = j750_materials();
-FGrade(["x/8+0.5", "-x/8+0.5"], [m.id("VeroCyan"), m.id("Agilus30")], true, Sphere(Vec3(0,0,0), 4, m.id("VeroCyan")))"#,
-    );
+    let m = graded_sphere();
     for element in [Element::C3D4, Element::C3D8R] {
-        let p = FeaParams {
-            element,
-            voxel: 0.7,
-            min_cell: 0.6,
-            max_cell: 2.0,
-            ..FeaParams::default()
-        };
+        let p = sized(element);
         let estimate = mesh(&m, &p).inp_bytes_at_least();
         let (_scratch, dir) = scratch(&format!("disk-{element:?}"));
         export(&m, &p, &dir).unwrap();
