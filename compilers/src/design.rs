@@ -21,12 +21,18 @@ pub fn grid_for(model: &Model, voxel: DVec3, pad: f64) -> Result<Grid, ExportErr
     } else {
         bbox
     };
-    Grid::covering(&bbox, voxel, MAX_VOXELS).map_err(|e| match e {
+    Grid::covering(&bbox, voxel, MAX_VOXELS).map_err(grid_error)
+}
+
+/// A grid error named by what fixes it: the voxel size, or the design
+/// (unbounded or empty).
+pub fn grid_error(e: GridError) -> ExportError {
+    match e {
         GridError::BadVoxel(_) | GridError::TooLarge { .. } => {
             ExportError::param("--voxel", e.to_string())
         }
         GridError::Unbounded(_) | GridError::Empty => ExportError::param("design", e.to_string()),
-    })
+    }
 }
 
 /// Check that every material of the design is in its table. Returns the

@@ -40,7 +40,7 @@ pub fn grid(model: &Model, voxel: f64) -> Result<Grid, ExportError> {
         ));
     }
     Grid::covering(&model.bbox(), DVec3::splat(voxel), MAX_VOXELS)
-        .map_err(|e| ExportError::param("--voxel", e.to_string()))
+        .map_err(crate::design::grid_error)
 }
 
 /// Mesh `model` into bricks of size `voxel`; materials drawn with `seed`,

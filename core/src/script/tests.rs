@@ -45,6 +45,23 @@ fn root_variable_is_the_design() {
 }
 
 #[test]
+fn wrong_argument_types_are_named_in_the_script_s_words() {
+    let m = "let m = default_materials();\nlet a = Sphere(Vec3(0,0,0), 1, m.id(\"red\"));\n";
+    for (call, got) in [
+        ("Intersection(a, a)", "got a node"),
+        ("Sphere(Vec3(0,0,0), \"big\", 1)", "got a string"),
+        ("Sphere(1, 1, 1)", "got an integer"),
+        ("Union(false, [a, Vec3(1,1,1)])", "got a Vec3"),
+        ("Union(false, [a, m])", "got a MaterialDefs"),
+        ("Union(1.5, [a])", "got an array"),
+    ] {
+        let e = run(&format!("{m}{call}")).unwrap_err();
+        assert!(e.message.contains(got), "{call}: {e}");
+        assert!(!e.message.contains("::"), "{call}: {e}");
+    }
+}
+
+#[test]
 fn errors_carry_line_and_column() {
     let e = run("let m = default_materials();\nlet s = Sphere(Vec3(0,0,0), -1, m.id(\"red\"));\ns")
         .unwrap_err();

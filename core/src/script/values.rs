@@ -14,6 +14,37 @@ pub type RResult<T> = Result<T, Box<EvalAltResult>>;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Vec3(pub DVec3);
 
+/// What a value is, in the script's words ("a string", "a node"):
+/// `Dynamic::type_name` gives Rust's names for our own types
+/// ("volcad_core::node::Node") and Rhai's for the rest ("i64").
+pub fn described(v: &Dynamic) -> String {
+    if v.is::<Node>() {
+        return "a node".into();
+    }
+    if v.is::<Vec3>() {
+        return "a Vec3".into();
+    }
+    match v.type_name() {
+        "i64" | "i32" => "an integer".into(),
+        "f64" | "f32" => "a number".into(),
+        "string" | "char" => "a string".into(),
+        "bool" => "true or false".into(),
+        "array" => "an array".into(),
+        "map" => "a map".into(),
+        "()" => "nothing".into(),
+        "Fn" => "a function".into(),
+        other => {
+            let name = other.rsplit("::").next().unwrap_or(other);
+            let name = if name == "Materials" {
+                "MaterialDefs"
+            } else {
+                name
+            };
+            format!("a {name}")
+        }
+    }
+}
+
 /// A runtime error with the script position of the call.
 pub fn fail<T>(pos: Position, msg: impl Into<String>) -> RResult<T> {
     Err(Box::new(EvalAltResult::ErrorRuntime(
@@ -39,7 +70,7 @@ pub fn num(v: &Dynamic, what: &str, pos: Position) -> RResult<f64> {
     } else {
         fail(
             pos,
-            format!("{what} must be a number, got {}", v.type_name()),
+            format!("{what} must be a number, got {}", described(v)),
         )
     }
 }
@@ -88,7 +119,7 @@ pub fn vec3(v: &Dynamic, what: &str, pos: Position) -> RResult<DVec3> {
             finite(&a[2], what, pos)?,
         ));
     }
-    fail(pos, format!("{what} must be a Vec3, got {}", v.type_name()))
+    fail(pos, format!("{what} must be a Vec3, got {}", described(v)))
 }
 
 /// A material id (0..=255); whether the table has it is checked when the
@@ -99,7 +130,7 @@ pub fn material(v: &Dynamic, pos: Position) -> RResult<u8> {
             pos,
             format!(
                 "material must be an id from materials.id(\"name\"), got {}",
-                v.type_name()
+                described(v)
             ),
         );
     };
@@ -113,7 +144,7 @@ pub fn material(v: &Dynamic, pos: Position) -> RResult<u8> {
 /// A node argument.
 pub fn node(v: &Dynamic, what: &str, pos: Position) -> RResult<Node> {
     v.clone().try_cast::<Node>().map_or_else(
-        || fail(pos, format!("{what} must be a node, got {}", v.type_name())),
+        || fail(pos, format!("{what} must be a node, got {}", described(v))),
         Ok,
     )
 }
@@ -123,7 +154,7 @@ pub fn nodes(v: &Dynamic, what: &str, pos: Position) -> RResult<Vec<Node>> {
     let Some(a) = v.clone().try_cast::<rhai::Array>() else {
         return fail(
             pos,
-            format!("{what} must be an array of nodes, got {}", v.type_name()),
+            format!("{what} must be an array of nodes, got {}", described(v)),
         );
     };
     a.iter()
@@ -137,7 +168,7 @@ pub fn boolean(v: &Dynamic, what: &str, pos: Position) -> RResult<bool> {
     v.as_bool().or_else(|_| {
         fail(
             pos,
-            format!("{what} must be true or false, got {}", v.type_name()),
+            format!("{what} must be true or false, got {}", described(v)),
         )
     })
 }
@@ -147,7 +178,7 @@ pub fn strings(v: &Dynamic, what: &str, pos: Position) -> RResult<Vec<String>> {
     let Some(a) = v.clone().try_cast::<rhai::Array>() else {
         return fail(
             pos,
-            format!("{what} must be an array of strings, got {}", v.type_name()),
+            format!("{what} must be an array of strings, got {}", described(v)),
         );
     };
     a.iter()
@@ -167,7 +198,7 @@ pub fn materials(v: &Dynamic, what: &str, pos: Position) -> RResult<Vec<u8>> {
             pos,
             format!(
                 "{what} must be an array of material ids, got {}",
-                v.type_name()
+                described(v)
             ),
         );
     };
