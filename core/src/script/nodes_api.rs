@@ -159,6 +159,14 @@ pub fn register_composites(engine: &mut Engine) {
                         ),
                         p,
                     ))
+                } else if a.is::<Node>() {
+                    // pyvcad's forms take the children as one list.
+                    fail(
+                        p,
+                        format!(
+                            "{name} takes (blend, [children]) or (k, blend, [children]): write {name}(false, [a, b]) for two nodes a and b"
+                        ),
+                    )
                 } else {
                     let k = non_negative(&a, &format!("{name}: smoothing radius"), p)?;
                     Ok(mk(

@@ -48,7 +48,9 @@ fn root_variable_is_the_design() {
 fn wrong_argument_types_are_named_in_the_script_s_words() {
     let m = "let m = default_materials();\nlet a = Sphere(Vec3(0,0,0), 1, m.id(\"red\"));\n";
     for (call, got) in [
-        ("Intersection(a, a)", "got a node"),
+        ("Intersection(a, a)", "write Intersection(false, [a, b])"),
+        ("Union(a, [a])", "write Union(false, [a, b])"),
+        ("Difference(a, 2)", "got an integer"),
         ("Sphere(Vec3(0,0,0), \"big\", 1)", "got a string"),
         ("Sphere(1, 1, 1)", "got an integer"),
         ("Union(false, [a, Vec3(1,1,1)])", "got a Vec3"),
