@@ -416,6 +416,12 @@ fn bench_reports_evaluation_and_export_rates() {
         out.contains("png voxels/s") && out.contains("mesh voxels/s"),
         "{out}"
     );
+    // The first line says what the figures are of.
+    assert!(
+        out.starts_with("points/s: 2000 points within 2 mm")
+            && out.lines().next().unwrap().contains("about 200000 voxels"),
+        "{out}"
+    );
     let row = out
         .lines()
         .find(|l| l.starts_with("graded_bar.rhai"))

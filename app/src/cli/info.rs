@@ -95,6 +95,20 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
     } else {
         args.designs.clone()
     };
+    // What the figures are of: points/s depends on how densely the points
+    // fill the band (docs/PERFORMANCE.md, twenty-third session).
+    println!(
+        "points/s: {} points within 2 mm of each design's surface, medians of up to 5 passes{}",
+        args.points,
+        if args.no_exports {
+            String::new()
+        } else {
+            format!(
+                "; voxels/s: exports of about {} voxels, medians of up to 3",
+                args.voxels
+            )
+        }
+    );
     println!(
         "{:<28} {:>8} {:>14} {:>16} {:>16} {:>11} {:>14} {:>14}",
         "design",
