@@ -42,6 +42,14 @@ fn graded_bar() -> Model {
     )
 }
 
+/// `shape` graded between three materials (red and blue along x and y,
+/// green constant) and rotated off every axis.
+fn tilted_three_materials(shape: &str) -> Model {
+    model(&format!(
+        r#"Rotate(20, 35, 10, Vec3(0,0,0), FGrade(["x/8+0.5", "0.3", "-y/8+0.5"], [m.id("red"), m.id("green"), m.id("blue")], true, {shape}))"#
+    ))
+}
+
 #[test]
 fn triangle_estimates_are_within_twice_the_count() {
     let cube = model(r#"RectPrism(Vec3(0,0,0), Vec3(10,10,10), m.id("red"))"#);
@@ -70,9 +78,7 @@ fn triangle_estimates_are_within_twice_the_count() {
 #[test]
 fn uniform_tiles_give_the_same_meshes() {
     let bar = graded_bar();
-    let tilted = model(
-        r#"Rotate(20, 35, 10, Vec3(0,0,0), FGrade(["x/8+0.5", "0.3", "-y/8+0.5"], [m.id("red"), m.id("green"), m.id("blue")], true, Sphere(Vec3(0,0,0), 4, m.id("gray"))))"#,
-    );
+    let tilted = tilted_three_materials(r#"Sphere(Vec3(0,0,0), 4, m.id("gray"))"#);
     let red = bar.table().id("red").expect("red");
     let seat = model_of_file(
         &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -107,9 +113,7 @@ fn uniform_tiles_give_the_same_meshes() {
 #[test]
 fn the_fallback_samples_again_what_the_planes_held() {
     let bar = graded_bar();
-    let tilted = model(
-        r#"Rotate(20, 35, 10, Vec3(0,0,0), FGrade(["x/8+0.5", "0.3", "-y/8+0.5"], [m.id("red"), m.id("green"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(6,5,4), m.id("gray"))))"#,
-    );
+    let tilted = tilted_three_materials(r#"RectPrism(Vec3(0,0,0), Vec3(6,5,4), m.id("gray"))"#);
     let red = bar.table().id("red").expect("red");
     for (name, m, by, segments) in [
         ("bar", &bar, SegmentBy::Dominant, 1),

@@ -488,10 +488,10 @@ fn register_vec3(engine: &mut Engine) {
 
 /// `materials.id("red")` and friends on a shared table.
 #[derive(Clone)]
-struct Materials(Arc<MaterialTable>);
+struct MaterialDefs(Arc<MaterialTable>);
 
 fn register_materials(engine: &mut Engine, ctx: &RunContext) {
-    engine.register_type_with_name::<Materials>("MaterialDefs");
+    engine.register_type_with_name::<MaterialDefs>("MaterialDefs");
     let set = |ctx: &RunContext, t: Arc<MaterialTable>| {
         let mut st = ctx.lock();
         let previous = st.table.as_ref().map(|o| o.origin().to_owned());
@@ -504,7 +504,7 @@ fn register_materials(engine: &mut Engine, ctx: &RunContext) {
             ));
         }
         st.table = Some(t.clone());
-        Materials(t)
+        MaterialDefs(t)
     };
     let c1 = ctx.clone();
     engine.register_fn("default_materials", move || {
@@ -517,7 +517,7 @@ fn register_materials(engine: &mut Engine, ctx: &RunContext) {
     let c3 = ctx.clone();
     engine.register_fn(
         "load_materials",
-        move |c: Ctx, path: &str| -> RResult<Materials> {
+        move |c: Ctx, path: &str| -> RResult<MaterialDefs> {
             let p = c.call_position();
             let full = c3.resolve(path, p)?;
             let t = MaterialTable::load(&full).or_else(|e| fail(p, e.to_string()))?;
@@ -526,7 +526,7 @@ fn register_materials(engine: &mut Engine, ctx: &RunContext) {
     );
     engine.register_fn(
         "id",
-        |c: Ctx, m: &mut Materials, name: &str| -> RResult<i64> {
+        |c: Ctx, m: &mut MaterialDefs, name: &str| -> RResult<i64> {
             m.0.id(name)
                 .map(i64::from)
                 .or_else(|e| fail(c.call_position(), e.to_string()))
@@ -534,20 +534,20 @@ fn register_materials(engine: &mut Engine, ctx: &RunContext) {
     );
     engine.register_fn(
         "name",
-        |c: Ctx, m: &mut Materials, id: i64| -> RResult<String> {
+        |c: Ctx, m: &mut MaterialDefs, id: i64| -> RResult<String> {
             let id =
                 m.0.check_id(id)
                     .or_else(|e| fail(c.call_position(), e.to_string()))?;
             Ok(m.0.name(id).to_owned())
         },
     );
-    engine.register_fn("contains", |m: &mut Materials, name: &str| {
+    engine.register_fn("contains", |m: &mut MaterialDefs, name: &str| {
         m.0.id(name).is_ok()
     });
-    engine.register_fn("num_materials", |m: &mut Materials| m.0.len() as i64 - 1);
+    engine.register_fn("num_materials", |m: &mut MaterialDefs| m.0.len() as i64 - 1);
     engine.register_fn(
         "color",
-        |c: Ctx, m: &mut Materials, id: i64| -> RResult<rhai::Array> {
+        |c: Ctx, m: &mut MaterialDefs, id: i64| -> RResult<rhai::Array> {
             let id =
                 m.0.check_id(id)
                     .or_else(|e| fail(c.call_position(), e.to_string()))?;

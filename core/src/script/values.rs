@@ -21,27 +21,19 @@ pub fn described(v: &Dynamic) -> String {
     if v.is::<Node>() {
         return "a node".into();
     }
-    if v.is::<Vec3>() {
-        return "a Vec3".into();
-    }
     match v.type_name() {
-        "i64" | "i32" => "an integer".into(),
-        "f64" | "f32" => "a number".into(),
-        "string" | "char" => "a string".into(),
+        "i64" => "an integer".into(),
+        "f64" => "a number".into(),
+        "string" => "a string".into(),
+        "char" => "a character".into(),
         "bool" => "true or false".into(),
         "array" => "an array".into(),
         "map" => "a map".into(),
         "()" => "nothing".into(),
         "Fn" => "a function".into(),
-        other => {
-            let name = other.rsplit("::").next().unwrap_or(other);
-            let name = if name == "Materials" {
-                "MaterialDefs"
-            } else {
-                name
-            };
-            format!("a {name}")
-        }
+        // Our other types are named in Rust as in scripts (Vec3,
+        // MaterialDefs, LatticeType), after their path.
+        other => format!("a {}", other.rsplit("::").next().unwrap_or(other)),
     }
 }
 
