@@ -159,6 +159,63 @@ fn every_cell_near_tetrahedra_starts_a_walk() {
     assert_eq!(f.locator.unstarted_cells(), 0);
 }
 
+#[test]
+fn points_on_shared_faces_and_nodes_locate_the_same_whatever_came_before() {
+    // Each thread starts from the tetrahedron it found last; a point on a
+    // face two tetrahedra share (or on a node) is inside both, and used to
+    // be located in whichever the previous point left it in.
+    let f = SimField::load(&seat("seat.inp"), &seat("seat_displacement.csv")).unwrap();
+    let (nodes, tets) = (f.nodes(), f.tets());
+    let centroid = |t: usize| tets[t].iter().map(|&n| nodes[n as usize]).sum::<DVec3>() / 4.0;
+    // Interior faces: sorted node triples that two tetrahedra list.
+    let mut faces: Vec<([u32; 3], usize)> = Vec::new();
+    for (t, tet) in tets.iter().enumerate() {
+        for skip in 0..4 {
+            let mut key: Vec<u32> = (0..4).filter(|&i| i != skip).map(|i| tet[i]).collect();
+            key.sort_unstable();
+            faces.push(([key[0], key[1], key[2]], t));
+        }
+    }
+    faces.sort_unstable();
+    let shared: Vec<(DVec3, [usize; 2])> = faces
+        .windows(2)
+        .filter(|w| w[0].0 == w[1].0)
+        .step_by(97)
+        .map(|w| {
+            let p = w[0].0.iter().map(|&n| nodes[n as usize]).sum::<DVec3>() / 3.0;
+            (p, [w[0].1, w[1].1])
+        })
+        .collect();
+    assert!(shared.len() > 500, "{}", shared.len());
+    // A node and two tetrahedra around it.
+    let around = |n: u32| -> Vec<usize> {
+        (0..tets.len())
+            .filter(|&t| tets[t].contains(&n))
+            .take(2)
+            .collect()
+    };
+    let at_nodes: Vec<(DVec3, [usize; 2])> = (0..nodes.len() as u32)
+        .step_by(211)
+        .filter_map(|n| match around(n)[..] {
+            [a, b] => Some((nodes[n as usize], [a, b])),
+            _ => None,
+        })
+        .collect();
+    let bits = |p: DVec3| {
+        let (t, w) = f.locate(p).expect("on the mesh");
+        let mut out = [0.0; 4];
+        assert!(f.sample(p, &mut out));
+        (t, w.map(f64::to_bits), out.map(f64::to_bits))
+    };
+    for (p, [a, b]) in shared.iter().chain(&at_nodes) {
+        f.locate(centroid(*a));
+        let after_a = bits(*p);
+        f.locate(centroid(*b));
+        let after_b = bits(*p);
+        assert_eq!(after_a, after_b, "{p} after tetrahedra {a} and {b}");
+    }
+}
+
 /// Two tetrahedra sharing the face (1, 2, 3); the second one is inverted.
 fn two_tets() -> (Vec<DVec3>, Vec<[u32; 4]>) {
     let nodes = vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z, DVec3::ONE];
