@@ -268,17 +268,29 @@ fn unbounded_design_refuses_to_export() {
     let d = scratch.path();
     let s = d.join("tile.rhai");
     std::fs::write(&s, "Tile(4, 4, 4, Sphere(Vec3(0,0,0), 1, 1))").unwrap();
-    let err = fails(&volcad(&[
-        "export",
-        "png",
-        s.to_str().unwrap(),
-        "--out",
-        d.join("o").to_str().unwrap(),
-        "--voxel",
-        "0.5",
-    ]));
-    assert!(err.contains("unbounded"), "{err}");
-    assert!(!d.join("o").exists());
+    // Every export words it alike, the tetrahedra (which need no voxel
+    // grid) included.
+    for kind in [
+        &["png"][..],
+        &["mesh"],
+        &["fea"],
+        &["fea", "--element", "c3d4"],
+        &["fea", "--element", "c3d4", "--voxel", "0.5"],
+    ] {
+        let out = d.join("o");
+        let mut args = vec!["export"];
+        args.extend_from_slice(kind);
+        args.extend([s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+        if kind.len() < 3 {
+            args.extend(["--voxel", "0.5"]);
+        }
+        let err = fails(&volcad(&args));
+        assert!(
+            err.contains("design: the design is unbounded (bounding box"),
+            "{kind:?}: {err}"
+        );
+        assert!(!out.exists(), "{kind:?}");
+    }
 }
 
 fn files_in(dir: &Path) -> Vec<String> {

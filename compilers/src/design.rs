@@ -3,8 +3,8 @@
 //! Errors name the parameter to change (`--voxel`, `design`, `materials`).
 
 use glam::DVec3;
-use volcad_core::Model;
 use volcad_core::sampler::{Grid, GridError};
+use volcad_core::{Aabb, Model};
 
 use crate::job::ExportError;
 
@@ -22,6 +22,15 @@ pub fn grid_for(model: &Model, voxel: DVec3, pad: f64) -> Result<Grid, ExportErr
         bbox
     };
     Grid::covering(&bbox, voxel, MAX_VOXELS).map_err(grid_error)
+}
+
+/// The design's bounding box, or the error every export gives for an
+/// empty or unbounded design (the FEA exports, which size elements
+/// rather than voxels, check it before anything else).
+pub fn bounded_box(model: &Model) -> Result<Aabb, ExportError> {
+    let b = model.bbox();
+    GridError::check_box(&b).map_err(grid_error)?;
+    Ok(b)
 }
 
 /// A grid error named by what fixes it: the voxel size, or the design

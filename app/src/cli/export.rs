@@ -294,7 +294,11 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
                 e => bail!("--element {e}: expected c3d8r or c3d4"),
             };
             let voxel = voxel.map(|v| v.min_element());
-            let size = model.bbox().size().min_element();
+            // The default element size comes from the box: an unbounded
+            // design is refused first, as every export words it.
+            let size = volcad_compilers::design::bounded_box(&model)?
+                .size()
+                .min_element();
             let min_cell = a.min_cell.or(voxel).unwrap_or(size / 10.0);
             let p = FeaParams {
                 element,

@@ -309,13 +309,7 @@ fn tet_mesh(
 
 /// Estimate the export's size from a coarse sampling of the model.
 pub fn estimate_fea(model: &Model, p: &FeaParams) -> Result<FeaEstimate, ExportError> {
-    let b = model.bbox();
-    if !b.is_finite() || b.is_empty() {
-        return Err(ExportError::param(
-            "design",
-            "the design is empty or unbounded",
-        ));
-    }
+    let b = crate::design::bounded_box(model)?;
     const N: usize = 24;
     let step = b.size() / N as f64;
     let cell = step.x * step.y * step.z;

@@ -23,13 +23,7 @@ const MAX_ROOTS: f64 = 5e7;
 /// The root lattice for `rule`: cubes whose Kuhn tetrahedra have mean edge
 /// `min_cell · 2^J ≥ max_cell`, so `3J` bisection levels reach `min_cell`.
 pub fn lattice_for(model: &Model, rule: &SizeRule) -> Result<Lattice, ExportError> {
-    let b = model.bbox();
-    if !b.is_finite() || b.is_empty() {
-        return Err(ExportError::param(
-            "design",
-            "the design is empty or unbounded (clip Tile or TPMS with a bounded shape)",
-        ));
-    }
+    let b = crate::design::bounded_box(model)?;
     let j = (rule.max_cell() / rule.min_cell())
         .log2()
         .ceil()

@@ -48,13 +48,10 @@ pub enum GridError {
     },
 }
 
-impl Grid {
-    /// The grid of `voxel`-sized cells covering `bbox` (count = ceil(extent /
-    /// voxel), at least 1, centred on the box).
-    pub fn covering(bbox: &Aabb, voxel: DVec3, max_voxels: u128) -> Result<Grid, GridError> {
-        if !(voxel.cmpgt(DVec3::ZERO).all() && voxel.is_finite()) {
-            return Err(GridError::BadVoxel(voxel));
-        }
+impl GridError {
+    /// `Empty` or `Unbounded` for a box no grid can cover, so every export
+    /// (grids, and the FEA tetrahedra, which need no grid) words them alike.
+    pub fn check_box(bbox: &Aabb) -> Result<(), GridError> {
         if bbox.is_empty() {
             return Err(GridError::Empty);
         }
@@ -65,6 +62,18 @@ impl Grid {
                 bbox.max.to_array()
             )));
         }
+        Ok(())
+    }
+}
+
+impl Grid {
+    /// The grid of `voxel`-sized cells covering `bbox` (count = ceil(extent /
+    /// voxel), at least 1, centred on the box).
+    pub fn covering(bbox: &Aabb, voxel: DVec3, max_voxels: u128) -> Result<Grid, GridError> {
+        if !(voxel.cmpgt(DVec3::ZERO).all() && voxel.is_finite()) {
+            return Err(GridError::BadVoxel(voxel));
+        }
+        GridError::check_box(bbox)?;
         let n = (bbox.size() / voxel).ceil().max(DVec3::ONE);
         let (nx, ny, nz) = (n.x as u128, n.y as u128, n.z as u128);
         let voxels = nx * ny * nz;
