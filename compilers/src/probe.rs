@@ -30,6 +30,8 @@ pub struct Probe {
     /// Area of the part's faces on its bounding box (mm²): planar, so a
     /// mesh export merges them into few triangles.
     pub flat_mm2: f64,
+    /// The probe's voxel (mm): parts thinner than this may be missed.
+    pub cell: DVec3,
 }
 
 /// Probe `model` over its bounding box with voxels no finer than `voxel`.
@@ -93,6 +95,7 @@ pub fn probe(model: &Model, voxel: DVec3) -> Probe {
         surface_mm2: area(crossings) * 2.0 / 3.0,
         // Axis-aligned: the cuberille area is the true area.
         flat_mm2: area(on_box),
+        cell: h,
     }
 }
 

@@ -13,6 +13,7 @@ use volcad_compilers::fea::{Element, FeaParams, Sizing, StepParams};
 use volcad_compilers::job::{self, design_hash};
 use volcad_compilers::mesh::{MeshFormats, MeshParams, SegmentBy};
 use volcad_compilers::png_stack::{self, Dither, PngParams};
+use volcad_compilers::resources::check_disk;
 
 use super::DesignArgs;
 use super::design::load_design;
@@ -283,6 +284,14 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
                 est.disk_bytes as f64 / 1e6,
                 est.memory_bytes as f64 / 1e6
             );
+            // This estimate sampled layers at the voxel size; the export
+            // checks up front by its coarse probe only (and again, exactly,
+            // before it writes), so the disk is checked here too.
+            let folder = dest
+                .parent()
+                .filter(|d| !d.as_os_str().is_empty())
+                .unwrap_or(Path::new("."));
+            check_disk(est.disk_bytes, folder, "a larger voxel size")?;
             job::spawn(dest, hash, move |ctx| {
                 volcad_compilers::mesh::export_meshes(&model, &p, ctx)
             })

@@ -269,6 +269,11 @@ impl Contourer {
         Some(lo)
     }
 
+    /// Triangles made so far (flat regions are triangulated by `finish`).
+    pub fn triangles(&self) -> usize {
+        self.meshes.iter().map(|m| m.triangles.len()).sum()
+    }
+
     /// Index in `label`'s mesh of vertex `v` (added when new), for the
     /// cube layer above plane `pz`.
     fn index_of(&mut self, pz: usize, label: u16, v: VRef) -> u32 {

@@ -15,7 +15,7 @@ pub(crate) fn model(src: &str) -> Model {
 /// Segment meshes of `m` through a plan that `adjust` changes first (the
 /// switches tests compare).
 fn built(m: &Model, p: &MeshParams, adjust: impl Fn(&mut Plan)) -> Vec<SegmentMesh> {
-    let mut pl = plan(m, p).expect("plan");
+    let mut pl = plan(m, p, Look::Probe).expect("plan");
     adjust(&mut pl);
     build(m, p, &pl, &AtomicBool::new(false), &|_, _| {}).expect("build")
 }
@@ -55,15 +55,27 @@ fn triangle_estimates_are_within_twice_the_count() {
     let cube = model(r#"RectPrism(Vec3(0,0,0), Vec3(10,10,10), m.id("red"))"#);
     let bar = graded_bar();
     let ball = model(r#"Sphere(Vec3(0,0,0), 5, m.id("red"))"#);
+    // Wires 0.12 mm across and 0.5 mm probe cells: most of them fall
+    // between the probe's samples, which saw a seventh of the triangles
+    // (and a fifth of the bunny lattice's), the sampled layers all of them.
+    let wires = model(
+        r#"let u = Union();
+        for k in 0..20 {
+            let y = -9.0 + k * 0.93;
+            u.add_child(Strut(Vec3(-10.0, y, 0.0), Vec3(10.0, y, 0.0), 0.06, m.id("gray")));
+        }
+        u"#,
+    );
     let red = bar.table().id("red").expect("red");
     let cancel = AtomicBool::new(false);
-    for (name, m, by, segments) in [
-        ("cube", &cube, SegmentBy::Dominant, 1),
-        ("bar", &bar, SegmentBy::Dominant, 1),
-        ("bar in 4", &bar, SegmentBy::Material(red), 4),
-        ("sphere", &ball, SegmentBy::Dominant, 1),
+    for (name, m, by, segments, voxel) in [
+        ("cube", &cube, SegmentBy::Dominant, 1, 0.1),
+        ("bar", &bar, SegmentBy::Dominant, 1, 0.1),
+        ("bar in 4", &bar, SegmentBy::Material(red), 4, 0.1),
+        ("sphere", &ball, SegmentBy::Dominant, 1, 0.1),
+        ("wires", &wires, SegmentBy::Dominant, 1, 0.04),
     ] {
-        let p = params(0.1, by, segments);
+        let p = params(voxel, by, segments);
         let est = estimate_mesh(m, &p).expect("estimate").triangles as f64;
         let made: usize = segment_meshes(m, &p, &cancel, |_, _| {})
             .expect("meshes")
@@ -151,7 +163,7 @@ fn uniform_tiles_are_used_and_agree_on_labels() {
         SegmentBy::Material(bar.table().id("red").expect("red")),
         4,
     );
-    let pl = plan(&bar, &p).expect("plan");
+    let pl = plan(&bar, &p, Look::Probe).expect("plan");
     let dims = pl.grid.dims;
     let test = |b: &[volcad_core::interval::Interval]| pl.classifier.uniform(b);
     let fast = Sampler::new(&bar, pl.grid, true).with_uniform(&test);
@@ -230,7 +242,7 @@ fn blocks_through_layers_agree_on_labels() {
             by,
             ..MeshParams::default()
         };
-        let pl = plan(&m, &p).expect("plan");
+        let pl = plan(&m, &p, Look::Probe).expect("plan");
         let dims = pl.grid.dims;
         let test = |b: &[volcad_core::interval::Interval]| pl.classifier.uniform(b);
         let plain = Sampler::new(&m, pl.grid, true);
