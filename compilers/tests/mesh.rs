@@ -409,6 +409,15 @@ fn bad_input_is_refused_naming_the_parameter() {
         ..params(0.5, 2, SegmentBy::Dominant)
     });
     assert!(e.starts_with("--format:"), "{e}");
+    // 40 billion voxels a layer: refused for memory, without sampling
+    // layers for the estimate first.
+    let plate = model(
+        r#"let m = default_materials(); RectPrism(Vec3(0,0,0), Vec3(2000, 2000, 1), m.id("red"))"#,
+    );
+    let e = estimate_mesh(&plate, &params(0.01, 2, SegmentBy::Dominant))
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("--voxel:") && e.contains("memory"), "{e}");
     let tile = model(
         r#"let m = default_materials(); Tile(GraphLattice(LatticeType::BodyCenteredCubic, Vec3(5,5,5), 0.5, m.id("red")))"#,
     );

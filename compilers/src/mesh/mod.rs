@@ -298,13 +298,18 @@ fn plan(model: &Model, p: &MeshParams, look: Look) -> Result<Plan, ExportError> 
     // its own).
     let flat_triangles = FLAT_TRIANGLES_PER_EDGE * (pr.flat_mm2 / face).sqrt() * more;
     let probed = pr.surface_mm2 * more / face * TRIANGLES_PER_FACE;
-    // Sampled layers see what the probe's cells are too coarse for.
-    let sampled =
-        if look == Look::Layers && pr.cell.max_element() > SAMPLE_BEYOND * p.voxel.min_element() {
-            sampled_triangles(model, grid, &classifier) as f64
-        } else {
-            0.0
-        };
+    // Sampled layers see what the probe's cells are too coarse for. Two
+    // layers and their planes must fit the slab budget: a grid whose layer
+    // alone outgrows memory is refused below, not sampled first.
+    let pair_bytes = 2 * layer * (4 + 4 * k + 2 + 4 + 4 * stride);
+    let sampled = if look == Look::Layers
+        && pr.cell.max_element() > SAMPLE_BEYOND * p.voxel.min_element()
+        && pair_bytes <= SLAB_BUDGET
+    {
+        sampled_triangles(model, grid, &classifier) as f64
+    } else {
+        0.0
+    };
     let triangles = (probed.max(sampled) + flat_triangles) as u64;
     // Meshes: 12 B per triangle, ~½ vertex per triangle at 12 B + map entry.
     let mesh_bytes = triangles * 12 + triangles / 2 * 40;
