@@ -389,6 +389,64 @@ fn png_export_cancels_cleanly_and_completes_with_a_manifest() {
     assert_eq!(manifest["kind"], "png");
 }
 
+/// Files in `dir` whose names end with `ext`.
+fn count_ext(dir: &Path, ext: &str) -> usize {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .filter(|e| e.file_name().to_string_lossy().ends_with(ext))
+        .count()
+}
+
+/// Clicks an export's Start button and steps until its job ends; it must
+/// end done.
+fn export_to_the_end(h: &mut Harness<'static, StudioApp>, button: &str) {
+    h.get_by_label(button).click();
+    wait_for(h, "the export", |a| {
+        matches!(job_state(a), Some("done" | "failed" | "cancelled"))
+    });
+    assert_eq!(job_state(h.state()), Some("done"), "{button}");
+}
+
+#[test]
+fn mesh_and_fea_exports_run_from_their_panels() {
+    let (scratch, mut h) = studio(BAR, "mesh-fea");
+    let dir = scratch.path();
+    wait_idle(&mut h);
+
+    // Segmented meshes by dominant material (red and blue), every format.
+    h.get_by_label("Meshes / 3MF").click();
+    h.run_steps(2);
+    let meshes = dir.join("meshes");
+    set_output_folder(&mut h, &meshes);
+    let est = wait_label(&mut h, "Estimate:");
+    assert!(
+        est.contains("2 segments") && est.contains("triangles"),
+        "{est}"
+    );
+    export_to_the_end(&mut h, "Export Meshes / 3MF");
+    assert_eq!(count_ext(&meshes, ".stl"), 2);
+    assert_eq!(count_ext(&meshes, ".obj"), 2);
+    assert!(meshes.join("segments.3mf").is_file());
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(meshes.join("manifest.json")).unwrap())
+            .unwrap();
+    assert_eq!(manifest["kind"], "mesh");
+
+    // An FEA deck of tetrahedra (the panel's default).
+    h.get_by_label("FEA (.inp)").click();
+    h.run_steps(2);
+    let fea = dir.join("fea");
+    set_output_folder(&mut h, &fea);
+    let est = wait_label(&mut h, "elements");
+    assert!(est.contains(".inp"), "{est}");
+    export_to_the_end(&mut h, "Export FEA (.inp)");
+    assert_eq!(count_ext(&fea, ".inp"), 1);
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(fea.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(manifest["kind"], "fea");
+}
+
 fn percentile(v: &[f64], p: f64) -> f64 {
     let mut s = v.to_vec();
     s.sort_by(f64::total_cmp);
