@@ -340,6 +340,34 @@ fn j750_preset_estimate() {
     assert!(e.memory_bytes > 0 && e.disk_bytes > 0);
 }
 
+/// The disk estimate codes and encodes a few layers as the export does:
+/// a tiled lattice's layers (thin struts, many edges) compress far worse
+/// than the rule of thumb for one material assumed, which said a tenth of
+/// what the stack took.
+#[test]
+fn the_disk_estimate_is_close_to_the_stack() {
+    let lattice = model(
+        r#"let m = default_materials();
+        let cell = GraphLattice(LatticeType::BodyCenteredCubic, Vec3(4, 4, 4), 0.4, m.id("gray"));
+        Intersection(false, [Tile(cell), Sphere(Vec3(0, 0, 0), 8, m.id("gray"))])"#,
+    );
+    for (name, m) in [("lattice", &lattice), ("graded bar", &model(GRADED_BAR))] {
+        let p = params(0.1, Dither::Random);
+        let est = estimate(m, &p).unwrap().disk_bytes as f64;
+        let dir = tmp();
+        let dest = dir.path().join("s");
+        export(m, &p, &dest).unwrap();
+        let made: u64 = std::fs::read_dir(&dest)
+            .unwrap()
+            .flatten()
+            .filter(|e| e.file_name().to_string_lossy().ends_with(".png"))
+            .map(|e| e.metadata().unwrap().len())
+            .sum();
+        let ratio = est / made as f64;
+        assert!((0.8..1.5).contains(&ratio), "{name}: {est} for {made}");
+    }
+}
+
 /// A design of one material everywhere is sliced from signs alone (no
 /// fractions, no picks): every pixel is that material exactly where the
 /// voxel's centre is inside, with either dither.

@@ -243,6 +243,7 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
                 est.disk_bytes as f64 / 1e6,
                 est.memory_bytes as f64 / 1e6
             );
+            check_disk(est.disk_bytes, out_folder(&dest), "a larger voxel size")?;
             job::spawn(dest, hash, move |ctx| {
                 png_stack::export_png_stack(&model, &p, ctx)
             })
@@ -284,14 +285,7 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
                 est.disk_bytes as f64 / 1e6,
                 est.memory_bytes as f64 / 1e6
             );
-            // This estimate sampled layers at the voxel size; the export
-            // checks up front by its coarse probe only (and again, exactly,
-            // before it writes), so the disk is checked here too.
-            let folder = dest
-                .parent()
-                .filter(|d| !d.as_os_str().is_empty())
-                .unwrap_or(Path::new("."));
-            check_disk(est.disk_bytes, folder, "a larger voxel size")?;
+            check_disk(est.disk_bytes, out_folder(&dest), "a larger voxel size")?;
             job::spawn(dest, hash, move |ctx| {
                 volcad_compilers::mesh::export_meshes(&model, &p, ctx)
             })
@@ -327,6 +321,16 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
         }
     };
     follow(handle, &interrupted)
+}
+
+/// The folder `--out` is made in, for disk checks. The estimates printed
+/// for slice stacks and meshes sample layers at the voxel size; the export
+/// jobs check up front by their coarse rules only (meshes check again,
+/// exactly, before writing), so the CLI checks with the closer figure.
+fn out_folder(dest: &Path) -> &Path {
+    dest.parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."))
 }
 
 /// A flag that Ctrl-C, SIGTERM and SIGHUP set, for [`follow`] to cancel the
