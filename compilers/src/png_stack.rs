@@ -49,7 +49,7 @@ use crate::job::{ExportError, JobContext, Summary};
 use crate::lazy_random;
 use crate::png_io::{self, bit_row_bytes};
 pub use crate::presets::{Preset, preset, presets};
-use crate::probe::probe;
+use crate::probe::{Look, probe, sampled_layers};
 use crate::resources::{check_disk, check_memory, run_with_threads};
 
 /// How each voxel's material is chosen from its fractions.
@@ -137,11 +137,11 @@ const MAX_SLAB_LAYERS: usize = 16;
 /// checks by the rule alone (the layers cost a few milliseconds, a sixth
 /// of the cube's 200³ stack).
 pub fn estimate(model: &Model, p: &PngParams) -> Result<Estimate, ExportError> {
-    estimate_with(model, p, true)
+    estimate_with(model, p, Look::Layers)
 }
 
-fn estimate_with(model: &Model, p: &PngParams, sample: bool) -> Result<Estimate, ExportError> {
-    palette(model)?;
+fn estimate_with(model: &Model, p: &PngParams, look: Look) -> Result<Estimate, ExportError> {
+    let pal = palette(model)?;
     let grid = grid_for(model, p.voxel, 0.0)?;
     let [nx, ny, nz] = grid.dims;
     let layers = match &p.layers {
@@ -201,10 +201,11 @@ fn estimate_with(model: &Model, p: &PngParams, sample: bool) -> Result<Estimate,
     // The rule above is rough (0.7 to 2.2 bytes a mixed voxel across the
     // examples); a few layers coded and encoded as the export does see
     // what it cannot.
-    let disk = match sample
-        .then(|| sampled_bytes(model, p, grid, &layers))
-        .flatten()
-    {
+    let sampled = match look {
+        Look::Layers => sampled_bytes(model, p, grid, &layers, &pal),
+        Look::Probe => None,
+    };
+    let disk = match sampled {
         Some(b) => disk.max(b as f64),
         None => disk,
     };
@@ -225,7 +226,7 @@ pub fn export_png_stack(
     p: &PngParams,
     ctx: &JobContext,
 ) -> Result<Summary, ExportError> {
-    let est = estimate_with(model, p, false)?;
+    let est = estimate_with(model, p, Look::Probe)?;
     check_disk(est.disk_bytes, ctx.folder(), "a larger voxel size")?;
     run_with_threads(p.threads, || write_stack(model, p, &est, ctx))
 }
@@ -419,21 +420,26 @@ const SAMPLED_LAYERS: usize = 3;
 /// layer below. How well a layer compresses depends on its colours and its
 /// mix: bytes per voxel went from 0.7 (the graded bar at 0.02 mm) to 2.2
 /// (the seat at 0.3 mm), which a rule of thumb cannot see.
-fn sampled_bytes(model: &Model, p: &PngParams, grid: Grid, layers: &Range<usize>) -> Option<u64> {
+fn sampled_bytes(
+    model: &Model,
+    p: &PngParams,
+    grid: Grid,
+    layers: &Range<usize>,
+    pal: &[[u8; 4]],
+) -> Option<u64> {
     let [nx, ny, _] = grid.dims;
     let k = model.materials().len();
     if nx * ny * (4 + 4 * k + 1 + 8) > SLAB_BUDGET {
         return None;
     }
-    let pal = palette(model).ok()?;
     let single = single_material_code(model);
     let sampler = stack_sampler(model, grid, single, false);
-    let picks = SAMPLED_LAYERS.min(layers.len());
     let mut slab = Slab::default();
     let mut codes = vec![0u8; nx * ny];
-    let mut bytes = 0usize;
-    for i in 0..picks {
-        let z = layers.start + (2 * i + 1) * layers.len() / (2 * picks);
+    let mut bits = Vec::new();
+    let (mut bytes, mut picks) = (0usize, 0usize);
+    for z in sampled_layers(layers.clone(), SAMPLED_LAYERS) {
+        picks += 1;
         sampler
             .sample_layers(
                 z,
@@ -443,10 +449,10 @@ fn sampled_bytes(model: &Model, p: &PngParams, grid: Grid, layers: &Range<usize>
             )
             .ok()?;
         pick_codes(model, grid, p.seed, single, z, &slab, &mut codes);
-        bytes += rgba_png(nx, ny, &codes, &pal).ok()?.len();
+        bytes += rgba_png(nx, ny, &codes, pal).ok()?.len();
         if p.per_material_bitmaps {
             for code in 1..=k as u8 {
-                bytes += bitmap_png(nx, ny, &codes, code).ok()?.len();
+                bytes += bitmap_png(nx, ny, &codes, code, &mut bits).ok()?.len();
             }
         }
     }
@@ -477,9 +483,17 @@ fn rgba_png(
 }
 
 /// The layer's 1-bit PNG of material `code`: white where the voxel is it.
-fn bitmap_png(nx: usize, ny: usize, codes: &[u8], code: u8) -> Result<Vec<u8>, png::EncodingError> {
+/// `bits` is scratch space, reused for a layer's several materials.
+fn bitmap_png(
+    nx: usize,
+    ny: usize,
+    codes: &[u8],
+    code: u8,
+    bits: &mut Vec<u8>,
+) -> Result<Vec<u8>, png::EncodingError> {
     let rb = bit_row_bytes(nx);
-    let mut bits = vec![0u8; rb * ny];
+    bits.clear();
+    bits.resize(rb * ny, 0);
     for (j, row) in codes.chunks_exact(nx).enumerate() {
         let out = &mut bits[(ny - 1 - j) * rb..(ny - j) * rb];
         for (x, c) in row.iter().enumerate() {
@@ -488,7 +502,7 @@ fn bitmap_png(nx: usize, ny: usize, codes: &[u8], code: u8) -> Result<Vec<u8>, p
             }
         }
     }
-    png_io::encode_bits(nx, ny, &bits)
+    png_io::encode_bits(nx, ny, bits)
 }
 
 /// Colour, encode and write layer `z` from its codes; count its materials.
@@ -513,10 +527,11 @@ fn write_layer(
         .map_err(|e| ExportError::Other(format!("{}: PNG encoding: {e}", path.display())))?;
     std::fs::write(&path, bytes).map_err(|e| ExportError::io(&path, e))?;
     let mut files = vec![name.clone()];
+    let mut bits = Vec::new();
     for f in folders {
         let rel = format!("{}/{name}", f.dir);
         let path = ctx.staging().join(&f.dir).join(&name);
-        let bytes = bitmap_png(nx, ny, codes, f.slot as u8 + 1)
+        let bytes = bitmap_png(nx, ny, codes, f.slot as u8 + 1, &mut bits)
             .map_err(|e| ExportError::Other(format!("{}: PNG encoding: {e}", path.display())))?;
         std::fs::write(&path, bytes).map_err(|e| ExportError::io(&path, e))?;
         files.push(rel);

@@ -9,6 +9,7 @@
 //! surface, about 3/2 of the true area for a surface with random
 //! orientation, so the sum is scaled by 2/3.
 
+use std::ops::Range;
 use std::sync::atomic::AtomicBool;
 
 use glam::DVec3;
@@ -17,6 +18,27 @@ use volcad_core::sampler::{Grid, Sampler, Slab};
 
 /// Samples per axis of the probe grid (at most).
 pub const PROBE_CELLS: usize = 40;
+
+/// How closely an export's estimate looks at the design.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Look {
+    /// The coarse probe and rules of thumb only (about a millisecond): what
+    /// an export job checks up front.
+    Probe,
+    /// Also a few layers sampled at the export's own voxel size and run
+    /// through its next steps (meshes contour them, slice stacks encode
+    /// them): what the estimates shown before an export use, and the CLI
+    /// checks with. Parts thinner than the probe's cells, and layers that
+    /// compress worse than the rule says, show there.
+    Layers,
+}
+
+/// Layers an estimate samples: the middles of `picks` equal stretches of
+/// `layers` (fewer when the range is shorter).
+pub fn sampled_layers(layers: Range<usize>, picks: usize) -> impl Iterator<Item = usize> {
+    let picks = picks.min(layers.len());
+    (0..picks).map(move |i| layers.start + (2 * i + 1) * layers.len() / (2 * picks))
+}
 
 /// What the probe saw.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -102,6 +124,14 @@ pub fn probe(model: &Model, voxel: DVec3) -> Probe {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sampled_layers_are_middles_of_equal_stretches() {
+        assert_eq!(sampled_layers(0..99, 3).collect::<Vec<_>>(), [16, 49, 82]);
+        assert_eq!(sampled_layers(10..12, 3).collect::<Vec<_>>(), [10, 11]);
+        assert_eq!(sampled_layers(5..6, 3).collect::<Vec<_>>(), [5]);
+        assert_eq!(sampled_layers(4..4, 3).count(), 0);
+    }
 
     #[test]
     fn sphere_probe_is_about_right() {

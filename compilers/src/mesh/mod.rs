@@ -58,7 +58,7 @@ pub use indexed::{EdgeReport, IndexedMesh};
 use crate::design::{grid_for, palette};
 use crate::job::{ExportError, JobContext, Summary};
 use crate::png_io::folder_name;
-use crate::probe::probe;
+use crate::probe::{Look, probe, sampled_layers};
 use crate::resources::{MemoryGuard, check_disk, check_memory, human_bytes, run_with_threads};
 use contour::{Contourer, Plane};
 use segment::{Classifier, Tally};
@@ -228,19 +228,6 @@ enum Flat {
     /// Merged, and every region contoured by its fallback.
     #[cfg_attr(not(test), allow(dead_code))]
     FallbackOnly,
-}
-
-/// How closely [`plan`] looks at the design before estimating triangles.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Look {
-    /// The coarse probe only: what an export checks up front (about one
-    /// millisecond; the exact sizes are checked again before writing).
-    Probe,
-    /// The probe and a few layers sampled at the export's voxel size
-    /// (`sampled_triangles`): what the estimates shown before an export
-    /// use. It costs about as much as six layers of the export (on the
-    /// graded bar and the cube at 10 M voxels, 6 % of the export).
-    Layers,
 }
 
 fn plan(model: &Model, p: &MeshParams, look: Look) -> Result<Plan, ExportError> {
@@ -414,12 +401,10 @@ fn sampled_triangles(model: &Model, grid: Grid, classifier: &Classifier) -> u64 
     }
     let uniform = |b: &[volcad_core::interval::Interval]| classifier.uniform(b);
     let sampler = sampler_for(model, grid, Some(&uniform));
-    let picks = SAMPLED_LAYERS.min(layers);
     let mut slab = Slab::default();
-    let mut made = 0;
-    for i in 0..picks {
-        // Middles of equal stretches of the layers.
-        let z = (2 * i + 1) * layers / (2 * picks);
+    let (mut made, mut picks) = (0, 0);
+    for z in sampled_layers(0..layers, SAMPLED_LAYERS) {
+        picks += 1;
         if sampler
             .sample_layers(z, z + 2, &mut slab, &AtomicBool::new(false))
             .is_err()
@@ -431,7 +416,7 @@ fn sampled_triangles(model: &Model, grid: Grid, classifier: &Classifier) -> u64 
         contourer.push_plane(1, classifier.plane(&slab, 1, dims, z + 1).0);
         made += contourer.triangles();
     }
-    (made as f64 * layers as f64 / picks as f64) as u64
+    (made as f64 * layers as f64 / picks.max(1) as f64) as u64
 }
 
 fn build(

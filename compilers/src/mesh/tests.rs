@@ -3,6 +3,7 @@
 use volcad_core::script::{ScriptOptions, model_of, model_of_file};
 
 use super::*;
+use crate::probe::Look;
 use std::sync::atomic::Ordering;
 
 /// `src` after `let m = default_materials();`, run and prepared (shared
