@@ -169,6 +169,18 @@ pub fn check_disk(needed: u64, dir: &Path, coarser: &str) -> Result<(), ExportEr
     Ok(())
 }
 
+/// [`check_disk`] for an export into `dest` (which need not exist yet): the
+/// disk of the folder it is made in. The CLI and the studio check with the
+/// estimates they show (which sample layers at the voxel size) before they
+/// start a job, whose own up-front check goes by coarser rules.
+pub fn check_disk_for(needed: u64, dest: &Path, coarser: &str) -> Result<(), ExportError> {
+    let folder = dest
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    check_disk(needed, folder, coarser)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -211,5 +223,12 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("--out: the output needs about"), "{e}");
+        // A destination not made yet is checked on its folder's disk.
+        let tmp = std::env::temp_dir();
+        let e = check_disk_for(u64::MAX / 2, &tmp.join("not-yet"), "a larger voxel size")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(&format!("disk of {}", tmp.display())), "{e}");
+        assert!(check_disk_for(1, &tmp.join("not-yet"), "x").is_ok());
     }
 }

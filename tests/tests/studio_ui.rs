@@ -447,6 +447,28 @@ fn mesh_and_fea_exports_run_from_their_panels() {
     assert_eq!(manifest["kind"], "fea");
 }
 
+#[test]
+fn an_export_larger_than_the_disk_is_not_started() {
+    let (scratch, mut h) = studio(BAR, "disk");
+    wait_idle(&mut h);
+    // The bar at 1 µm: 7.5·10¹¹ voxels, some 500 GB of PNGs, more than
+    // this disk holds; each layer still fits in memory.
+    let out = scratch.path().join("huge");
+    set_output_folder(&mut h, &out);
+    set_png_voxel(&mut h, 0.001);
+    let est = wait_label(&mut h, "Estimate: 15000 ×");
+    assert!(est.contains("GiB on disk"), "{est}");
+    h.get_by_label("Export PNG stack").click();
+    h.run_steps(2);
+    assert!(h.state().jobs().list().is_empty(), "no job starts");
+    let log = h.state().log_lines().join("\n");
+    assert!(
+        log.contains("PNG stack export not started: --out: the output needs about"),
+        "{log}"
+    );
+    assert!(!out.exists());
+}
+
 fn percentile(v: &[f64], p: f64) -> f64 {
     let mut s = v.to_vec();
     s.sort_by(f64::total_cmp);

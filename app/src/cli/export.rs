@@ -13,7 +13,7 @@ use volcad_compilers::fea::{Element, FeaParams, Sizing, StepParams};
 use volcad_compilers::job::{self, design_hash};
 use volcad_compilers::mesh::{MeshFormats, MeshParams, SegmentBy};
 use volcad_compilers::png_stack::{self, Dither, PngParams};
-use volcad_compilers::resources::check_disk;
+use volcad_compilers::resources::check_disk_for;
 
 use super::DesignArgs;
 use super::design::load_design;
@@ -243,7 +243,7 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
                 est.disk_bytes as f64 / 1e6,
                 est.memory_bytes as f64 / 1e6
             );
-            check_disk(est.disk_bytes, out_folder(&dest), "a larger voxel size")?;
+            check_disk_for(est.disk_bytes, &dest, "a larger voxel size")?;
             job::spawn(dest, hash, move |ctx| {
                 png_stack::export_png_stack(&model, &p, ctx)
             })
@@ -285,7 +285,7 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
                 est.disk_bytes as f64 / 1e6,
                 est.memory_bytes as f64 / 1e6
             );
-            check_disk(est.disk_bytes, out_folder(&dest), "a larger voxel size")?;
+            check_disk_for(est.disk_bytes, &dest, "a larger voxel size")?;
             job::spawn(dest, hash, move |ctx| {
                 volcad_compilers::mesh::export_meshes(&model, &p, ctx)
             })
@@ -321,16 +321,6 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
         }
     };
     follow(handle, &interrupted)
-}
-
-/// The folder `--out` is made in, for disk checks. The estimates printed
-/// for slice stacks and meshes sample layers at the voxel size; the export
-/// jobs check up front by their coarse rules only (meshes check again,
-/// exactly, before writing), so the CLI checks with the closer figure.
-fn out_folder(dest: &Path) -> &Path {
-    dest.parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."))
 }
 
 /// A flag that Ctrl-C, SIGTERM and SIGHUP set, for [`follow`] to cancel the

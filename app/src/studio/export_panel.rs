@@ -18,7 +18,7 @@ use volcad_compilers::fea::{Element, FeaParams, Sizing, StepParams};
 use volcad_compilers::job::{self, design_hash};
 use volcad_compilers::mesh::{MeshFormats, MeshParams, SegmentBy};
 use volcad_compilers::png_stack::{self, Dither, PngParams};
-use volcad_compilers::resources::human_bytes;
+use volcad_compilers::resources::{check_disk_for, human_bytes};
 use volcad_core::Model;
 
 use super::jobs::{Jobs, fresh_destination};
@@ -80,7 +80,7 @@ struct EstimateWorker {
     key: Option<(usize, Params)>,
     /// Number of the newest request; only its answer is shown.
     seq: u64,
-    text: Option<Result<String, String>>,
+    text: Option<Result<Estimated, String>>,
     link: Option<WorkerLink>,
 }
 
@@ -95,7 +95,7 @@ struct EstimateRequest {
 /// The worker's two channels (the worker ends when `jobs` is dropped).
 struct WorkerLink {
     jobs: Sender<EstimateRequest>,
-    answers: Receiver<(u64, Result<String, String>)>,
+    answers: Receiver<(u64, Result<Estimated, String>)>,
     /// Estimates computed (read by tests).
     #[cfg_attr(not(test), allow(dead_code))]
     computed: Arc<AtomicUsize>,
@@ -167,39 +167,57 @@ impl EstimateWorker {
     }
 }
 
-fn estimate(model: &Model, p: &Params) -> Result<String, String> {
+/// An estimate as the panel shows it, and the output size to check the
+/// disk with before a job starts (slice stacks and meshes; an FEA export
+/// checks its deck's size once its mesh is built).
+#[derive(Clone, Debug, PartialEq)]
+struct Estimated {
+    text: String,
+    disk_bytes: Option<u64>,
+}
+
+fn estimate(model: &Model, p: &Params) -> Result<Estimated, String> {
     let e = |e: volcad_compilers::ExportError| e.to_string();
     Ok(match p {
         Params::Png(p) => {
             let est = png_stack::estimate(model, p).map_err(e)?;
             let [nx, ny, nz] = est.grid.dims;
-            format!(
-                "{nx} × {ny} × {nz} voxels ({:.3e}), {} files, about {} on disk, {} memory",
-                est.voxels as f64,
-                est.files,
-                human_bytes(est.disk_bytes),
-                human_bytes(est.memory_bytes)
-            )
+            Estimated {
+                text: format!(
+                    "{nx} × {ny} × {nz} voxels ({:.3e}), {} files, about {} on disk, {} memory",
+                    est.voxels as f64,
+                    est.files,
+                    human_bytes(est.disk_bytes),
+                    human_bytes(est.memory_bytes)
+                ),
+                disk_bytes: Some(est.disk_bytes),
+            }
         }
         Params::Mesh(p) => {
             let est = volcad_compilers::mesh::estimate_mesh(model, p).map_err(e)?;
             let [nx, ny, nz] = est.grid.dims;
-            format!(
-                "{nx} × {ny} × {nz} voxels ({:.3e}), {} segments, about {} triangles, {} on disk",
-                est.voxels as f64,
-                est.segments,
-                est.triangles,
-                human_bytes(est.disk_bytes)
-            )
+            Estimated {
+                text: format!(
+                    "{nx} × {ny} × {nz} voxels ({:.3e}), {} segments, about {} triangles, {} on disk",
+                    est.voxels as f64,
+                    est.segments,
+                    est.triangles,
+                    human_bytes(est.disk_bytes)
+                ),
+                disk_bytes: Some(est.disk_bytes),
+            }
         }
         Params::Fea(p) => {
             let est = volcad_compilers::fea::estimate_fea(model, p).map_err(e)?;
-            format!(
-                "about {} elements, {} nodes, {} .inp",
-                est.elements,
-                est.nodes,
-                human_bytes(est.file_bytes)
-            )
+            Estimated {
+                text: format!(
+                    "about {} elements, {} nodes, {} .inp",
+                    est.elements,
+                    est.nodes,
+                    human_bytes(est.file_bytes)
+                ),
+                disk_bytes: None,
+            }
         }
     })
 }
@@ -315,7 +333,7 @@ impl ExportPanels {
                 });
             }
             Some(Ok(t)) => {
-                ui.label(egui::RichText::new(format!("Estimate: {t}")).small());
+                ui.label(egui::RichText::new(format!("Estimate: {}", t.text)).small());
             }
             Some(Err(e)) => {
                 ui.colored_label(ui.visuals().error_fg_color, e);
@@ -331,9 +349,23 @@ impl ExportPanels {
             ok,
             egui::Button::new(format!("Export {}", self.kind.title())),
         );
+        let disk_bytes = match &self.estimate.text {
+            Some(Ok(t)) => t.disk_bytes,
+            _ => None,
+        };
+        // The job's own up-front check goes by coarser rules (see
+        // `check_disk_for`); this estimate sampled layers at the voxel size.
+        let room = |dest: &Path| {
+            disk_bytes.map_or(Ok(()), |b| {
+                check_disk_for(b, dest, "a larger voxel size").map_err(|e| e.to_string())
+            })
+        };
         if start.clicked()
             && let Some(dest) = dest
         {
+            if let Err(e) = room(&dest) {
+                return Action::Log(format!("{} export not started: {e}", self.kind.title()));
+            }
             let hash = design_hash(&[source.as_bytes()]);
             let model = model.clone();
             let handle = match self.params() {
@@ -650,7 +682,12 @@ mod tests {
             std::thread::sleep(std::time::Duration::from_millis(5));
             w.update(&ctx, &model, &mesh(0.2));
         }
-        let text = w.text.clone().expect("an answer").expect("an estimate");
+        let text = w
+            .text
+            .clone()
+            .expect("an answer")
+            .expect("an estimate")
+            .text;
         // 20 mm at 0.2 mm, padded by a voxel on every side.
         assert!(text.starts_with("102 × 102 × 102 voxels"), "{text}");
         let computed = w.link.as_ref().unwrap().computed.load(Ordering::Relaxed);
