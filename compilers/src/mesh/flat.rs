@@ -37,8 +37,6 @@
 //! takes those again ([`SampleAt`]); its outline points keep the positions
 //! its neighbours share, so it stays closed whatever the samples.
 
-use std::collections::HashMap;
-
 use glam::DVec3;
 use rayon::prelude::*;
 use volcad_core::fastmath::round_i32;
@@ -47,7 +45,7 @@ use super::contour::Cube;
 use super::indexed::IndexedMesh;
 use super::interface::{Interface, cut_field, front_back};
 use super::outline::triangulate;
-use super::vertex_keys::Tri;
+use super::vertex_keys::{FastMap, Tri};
 
 /// Largest deviation of an edge difference from its axis mean, relative to
 /// `|Δx| + |Δy| + |Δz|`: a sphere of radius `R` sampled at `h` deviates by
@@ -217,7 +215,7 @@ pub(super) struct Regions {
     keys: Vec<KeyId>,
     /// The distinct keys, by id, and their ids.
     table: Vec<FlatKey>,
-    ids: HashMap<FlatKey, KeyId>,
+    ids: FastMap<FlatKey, KeyId>,
     /// Kept cubes by band, with the id of each band's first cube.
     kept: Vec<(u32, KeptCubes)>,
     edges: Vec<Edge>,
@@ -233,7 +231,7 @@ impl Regions {
             parent: Vec::new(),
             keys: Vec::new(),
             table: Vec::new(),
-            ids: HashMap::new(),
+            ids: FastMap::default(),
             kept: Vec::new(),
             edges: Vec::new(),
             stride,
@@ -394,7 +392,7 @@ impl Regions {
             match t {
                 Some(t) => {
                     if y != 0 {
-                        let to_y: HashMap<u32, u32> = r
+                        let to_y: FastMap<u32, u32> = r
                             .edges
                             .iter()
                             .map(|e| &self.edges[*e as usize])
@@ -421,7 +419,7 @@ impl Regions {
         tris: &mut Vec<Tri>,
     ) {
         let (x, y) = (r.key.x, r.key.y);
-        let mut map: HashMap<(u16, u64), u32> = HashMap::new();
+        let mut map: FastMap<(u16, u64), u32> = FastMap::default();
         for e in r.edges.iter().map(|e| &self.edges[*e as usize]) {
             for k in 0..2 {
                 map.insert((x, e.keys[k]), e.xi[k]);

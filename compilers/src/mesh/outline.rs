@@ -11,7 +11,7 @@
 //! 10⁻⁹. A region that fails any check gets `None`, and [`super::flat`]
 //! contours it cube by cube with marching tetrahedra instead.
 
-use std::collections::HashMap;
+use super::vertex_keys::FastMap;
 
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 
@@ -39,7 +39,7 @@ pub(super) fn triangulate(
     };
     let (u, v) = ((drop + 1) % 3, (drop + 2) % 3);
     let len = outline.len();
-    let mut local: HashMap<u32, usize> = HashMap::with_capacity(len);
+    let mut local: FastMap<u32, usize> = FastMap::with_capacity_and_hasher(len, Default::default());
     let mut global = Vec::with_capacity(len);
     let mut pts = Vec::with_capacity(len);
     let mut edges = Vec::with_capacity(len);
@@ -54,7 +54,8 @@ pub(super) fn triangulate(
         }));
     }
     // Each outline edge once, in one direction.
-    let mut seen: HashMap<[usize; 2], ()> = HashMap::with_capacity(edges.len());
+    let mut seen: FastMap<[usize; 2], ()> =
+        FastMap::with_capacity_and_hasher(edges.len(), Default::default());
     for e in &edges {
         if e[0] == e[1] || seen.insert([e[0].min(e[1]), e[0].max(e[1])], ()).is_some() {
             return None;
