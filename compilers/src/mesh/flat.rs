@@ -72,10 +72,16 @@ pub(super) fn flat_key(voxel: DVec3, iface: Interface, cube: &Cube) -> Option<Fl
         return None;
     }
     let (x, y) = front_back(l0, other);
-    let mut g = [0.0; 8];
-    for (k, g) in g.iter_mut().enumerate() {
-        *g = cut_field(iface, x, y, cube.dist[k], cube.value[k])?;
-    }
+    // Next to void (the usual surface) the field is the distance.
+    let g: [f64; 8] = if y == 0 {
+        cube.dist.map(f64::from)
+    } else {
+        let mut g = [0.0; 8];
+        for (k, g) in g.iter_mut().enumerate() {
+            *g = cut_field(iface, x, y, cube.dist[k], cube.value[k])?;
+        }
+        g
+    };
     // Which side holds `g = 0` exactly, as the labels put it: inside for
     // distances (d ≤ 0), the upper range for ranges (⌊f·n⌋), the lower slot
     // for dominant ties.
