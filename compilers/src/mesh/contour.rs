@@ -41,7 +41,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use volcad_core::sampler::Grid;
 
-use super::flat::{FlatKey, KeptCubes, Regions, SampleAt, flat_key};
+use super::flat::{FlatKey, FlatMemo, KeptCubes, Regions, SampleAt};
 use super::indexed::IndexedMesh;
 use super::interface::{Interface, cut_field, front_back};
 use super::mixed::mixed_cubes;
@@ -331,6 +331,7 @@ impl Contourer {
         let mut out = Vec::with_capacity(tris);
         let mut flats = BandFlats::with_capacity(flat, self.grid.dims);
         let mut scratch = Scratch::default();
+        let mut memo = FlatMemo::default();
         for j in js {
             let rows = [
                 &lo.label[j * nx..(j + 1) * nx],
@@ -341,7 +342,7 @@ impl Contourer {
             for i in mixed_cubes(rows) {
                 let cube = self.cube([i, j, z], lo, hi);
                 if self.merge
-                    && let Some(key) = flat_key(self.grid.voxel, self.iface, &cube)
+                    && let Some(key) = memo.key(self.grid.voxel, self.iface, &cube)
                 {
                     let mask = corner_mask(&cube, key.x);
                     flats.at.push(([j, i], key, mask));
