@@ -217,7 +217,9 @@ impl Classifier {
             let fv = &fracs[x * k..(x + 1) * k];
             let (lab, f) = match last {
                 Some((u, lab, f)) if same_bits(&fracs[u * k..][..k], fv) => {
-                    copy_value(values, u, x, stride);
+                    if stride > 0 {
+                        copy_value(values, u, x, stride);
+                    }
                     (lab, f)
                 }
                 _ => self.classify(fv, &mut values[x * stride..(x + 1) * stride]),
@@ -304,7 +306,9 @@ impl Classifier {
                     let (lab, fv) = runs.classes[sp.rect];
                     let v = &runs.values[sp.rect * stride..(sp.rect + 1) * stride];
                     labels[a..b].fill(lab);
-                    fill_pattern(&mut values[a * stride..b * stride], v);
+                    if stride > 0 {
+                        fill_pattern(&mut values[a * stride..b * stride], v);
+                    }
                     if lab > 0 {
                         let n = (b - a) as u64;
                         t.voxels[lab as usize - 1] += n;
