@@ -313,7 +313,12 @@ impl Contourer {
             base: [i, j, z],
             label: std::array::from_fn(|c| plane(c).label[idx[c]]),
             dist: std::array::from_fn(|c| plane(c).dist[idx[c]]),
-            value: std::array::from_fn(|c| &plane(c).value[idx[c] * s..(idx[c] + 1) * s]),
+            // (One segment stores no values: nothing to slice.)
+            value: if s == 0 {
+                [&[]; 8]
+            } else {
+                std::array::from_fn(|c| &plane(c).value[idx[c] * s..(idx[c] + 1) * s])
+            },
         }
     }
 
