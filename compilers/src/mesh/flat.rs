@@ -495,8 +495,7 @@ mod tests {
     use glam::DVec3;
     use volcad_core::sampler::Grid;
 
-    use super::super::contour::Cube;
-    use super::super::contour::{Contourer, Plane};
+    use super::super::contour::{Contourer, Cube, Plane};
     use super::super::field::{border_void, contour_field};
     use super::super::indexed::{IndexedMesh, tri_set};
     use super::super::interface::Interface;
