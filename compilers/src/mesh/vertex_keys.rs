@@ -29,7 +29,12 @@ impl Hasher for KeyHasher {
     }
 
     fn write_u64(&mut self, k: u64) {
-        self.0 = k.wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(26);
+        // Mixed into the state (not replacing it), so a key's earlier parts
+        // count: `(label, key)` pairs of two labels and one key land apart.
+        // A lone u64 hashes as before (the state starts at 0).
+        self.0 = (self.0 ^ k)
+            .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            .rotate_left(26);
     }
 }
 
@@ -82,5 +87,27 @@ impl BandMesh {
             })
             .collect();
         BandMesh { verts, tris }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::hash::BuildHasher;
+
+    use super::*;
+
+    #[test]
+    fn every_part_of_a_key_counts_in_its_hash() {
+        let h = BuildHasherDefault::<KeyHasher>::default();
+        let key = 0x0123_4567_89ab_cdef_u64;
+        // A lone vertex key hashes as Fibonacci hashing of the key.
+        assert_eq!(
+            h.hash_one(key),
+            key.wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(26)
+        );
+        // The label of a (label, key) pair is not dropped by the key.
+        assert_ne!(h.hash_one((1u16, key)), h.hash_one((2u16, key)));
+        // Flat-region keys and outline edges go through the bytes.
+        assert_ne!(h.hash_one([3usize, 4]), h.hash_one([4usize, 3]));
     }
 }
