@@ -44,6 +44,7 @@ use volcad_core::sampler::Grid;
 use super::flat::{FlatKey, FlatMemo, KeptCubes, Regions, SampleAt};
 use super::indexed::IndexedMesh;
 use super::interface::{Interface, cut_field, front_back};
+use super::layer_dist::LayerDist;
 use super::mixed::mixed_cubes;
 use super::vertex_keys::{BandMesh, KeyMap};
 use super::vertex_keys::{Tri, VRef};
@@ -53,8 +54,8 @@ use super::vertex_keys::{Tri, VRef};
 pub struct Plane {
     /// 0 = void, 1.. = label.
     pub label: Vec<u16>,
-    /// Signed distance (mm).
-    pub dist: Vec<f32>,
+    /// Signed distance (mm): a layer of the sampled slab's buffer.
+    pub dist: LayerDist,
     /// Interface values, [`Interface::stride`] per sample.
     pub value: Vec<f32>,
 }
@@ -309,10 +310,11 @@ impl Contourer {
         let s = self.iface.stride();
         let idx: [usize; 8] = std::array::from_fn(|c| (j + (c >> 1 & 1)) * nx + i + (c & 1));
         let plane = |c: usize| if c & 4 == 0 { lo } else { hi };
+        let dist = [&*lo.dist, &*hi.dist];
         Cube {
             base: [i, j, z],
             label: std::array::from_fn(|c| plane(c).label[idx[c]]),
-            dist: std::array::from_fn(|c| plane(c).dist[idx[c]]),
+            dist: std::array::from_fn(|c| dist[c >> 2][idx[c]]),
             // (One segment stores no values: nothing to slice.)
             value: if s == 0 {
                 [&[]; 8]

@@ -29,7 +29,7 @@ pub(super) fn contour_field(mut c: Contourer, grid: &Grid, values: &[f32]) -> In
             z,
             Plane {
                 label,
-                dist,
+                dist: dist.into(),
                 value: Vec::new(),
             },
         );

@@ -628,7 +628,7 @@ mod tests {
                     z,
                     Plane {
                         label,
-                        dist: d,
+                        dist: d.into(),
                         value,
                     },
                 );

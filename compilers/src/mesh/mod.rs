@@ -32,6 +32,7 @@ mod field;
 mod flat;
 pub mod indexed;
 mod interface;
+mod layer_dist;
 mod mixed;
 pub mod obj;
 mod outline;
@@ -61,6 +62,7 @@ use crate::png_io::folder_name;
 use crate::probe::{Look, probe, sampled_layers};
 use crate::resources::{MemoryGuard, check_disk, check_memory, human_bytes, run_with_threads};
 use contour::{Contourer, Plane};
+use layer_dist::{DistPool, LayerDist};
 use segment::{Classifier, Tally};
 
 /// Infill percent from `f` when no expression is given.
@@ -306,8 +308,10 @@ fn plan(model: &Model, p: &MeshParams, look: Look) -> Result<Plan, ExportError> 
     let flat_cubes = (pr.flat_mm2 + pr.surface_mm2) * more / face;
     let flat_bytes = (flat_cubes * FLAT_CUBE_BYTES) as u64;
     // Planes: one slab being contoured, the next being labelled, and the
-    // contourer's previous plane.
-    let planes = ((2 * slab_layers + 1) * layer * (2 + 4 + 4 * stride)) as u64;
+    // contourer's previous plane; their distances are the slabs' buffers
+    // (three circulate: the one sampled into is in `per_layer`).
+    let planes =
+        ((2 * slab_layers + 1) * layer * (2 + 4 * stride) + 2 * slab_layers * layer * 4) as u64;
     let memory_bytes = (slab_layers * per_layer) as u64 + planes + mesh_bytes + flat_bytes;
     check_memory(
         memory_bytes,
@@ -439,11 +443,24 @@ fn build(
     };
     let mut tally = Tally::new(pl.classifier.segments());
     let mut slab = Slab::default();
-    // Sample and label one slab of planes, into retired planes' buffers.
+    let pool = std::sync::Mutex::new(DistPool::default());
+    // Sample and label one slab of planes, into retired planes' buffers;
+    // the planes share the slab's distances (see `layer_dist`).
     let labelled = |slab: &mut Slab, z0: usize, z1: usize, mut spare: Vec<Plane>| {
+        let lock = || {
+            pool.lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+        };
+        // Retired planes let go of their slab's buffer first, so it can
+        // come back (else every slab faulted in a fresh one).
+        for p in &mut spare {
+            p.dist = LayerDist::default();
+        }
+        slab.dist = lock().take();
         sampler
             .sample_layers(z0, z1, slab, cancel)
             .map_err(|_| ExportError::Cancelled)?;
+        let dist = lock().share(std::mem::take(&mut slab.dist));
         // Planes are labelled in parallel: on one thread this was a third
         // of a slab's time on the graded bar, with the other core idle
         // once it had contoured the previous slab.
@@ -453,7 +470,10 @@ fn build(
         let slab = &*slab;
         Ok::<_, ExportError>(
             jobs.into_par_iter()
-                .map(|(z, reuse)| pl.classifier.plane_into(slab, z - z0, dims, z, reuse))
+                .map(|(z, reuse)| {
+                    pl.classifier
+                        .plane_into(slab, &dist, z - z0, dims, z, reuse)
+                })
                 .collect::<Vec<_>>(),
         )
     };

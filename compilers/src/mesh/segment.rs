@@ -13,6 +13,8 @@
 //!
 //! Labels are `segment + 1` (0 = void), as [`super::contour`] takes them.
 
+use std::sync::Arc;
+
 use glam::DVec3;
 use rayon::prelude::*;
 use volcad_core::Model;
@@ -22,6 +24,7 @@ use volcad_core::sampler::{Slab, SolidRect, fill_pattern};
 
 use super::contour::Plane;
 use super::interface::Interface;
+use super::layer_dist::LayerDist;
 use crate::dither::{BOUND_MARGIN as EPS, MIN_TOTAL};
 
 /// How voxels are put into segments.
@@ -234,15 +237,18 @@ impl Classifier {
     /// The plane of labels for layer `l` of `slab` (grid `[nx, ny, nz]`,
     /// global layer `z`), with its tallies.
     pub fn plane(&self, slab: &Slab, l: usize, dims: [usize; 3], z: usize) -> (Plane, Tally) {
-        self.plane_into(slab, l, dims, z, Plane::default())
+        let dist = Arc::new(slab.dist.clone());
+        self.plane_into(slab, &dist, l, dims, z, Plane::default())
     }
 
     /// [`Self::plane`] into the buffers of a plane the caller no longer
     /// needs (fresh buffers each layer cost page faults and zeroing by the
-    /// kernel: a tenth of a cube export).
+    /// kernel: a tenth of a cube export), with the slab's distances
+    /// `slab_dist` shared rather than copied (`slab.dist` is not read).
     pub fn plane_into(
         &self,
         slab: &Slab,
+        slab_dist: &Arc<Vec<f32>>,
         l: usize,
         [nx, ny, nz]: [usize; 3],
         z: usize,
@@ -253,11 +259,11 @@ impl Classifier {
         let stride = self.interface().stride();
         let Plane {
             mut label,
-            mut dist,
+            dist: _,
             mut value,
         } = reuse;
-        dist.clear();
-        dist.extend_from_slice(&slab.dist[l * layer..(l + 1) * layer]);
+        let dist = LayerDist::new(slab_dist, l * layer..(l + 1) * layer);
+        let rows_dist: &[f32] = &dist;
         let fracs = &slab.fracs[l * layer * k..(l + 1) * layer * k];
         label.clear();
         label.resize(layer, 0);
@@ -290,7 +296,7 @@ impl Classifier {
                 if edge_plane || y == 0 || y + 1 == ny {
                     return;
                 }
-                let row = &dist[y * nx..(y + 1) * nx];
+                let row = &rows_dist[y * nx..(y + 1) * nx];
                 let fracs = &fracs[y * nx * k..(y + 1) * nx * k];
                 let mut x = 1;
                 for sp in runs.row(y) {
@@ -298,7 +304,12 @@ impl Classifier {
                     if a >= b {
                         continue;
                     }
-                    self.voxels(row, fracs, k, x..a, labels, values, &mut t);
+                    // (Most runs start where the last ended: the cube's
+                    // layers have about fourteen runs a row, and the empty
+                    // calls were a sixth of labelling it.)
+                    if x < a {
+                        self.voxels(row, fracs, k, x..a, labels, values, &mut t);
+                    }
                     // The run's voxels are inside and share its rectangle's
                     // fractions, classified once.
                     let (lab, fv) = runs.classes[sp.rect];
