@@ -7,7 +7,7 @@
 //! range, and the buffer goes back to the sampler once the contourer has
 //! retired all of them ([`DistPool`]). The contourer keeps the last plane
 //! of a slab while the next slab is contoured and the one after is sampled,
-//! so about three buffers circulate.
+//! so three buffers circulate (checked in debug builds by `build`).
 
 use std::ops::Deref;
 use std::sync::Arc;
@@ -62,6 +62,8 @@ impl PartialEq for LayerDist {
 #[derive(Default)]
 pub struct DistPool {
     out: Vec<Arc<Vec<f32>>>,
+    /// Buffers made new (the rest came back).
+    fresh: usize,
 }
 
 impl DistPool {
@@ -69,8 +71,16 @@ impl DistPool {
     pub fn take(&mut self) -> Vec<f32> {
         match self.out.iter().position(|b| Arc::strong_count(b) == 1) {
             Some(i) => Arc::try_unwrap(self.out.swap_remove(i)).unwrap_or_default(),
-            None => Vec::new(),
+            None => {
+                self.fresh += 1;
+                Vec::new()
+            }
         }
+    }
+
+    /// How many buffers [`Self::take`] had to make new.
+    pub fn fresh(&self) -> usize {
+        self.fresh
     }
 
     /// Share `buf` (a sampled slab's distances) with its planes.
@@ -99,5 +109,6 @@ mod tests {
         drop(b);
         assert_eq!(pool.take(), vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0]);
         assert!(pool.take().is_empty(), "given out once");
+        assert_eq!(pool.fresh(), 3, "three takes found nothing free");
     }
 }

@@ -416,8 +416,12 @@ fn sampled_triangles(model: &Model, grid: Grid, classifier: &Classifier) -> u64 
             return 0;
         }
         let mut contourer = Contourer::new(grid, classifier.segments(), classifier.interface());
-        contourer.push_plane(0, classifier.plane(&slab, 0, dims, z).0);
-        contourer.push_plane(1, classifier.plane(&slab, 1, dims, z + 1).0);
+        // Both planes share the slab's distances, as in the export.
+        let dist = std::sync::Arc::new(std::mem::take(&mut slab.dist));
+        for (l, z) in [(0, z), (1, z + 1)] {
+            let plane = classifier.plane_into(&slab, &dist, l, dims, z, Plane::default());
+            contourer.push_plane(l, plane.0);
+        }
         made += contourer.triangles();
     }
     (made as f64 * layers as f64 / picks.max(1) as f64) as u64
@@ -443,24 +447,15 @@ fn build(
     };
     let mut tally = Tally::new(pl.classifier.segments());
     let mut slab = Slab::default();
-    let pool = std::sync::Mutex::new(DistPool::default());
+    let mut pool = DistPool::default();
     // Sample and label one slab of planes, into retired planes' buffers;
     // the planes share the slab's distances (see `layer_dist`).
-    let labelled = |slab: &mut Slab, z0: usize, z1: usize, mut spare: Vec<Plane>| {
-        let lock = || {
-            pool.lock()
-                .unwrap_or_else(std::sync::PoisonError::into_inner)
-        };
-        // Retired planes let go of their slab's buffer first, so it can
-        // come back (else every slab faulted in a fresh one).
-        for p in &mut spare {
-            p.dist = LayerDist::default();
-        }
-        slab.dist = lock().take();
+    let mut labelled = |slab: &mut Slab, z0: usize, z1: usize, mut spare: Vec<Plane>| {
+        slab.dist = pool.take();
         sampler
             .sample_layers(z0, z1, slab, cancel)
             .map_err(|_| ExportError::Cancelled)?;
-        let dist = lock().share(std::mem::take(&mut slab.dist));
+        let dist = pool.share(std::mem::take(&mut slab.dist));
         // Planes are labelled in parallel: on one thread this was a third
         // of a slab's time on the graded bar, with the other core idle
         // once it had contoured the previous slab.
@@ -499,7 +494,14 @@ fn build(
                 let mut retired = Vec::new();
                 for (z, (plane, t)) in (z0..).zip(planes) {
                     tally.add(&t);
-                    retired.extend(contourer.push_plane(z, plane));
+                    // A retired plane lets go of its slab's distances at
+                    // once (it is kept for its other buffers), so the
+                    // buffer can come back to the sampler (kept until
+                    // reuse, every slab faulted in a fresh one).
+                    retired.extend(contourer.push_plane(z, plane).map(|mut p| {
+                        p.dist = LayerDist::default();
+                        p
+                    }));
                 }
                 retired
             },
@@ -513,6 +515,9 @@ fn build(
         z0 = z1;
         z1 = next.map_or(nz, |n| n.1);
     }
+    // The slab sampled into, the one contoured and the one whose last
+    // plane the contourer held: more means retired planes kept buffers.
+    debug_assert!(pool.fresh() <= 3, "{} distance buffers", pool.fresh());
     let names = segment_names(model, p, &pl.classifier);
     let n = pl.classifier.segments();
     contourer
