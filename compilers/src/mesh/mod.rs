@@ -497,7 +497,7 @@ fn build(
                     // A retired plane lets go of its slab's distances at
                     // once (it is kept for its other buffers), so the
                     // buffer can come back to the sampler (kept until
-                    // reuse, every slab faulted in a fresh one).
+                    // reuse, a fourth buffer was needed).
                     retired.extend(contourer.push_plane(z, plane).map(|mut p| {
                         p.dist = LayerDist::default();
                         p
