@@ -394,16 +394,19 @@ impl Contourer {
             let id = cur[c];
             let key = self.regions.key_id(id);
             let mut cube = None;
-            for (axis, side) in [(0, 0), (0, 1), (1, 0), (1, 1), (2, 0)] {
-                if !face_cut(mask, axis, side) {
-                    continue;
-                }
-                let nb = match (axis, side) {
-                    (0, 0) if i > 0 => cur[c - 1],
-                    (0, 1) if i + 1 < cw => cur[c + 1],
-                    (1, 0) if j > 0 => cur[c - cw],
-                    (1, 1) if j + 1 < ch => cur[c + cw],
-                    (2, 0) => self.prev_flat[c],
+            // Only the faces the cut crosses (two to four of the five), in
+            // the order left, right, front, back, below.
+            let mut cuts = CUT_FACES[mask as usize];
+            while cuts != 0 {
+                let f = cuts.trailing_zeros() as usize;
+                cuts &= cuts - 1;
+                let (axis, side) = (f >> 1, (f & 1) as u8);
+                let nb = match f {
+                    0 if i > 0 => cur[c - 1],
+                    1 if i + 1 < cw => cur[c + 1],
+                    2 if j > 0 => cur[c - cw],
+                    3 if j + 1 < ch => cur[c + cw],
+                    4 => self.prev_flat[c],
                     _ => NOT_FLAT,
                 };
                 if nb != NOT_FLAT && self.regions.key_id(nb) == key {
@@ -678,9 +681,31 @@ fn two_label_cut((o, p, s, lo, rest): (u8, u8, u8, u16, u16)) -> [(u16, Pt, Pt);
     [(lo, edge(p, o), edge(o, s)), (rest, edge(o, s), edge(p, o))]
 }
 
+/// Per mask of one label's corners, the faces of the cube the cut crosses
+/// that [`Contourer::flat_layer`] joins or outlines: bit `2·axis + side`
+/// for the four faces across x and y and the one below (bit 4; the face
+/// above is settled with the next layer). A table, since every flat cube
+/// asks: the five tests in a loop were a tenth of the joining's
+/// instructions on the cube.
+const CUT_FACES: [u8; 256] = {
+    let mut t = [0u8; 256];
+    let mut m = 0;
+    while m < 256 {
+        let mut f = 0;
+        while f < 5 {
+            if face_cut(m as u8, f >> 1, (f & 1) as u8) {
+                t[m] |= 1 << f;
+            }
+            f += 1;
+        }
+        m += 1;
+    }
+    t
+};
+
 /// Whether the face (`axis`, `side`) of a two-label cube is cut, from the
 /// mask of one label's corners.
-fn face_cut(mask: u8, axis: usize, side: u8) -> bool {
+const fn face_cut(mask: u8, axis: usize, side: u8) -> bool {
     // Corners with bit `axis` clear, per axis; the other side is the rest.
     const LOW: [u8; 3] = [0b0101_0101, 0b0011_0011, 0b0000_1111];
     let face = if side == 0 { LOW[axis] } else { !LOW[axis] };

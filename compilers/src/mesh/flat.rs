@@ -53,6 +53,8 @@ use super::vertex_keys::{FastMap, Tri};
 const FLAT_TOL: f64 = 1e-3;
 /// Normal quantisation per component.
 const NORMAL_BINS: f64 = 1024.0;
+/// Keys [`Regions::add_band`] remembers while interning a band's cubes.
+const RECENT_KEYS: usize = 4;
 
 /// What makes flat cubes one region.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -284,18 +286,23 @@ impl Regions {
     /// same order); returns the first id (the others follow).
     pub fn add_band(&mut self, keys: impl Iterator<Item = FlatKey>, kept: KeptCubes) -> u32 {
         let first = self.parent.len() as u32;
-        // Runs of cubes share a key: look it up once a run.
-        let mut last: Option<(FlatKey, KeyId)> = None;
+        // Runs of cubes share a key, and a row crosses few faces: the keys
+        // met last are looked up without hashing (with one remembered, the
+        // cube's side faces, met in turn along every row, hashed each cube:
+        // a seventh of the joining's instructions).
+        let mut recent: [Option<(FlatKey, KeyId)>; RECENT_KEYS] = [None; RECENT_KEYS];
+        let mut next_slot = 0;
         for key in keys {
-            let id = match last {
-                Some((k, id)) if k == key => id,
-                _ => {
+            let id = match recent.iter().flatten().find(|(k, _)| *k == key) {
+                Some(&(_, id)) => id,
+                None => {
                     let next = self.table.len() as KeyId;
                     let id = *self.ids.entry(key).or_insert(next);
                     if id == next {
                         self.table.push(key);
                     }
-                    last = Some((key, id));
+                    recent[next_slot] = Some((key, id));
+                    next_slot = (next_slot + 1) % RECENT_KEYS;
                     id
                 }
             };
@@ -357,6 +364,12 @@ impl Regions {
 
     /// Join the regions of `a` and `b` (the lower root stays).
     pub fn union(&mut self, a: u32, b: u32) {
+        // Most joins on a flat face are of cubes already in one region
+        // whose parents agree (a cube joined to its left neighbour's root,
+        // and its front neighbour pointing there too): settled unfound.
+        if self.parent[a as usize] == self.parent[b as usize] {
+            return;
+        }
         let (ra, rb) = (self.find(a), self.find(b));
         self.parent[ra.max(rb) as usize] = ra.min(rb);
     }
