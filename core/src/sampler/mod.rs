@@ -80,6 +80,10 @@ enum Settled {
     Open,
     /// Every voxel is outside; the value to store.
     Outside(f32),
+    /// The surface may be near, but the bound is one number over a tile of
+    /// more than one voxel: every voxel's distance is that number (see
+    /// `settle`).
+    Exact(f64),
     /// Every voxel is inside; the value to store, whether they may all
     /// take the centre's fractions (fixed, or uniform for the consumer),
     /// and whether the consumer's test found them mixed (smaller boxes may
@@ -400,6 +404,18 @@ impl<'a> Sampler<'a> {
         match self.settle(&b, k) {
             Settled::Open => {}
             Settled::Outside(value) => return self.fill(r, out, value, Fill::Outside),
+            // Where the voxels' fractions need no evaluation either (none
+            // asked, or the design's fixed mix), the tile is written as
+            // evaluating it would: zeros outside, the mix inside.
+            Settled::Exact(d) if k == 0 || matches!(shared, Shared::Constant(Some(_))) => {
+                let how = match shared {
+                    Shared::Constant(Some(one)) if d <= 0.0 => Fill::Constant(&one[..k]),
+                    _ if d <= 0.0 => Fill::Constant(&[]),
+                    _ => Fill::Outside,
+                };
+                return self.fill(r, out, d as f32, how);
+            }
+            Settled::Exact(_) => {}
             Settled::Solid { mixed: true, .. } if w > LEAF || h > LEAF => {
                 return self.split(r, out, shared);
             }
@@ -503,6 +519,23 @@ impl<'a> Sampler<'a> {
             return Settled::Outside(iv.lo as f32);
         }
         if iv.hi.is_nan() || iv.hi >= -margin {
+            // A bound that is one number over a box of voxel centres is
+            // every voxel's distance: the exact intervals (a box's, a
+            // cylinder's, and their translates and unions) evaluate the
+            // point function at the box's nearest and farthest offsets
+            // (`model::bound`), with float
+            // operations that are monotone, so each voxel's value lies
+            // between the two ends as computed, bit for bit. Bounds that
+            // are not exact (Lipschitz, expressions) are never one number
+            // over a box that is not a point. A layer through a face
+            // parallel to it (the cube's top and bottom) is such a tile
+            // away from the other faces: the cube's layers within a voxel
+            // diagonal of them (47 thousand voxels each at 0.0464 mm) were
+            // evaluated voxel by voxel, 5 % of its mesh export's
+            // instructions (callgrind, one thread: 1,046.8 → 990.6 M).
+            if iv.lo == iv.hi && iv.lo.is_finite() && b.min != b.max {
+                return Settled::Exact(iv.lo);
+            }
             return Settled::Open;
         }
         let mut mixed = false;

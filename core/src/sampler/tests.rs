@@ -101,3 +101,64 @@ fn shared_fractions_are_the_evaluated_ones() {
         assert_eq!(spared > inside / 10, spares, "{spared} of {inside} spared");
     }
 }
+
+#[test]
+fn tiles_of_one_exact_distance_store_what_evaluating_gives() {
+    // Flat faces parallel to the layers (a box's, a cylinder's caps, also
+    // translated and in a union with a curved part): layers through them
+    // have tiles whose bound is one number.
+    for src in [
+        r#"RectPrism(Vec3(0, 0, 0), Vec3(10, 10, 10), 1)"#,
+        r#"Cylinder(Vec3(0.3, 0, 0), 4, 6, 1)"#,
+        r#"Union(false, [Translate(0.25, 0, 0.5, RectPrism(Vec3(0, 0, 0), Vec3(8, 6, 4), 1)),
+                         Sphere(Vec3(3, 0, 3), 2, 1)])"#,
+        r#"Rotate(0, 0, 30, Vec3(0, 0, 0), RectPrism(Vec3(0, 0, 0), Vec3(8, 6, 4), 1))"#,
+    ] {
+        let m = model(src);
+        let grid = Grid::covering(&m.bbox().expand(0.3), DVec3::splat(0.11), 1 << 30).unwrap();
+        let margin = grid.voxel.length();
+        for with_fracs in [false, true] {
+            let s = Sampler::new(&m, grid, with_fracs);
+            let (slab, _) = sample_all(&s);
+            for z in 0..grid.dims[2] {
+                for y in 0..grid.dims[1] {
+                    for x in 0..grid.dims[0] {
+                        let v = (z * grid.dims[1] + y) * grid.dims[0] + x;
+                        let d = m.distance(grid.center(x, y, z));
+                        if d.abs() > margin {
+                            continue;
+                        }
+                        assert_eq!(
+                            slab.dist[v].to_bits(),
+                            (d as f32).to_bits(),
+                            "{src}: voxel ({x}, {y}, {z}), fractions {with_fracs}"
+                        );
+                        if with_fracs {
+                            let want: &[f32] = if d <= 0.0 { &[1.0] } else { &[0.0] };
+                            assert_eq!(slab.fracs_of(v), want, "{src}: ({x}, {y}, {z})");
+                        }
+                    }
+                }
+            }
+            // Without one-number tiles every voxel of the first layer
+            // inside the box's bottom face is evaluated (all are within
+            // the margin of the face).
+            if src.starts_with("RectPrism") {
+                let [nx, ny, _] = grid.dims;
+                let z = (0..grid.dims[2])
+                    .find(|&z| m.distance(grid.center(nx / 2, ny / 2, z)) <= 0.0)
+                    .expect("a layer inside");
+                let one = Sampler::new(&m, grid, with_fracs);
+                let mut layer = Slab::default();
+                one.sample_layers(z, z + 1, &mut layer, &AtomicBool::new(false))
+                    .expect("not cancelled");
+                let evaluated = one.stats.evaluated.load(Ordering::Relaxed);
+                assert!(
+                    evaluated * 5 < (nx * ny) as u64,
+                    "{evaluated} of {} evaluated in layer {z}",
+                    nx * ny
+                );
+            }
+        }
+    }
+}
