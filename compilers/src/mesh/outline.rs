@@ -1,14 +1,17 @@
 //! Triangulation of a flat region's outline (see [`super::flat`]).
 //!
-//! The outline is projected along the normal's largest axis and
-//! triangulated by a constrained Delaunay triangulation (spade, exact
-//! predicates), which keeps every outline point (collinear ones included;
-//! dropping one would leave a T-junction). Faces inside the outline are
-//! found by flood fill from the hull, flipping at each outline edge, and
-//! oriented like the outline (the label `x`'s outward side). The region
-//! is checked: no duplicate points, no crossing outline edges, and the
-//! inside faces' area equal to the outline's (shoelace formula) within
-//! 10⁻⁹. A region that fails any check gets `None`, and [`super::flat`]
+//! The outline is projected along the normal's largest axis. An outline
+//! that is one convex loop (a box's face, a slab's interface) is cut into
+//! a strip of triangles with exact orientation tests alone
+//! ([`convex_strip`]); any other is triangulated by a constrained Delaunay
+//! triangulation (spade, exact predicates). Both keep every outline point
+//! (collinear ones included; dropping one would leave a T-junction). In
+//! the Delaunay path faces inside the outline are found by flood fill from
+//! the hull, flipping at each outline edge. Triangles are oriented like
+//! the outline (the label `x`'s outward side). The region is checked: no
+//! duplicate points, no crossing outline edges (Delaunay path; a convex
+//! loop has none), and the inside faces' area equal to the outline's
+//! (shoelace formula) within 10⁻⁹. A region that fails any check gets `None`, and [`super::flat`]
 //! contours it cube by cube with marching tetrahedra instead.
 
 use super::vertex_keys::FastMap;
@@ -65,6 +68,9 @@ pub(super) fn triangulate(
         .iter()
         .map(|[a, b]| pts[*a].x * pts[*b].y - pts[*b].x * pts[*a].y)
         .sum();
+    if let Some(strip) = convex_strip(&pts, &edges, area2) {
+        return oriented(strip, &pts, &global, area2);
+    }
     let count = pts.len();
     let mut conflict = false;
     let cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::try_bulk_load_cdt(
@@ -109,15 +115,29 @@ pub(super) fn triangulate(
             }
         }
     }
-    let mut out = Vec::new();
+    let inside = cdt
+        .inner_faces()
+        .filter_map(|f| match parity[f.fix().index()] {
+            1 => Some(Some(f.vertices().map(|h| h.fix().index()))),
+            0 => None,
+            _ => Some(None),
+        });
+    let faces: Option<Vec<[usize; 3]>> = inside.collect();
+    oriented(faces?, &pts, &global, area2)
+}
+
+/// `faces` (local indices) as global indices oriented like the outline, or
+/// `None` when their areas do not add up to the outline's (an overlap or a
+/// gap) or there are none.
+fn oriented(
+    faces: Vec<[usize; 3]>,
+    pts: &[Point2<f64>],
+    global: &[u32],
+    area2: f64,
+) -> Option<Vec<[u32; 3]>> {
+    let mut out = Vec::with_capacity(faces.len());
     let mut sum2 = 0.0;
-    for f in cdt.inner_faces() {
-        match parity[f.fix().index()] {
-            1 => {}
-            0 => continue,
-            _ => return None,
-        }
-        let [a, b, c] = f.vertices().map(|h| h.fix().index());
+    for [a, b, c] in faces {
         let (pa, pb, pc) = (pts[a], pts[b], pts[c]);
         let s = (pb.x - pa.x) * (pc.y - pa.y) - (pb.y - pa.y) * (pc.x - pa.x);
         sum2 += s.abs();
@@ -131,4 +151,252 @@ pub(super) fn triangulate(
         return None;
     }
     Some(out)
+}
+
+/// The triangles of an outline that is one convex loop, as a strip, or
+/// `None` for any other outline (which the Delaunay path takes).
+///
+/// Why: a planar face of a box or a slab is a rectangle whose sides carry
+/// a point at every voxel, exactly collinear and, four at a time, exactly
+/// cocircular, so the Delaunay triangulation's in-circle tests all take
+/// `robust`'s exact path (which zeroes 9 KB of scratch a call). A convex
+/// loop needs only orientation tests: every triangle of three of its
+/// points is inside it, so zig-zagging between its two ends from a
+/// strictly convex corner, taking the side whose triangle turns strictly
+/// left (`robust::orient2d`, exact), covers it with `n − 2` triangles and
+/// no overlap. Convex means: one loop through every point, every turn left
+/// or straight, consecutive points distinct, and x and y each change
+/// direction at most twice around it (which rules out a star that turns
+/// left at every point but winds twice).
+fn convex_strip(pts: &[Point2<f64>], edges: &[[usize; 2]], area2: f64) -> Option<Vec<[usize; 3]>> {
+    let n = pts.len();
+    if n < 3 || edges.len() != n || area2.is_nan() || area2 == 0.0 {
+        return None;
+    }
+    // One loop: each point starts one edge and ends one, and following the
+    // edges from point 0 comes back after all n.
+    let mut next = vec![usize::MAX; n];
+    let mut ends = vec![false; n];
+    for &[a, b] in edges {
+        if next[a] != usize::MAX || ends[b] {
+            return None;
+        }
+        next[a] = b;
+        ends[b] = true;
+    }
+    let mut ring = Vec::with_capacity(n);
+    let mut v = 0;
+    for k in 0..n {
+        if k > 0 && v == 0 {
+            return None;
+        }
+        ring.push(v);
+        v = next[v];
+    }
+    if v != 0 {
+        return None;
+    }
+    if area2 < 0.0 {
+        ring.reverse();
+    }
+    let at = |i: usize| robust::Coord {
+        x: pts[i].x,
+        y: pts[i].y,
+    };
+    let orient = |a: usize, b: usize, c: usize| robust::orient2d(at(a), at(b), at(c));
+    let mut start = None;
+    let (mut turns_x, mut turns_y) = (0, 0);
+    let (mut last_x, mut last_y) = (0i8, 0i8);
+    for k in 0..n {
+        let (u, w) = (ring[(k + n - 1) % n], ring[(k + 1) % n]);
+        let o = orient(u, ring[k], w);
+        if o < 0.0 || !o.is_finite() {
+            return None;
+        }
+        if o > 0.0 && start.is_none() {
+            start = Some(k);
+        }
+        let (p, q) = (at(ring[k]), at(w));
+        if p.x == q.x && p.y == q.y {
+            return None;
+        }
+        for (d, last, turns) in [
+            (q.x.total_cmp(&p.x) as i8, &mut last_x, &mut turns_x),
+            (q.y.total_cmp(&p.y) as i8, &mut last_y, &mut turns_y),
+        ] {
+            if d != 0 {
+                if *last != 0 && d != *last {
+                    *turns += 1;
+                }
+                *last = d;
+            }
+        }
+    }
+    // The count above started mid-run: the wrap back to the first
+    // direction counts too.
+    let first = |axis: usize| {
+        (0..n).find_map(|k| {
+            let (p, q) = (at(ring[k]), at(ring[(k + 1) % n]));
+            let d = if axis == 0 {
+                q.x.total_cmp(&p.x)
+            } else {
+                q.y.total_cmp(&p.y)
+            } as i8;
+            (d != 0).then_some(d)
+        })
+    };
+    turns_x += usize::from(first(0).is_some_and(|d| d != last_x));
+    turns_y += usize::from(first(1).is_some_and(|d| d != last_y));
+    if turns_x > 2 || turns_y > 2 {
+        return None;
+    }
+    let s = start?;
+    ring.rotate_left(s);
+    let mut tris = Vec::with_capacity(n - 2);
+    tris.push([ring[n - 1], ring[0], ring[1]]);
+    let (mut lo, mut hi) = (1, n - 1);
+    let mut from_lo = true;
+    while hi - lo > 1 {
+        let a = orient(ring[lo], ring[lo + 1], ring[hi]) > 0.0;
+        let b = orient(ring[lo], ring[hi - 1], ring[hi]) > 0.0;
+        let take_lo = match (a, b) {
+            (true, true) => from_lo,
+            (true, false) => true,
+            (false, true) => false,
+            (false, false) => return None,
+        };
+        if take_lo {
+            tris.push([ring[lo], ring[lo + 1], ring[hi]]);
+            lo += 1;
+        } else {
+            tris.push([ring[lo], ring[hi - 1], ring[hi]]);
+            hi -= 1;
+        }
+        from_lo = !take_lo;
+    }
+    Some(tris)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `loop_pts` as vertices in the z = 0 plane and the loop's edges.
+    fn outline(loop_pts: &[[f32; 2]]) -> (Vec<[f32; 3]>, Vec<[u32; 2]>) {
+        let verts = loop_pts.iter().map(|p| [p[0], p[1], 0.0]).collect();
+        let n = loop_pts.len() as u32;
+        let edges = (0..n).map(|i| [i, (i + 1) % n]).collect();
+        (verts, edges)
+    }
+
+    fn area2(verts: &[[f32; 3]], t: [u32; 3]) -> f64 {
+        let p = t.map(|i| verts[i as usize].map(f64::from));
+        (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0])
+    }
+
+    /// A rectangle with a point every `step` along its sides, counter-
+    /// clockwise (or clockwise when `cw`): a box's face.
+    fn rectangle(w: usize, h: usize, cw: bool) -> Vec<[f32; 2]> {
+        let mut p = Vec::new();
+        (0..w).for_each(|i| p.push([i as f32 * 0.25, 0.0]));
+        (0..h).for_each(|j| p.push([w as f32 * 0.25, j as f32 * 0.25]));
+        (0..w).for_each(|i| p.push([(w - i) as f32 * 0.25, h as f32 * 0.25]));
+        (0..h).for_each(|j| p.push([0.0, (h - j) as f32 * 0.25]));
+        if cw {
+            p.reverse();
+        }
+        p
+    }
+
+    fn strip_of(loop_pts: &[[f32; 2]]) -> Option<Vec<[usize; 3]>> {
+        let pts: Vec<Point2<f64>> = loop_pts
+            .iter()
+            .map(|p| Point2::new(f64::from(p[0]), f64::from(p[1])))
+            .collect();
+        let n = pts.len();
+        let edges: Vec<[usize; 2]> = (0..n).map(|i| [i, (i + 1) % n]).collect();
+        let area2: f64 = edges
+            .iter()
+            .map(|[a, b]| pts[*a].x * pts[*b].y - pts[*b].x * pts[*a].y)
+            .sum();
+        convex_strip(&pts, &edges, area2)
+    }
+
+    #[test]
+    fn convex_loops_become_strips_that_tile_them() {
+        for cw in [false, true] {
+            let r = rectangle(40, 7, cw);
+            let n = r.len();
+            assert_eq!(strip_of(&r).map(|t| t.len()), Some(n - 2), "a convex loop");
+            let (verts, edges) = outline(&r);
+            let tris = triangulate([0, 0, 1], edges.into_iter(), &verts).expect("triangulated");
+            assert_eq!(tris.len(), n - 2);
+            // Every point kept, every triangle turning like the outline
+            // (strictly: no sliver of zero area), areas adding up.
+            let mut used = vec![false; n];
+            let sign = if cw { -1.0 } else { 1.0 };
+            let mut sum = 0.0;
+            for t in &tris {
+                t.iter().for_each(|&i| used[i as usize] = true);
+                let a = area2(&verts, *t) * sign;
+                assert!(a > 0.0, "{t:?}: {a}");
+                sum += a;
+            }
+            assert!(used.iter().all(|&u| u));
+            let want = 2.0 * 40.0 * 7.0 * 0.0625;
+            assert!((sum - want).abs() < 1e-9 * want, "{sum} vs {want}");
+        }
+    }
+
+    #[test]
+    fn other_outlines_take_the_delaunay_path() {
+        // An L (a reflex corner), a star that turns left at every point
+        // but winds twice, and a square with a hole (two loops).
+        let l = [
+            [0.0, 0.0],
+            [2.0, 0.0],
+            [2.0, 1.0],
+            [1.0, 1.0],
+            [1.0, 2.0],
+            [0.0, 2.0],
+        ];
+        assert!(strip_of(&l).is_none());
+        let star: Vec<[f32; 2]> = (0..5)
+            .map(|k| {
+                let a = std::f32::consts::TAU * (2 * k) as f32 / 5.0;
+                [a.cos(), a.sin()]
+            })
+            .collect();
+        assert!(strip_of(&star).is_none());
+        let (verts, edges) = outline(&l);
+        let tris = triangulate([0, 0, 1], edges.into_iter(), &verts).expect("the L");
+        assert_eq!(tris.len(), 4);
+        let sum: f64 = tris.iter().map(|t| area2(&verts, *t)).sum();
+        assert!((sum - 6.0).abs() < 1e-12, "{sum}");
+        let mut verts: Vec<[f32; 3]> = Vec::new();
+        let mut edges = Vec::new();
+        for (square, cw) in [(4.0f32, false), (1.0, true)] {
+            let base = verts.len() as u32;
+            let mut c = [
+                [-square, -square],
+                [square, -square],
+                [square, square],
+                [-square, square],
+            ];
+            if cw {
+                c.reverse();
+            }
+            verts.extend(c.iter().map(|p| [p[0], p[1], 0.0]));
+            edges.extend((0..4).map(|i| [base + i, base + (i + 1) % 4]));
+        }
+        let pts: Vec<Point2<f64>> = verts
+            .iter()
+            .map(|p| Point2::new(f64::from(p[0]), f64::from(p[1])))
+            .collect();
+        let local: Vec<[usize; 2]> = edges.iter().map(|e| e.map(|i| i as usize)).collect();
+        assert!(convex_strip(&pts, &local, 1.0).is_none(), "two loops");
+        let tris = triangulate([0, 0, 1], edges.into_iter(), &verts).expect("the holed square");
+        let sum: f64 = tris.iter().map(|t| area2(&verts, *t)).sum();
+        assert!((sum - (64.0 - 4.0) * 2.0).abs() < 1e-9, "{sum}");
+    }
 }
