@@ -368,6 +368,16 @@ mod tests {
             })
             .collect();
         assert!(strip_of(&star).is_none());
+        // A rectangle whose bottom side's points wobble by 10⁻⁴ (some turn
+        // right): not convex, so Delaunay triangulates it.
+        let mut wobbly = rectangle(30, 5, false);
+        for (i, p) in wobbly.iter_mut().enumerate().take(30).skip(1) {
+            p[1] = if i % 3 == 0 { 1e-4 } else { -1e-4 };
+        }
+        assert!(strip_of(&wobbly).is_none());
+        let (verts, edges) = outline(&wobbly);
+        let tris = triangulate([0, 0, 1], edges.into_iter(), &verts).expect("the wobbly one");
+        assert_eq!(tris.len(), wobbly.len() - 2);
         let (verts, edges) = outline(&l);
         let tris = triangulate([0, 0, 1], edges.into_iter(), &verts).expect("the L");
         assert_eq!(tris.len(), 4);
