@@ -21,12 +21,17 @@ pub use volcad_core::heap::{available_memory, human_bytes};
 /// the cube's whole 10 M-voxel export.
 #[cfg(unix)]
 pub fn available_disk(dir: &Path) -> Option<u64> {
-    let existing = dir.ancestors().find(|a| a.exists())?;
-    let existing = if existing.as_os_str().is_empty() {
-        Path::new(".")
-    } else {
-        existing
-    };
+    // A relative path's last ancestor is "", the current folder.
+    let existing = dir
+        .ancestors()
+        .map(|a| {
+            if a.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                a
+            }
+        })
+        .find(|a| a.exists())?;
     let s = rustix::fs::statvfs(existing).ok()?;
     s.f_bavail.checked_mul(s.f_frsize)
 }
@@ -230,6 +235,14 @@ mod tests {
         assert!(!missing.exists());
         let below = available_disk(&missing).expect("the nearest existing folder's disk");
         assert!(below.abs_diff(ours) < 64 << 20, "{below} against {ours}");
+        // A relative folder that does not exist: the current folder's disk.
+        let here = available_disk(Path::new(".")).expect("the current folder's disk");
+        let relative = available_disk(Path::new("volcad-no-such-folder/a"))
+            .expect("a missing relative folder falls back to the current one");
+        assert!(
+            relative.abs_diff(here) < 64 << 20,
+            "{relative} against {here}"
+        );
     }
 
     #[test]
