@@ -685,8 +685,8 @@ fn two_label_cut((o, p, s, lo, rest): (u8, u8, u8, u16, u16)) -> [(u16, Pt, Pt);
 /// that [`Contourer::flat_layer`] joins or outlines: bit `2·axis + side`
 /// for the four faces across x and y and the one below (bit 4; the face
 /// above is settled with the next layer). A table, since every flat cube
-/// asks: the five tests in a loop were a tenth of the joining's
-/// instructions on the cube.
+/// asks: the five tests in a loop were 8 % of the joining's instructions
+/// on the cube (13.4 of 161.5 M).
 const CUT_FACES: [u8; 256] = {
     let mut t = [0u8; 256];
     let mut m = 0;

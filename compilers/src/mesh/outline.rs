@@ -158,9 +158,10 @@ fn oriented(
 ///
 /// Why: a planar face of a box or a slab is a rectangle whose sides carry
 /// a point at every voxel, exactly collinear and, four at a time, exactly
-/// cocircular, so the Delaunay triangulation's in-circle tests all take
-/// `robust`'s exact path (which zeroes 9 KB of scratch a call). A convex
-/// loop needs only orientation tests: every triangle of three of its
+/// cocircular, so many of the Delaunay triangulation's in-circle tests
+/// take `robust`'s exact path (whose zeroed scratch arrays take 26 KB a
+/// call; a quarter of the cube's triangulation was that `memset`). A
+/// convex loop needs only orientation tests: every triangle of three of its
 /// points is inside it, so zig-zagging between its two ends from a
 /// strictly convex corner, taking the side whose triangle turns strictly
 /// left (`robust::orient2d`, exact), covers it with `n − 2` triangles and
@@ -205,8 +206,9 @@ fn convex_strip(pts: &[Point2<f64>], edges: &[[usize; 2]], area2: f64) -> Option
     };
     let orient = |a: usize, b: usize, c: usize| robust::orient2d(at(a), at(b), at(c));
     let mut start = None;
-    let (mut turns_x, mut turns_y) = (0, 0);
-    let (mut last_x, mut last_y) = (0i8, 0i8);
+    // Per axis: the direction of the first and of the last edge that moves
+    // along it, and the changes of direction between them.
+    let mut dirs = [(0i8, 0i8, 0usize); 2];
     for k in 0..n {
         let (u, w) = (ring[(k + n - 1) % n], ring[(k + 1) % n]);
         let o = orient(u, ring[k], w);
@@ -220,33 +222,24 @@ fn convex_strip(pts: &[Point2<f64>], edges: &[[usize; 2]], area2: f64) -> Option
         if p.x == q.x && p.y == q.y {
             return None;
         }
-        for (d, last, turns) in [
-            (q.x.total_cmp(&p.x) as i8, &mut last_x, &mut turns_x),
-            (q.y.total_cmp(&p.y) as i8, &mut last_y, &mut turns_y),
-        ] {
+        for (d, (first, last, turns)) in [q.x.total_cmp(&p.x), q.y.total_cmp(&p.y)]
+            .into_iter()
+            .zip(&mut dirs)
+        {
+            let d = d as i8;
             if d != 0 {
-                if *last != 0 && d != *last {
+                if *first == 0 {
+                    *first = d;
+                } else if d != *last {
                     *turns += 1;
                 }
                 *last = d;
             }
         }
     }
-    // The count above started mid-run: the wrap back to the first
-    // direction counts too.
-    let first = |axis: usize| {
-        (0..n).find_map(|k| {
-            let (p, q) = (at(ring[k]), at(ring[(k + 1) % n]));
-            let d = if axis == 0 {
-                q.x.total_cmp(&p.x)
-            } else {
-                q.y.total_cmp(&p.y)
-            } as i8;
-            (d != 0).then_some(d)
-        })
-    };
-    turns_x += usize::from(first(0).is_some_and(|d| d != last_x));
-    turns_y += usize::from(first(1).is_some_and(|d| d != last_y));
+    // Around the loop, the last edge turns back into the first.
+    let [(fx, lx, tx), (fy, ly, ty)] = dirs;
+    let (turns_x, turns_y) = (tx + usize::from(fx != lx), ty + usize::from(fy != ly));
     if turns_x > 2 || turns_y > 2 {
         return None;
     }

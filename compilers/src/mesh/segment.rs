@@ -235,7 +235,10 @@ impl Classifier {
     }
 
     /// The plane of labels for layer `l` of `slab` (grid `[nx, ny, nz]`,
-    /// global layer `z`), with its tallies.
+    /// global layer `z`), with its tallies; for tests, which compare
+    /// samplers (it copies the slab's distances; exports share them
+    /// through [`Self::plane_into`]).
+    #[cfg(test)]
     pub fn plane(&self, slab: &Slab, l: usize, dims: [usize; 3], z: usize) -> (Plane, Tally) {
         let dist = Arc::new(slab.dist.clone());
         self.plane_into(slab, &dist, l, dims, z, Plane::default())
