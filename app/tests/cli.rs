@@ -434,6 +434,12 @@ fn bench_reports_evaluation_and_export_rates() {
             && out.lines().next().unwrap().contains("about 200000 voxels"),
         "{out}"
     );
+    // The second, which machine and how many threads.
+    let machine = out.lines().nth(1).unwrap_or_default();
+    assert!(
+        machine.starts_with("machine: ") && machine.contains(" thread"),
+        "{out}"
+    );
     let row = out
         .lines()
         .find(|l| l.starts_with("graded_bar.rhai"))

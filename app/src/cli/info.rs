@@ -109,6 +109,9 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
             )
         }
     );
+    // Which machine: figures differ by a factor of two between the
+    // processors this project's machines have had (docs/PERFORMANCE.md).
+    println!("machine: {}", machine());
     println!(
         "{:<28} {:>8} {:>14} {:>16} {:>16} {:>11} {:>14} {:>14}",
         "design",
@@ -155,6 +158,29 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// The processor and the threads the figures use, as `volcad bench`
+/// prints them: `/proc/cpuinfo`'s model name where there is one (Linux),
+/// else the architecture.
+fn machine() -> String {
+    let model = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| cpu_model(&s));
+    let threads = rayon::current_num_threads();
+    format!(
+        "{}, {threads} thread{}",
+        model.unwrap_or_else(|| std::env::consts::ARCH.to_string()),
+        if threads == 1 { "" } else { "s" }
+    )
+}
+
+/// The first `model name` in a `/proc/cpuinfo` text.
+fn cpu_model(cpuinfo: &str) -> Option<String> {
+    cpuinfo.lines().find_map(|l| {
+        let (key, value) = l.split_once(':')?;
+        (key.trim() == "model name" && !value.trim().is_empty()).then(|| value.trim().to_string())
+    })
 }
 
 /// Export passes per figure: the median of up to three, as points/s takes
@@ -226,4 +252,22 @@ fn next_id() -> u64 {
     use std::sync::atomic::{AtomicU64, Ordering};
     static N: AtomicU64 = AtomicU64::new(0);
     N.fetch_add(1, Ordering::Relaxed)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::cpu_model;
+
+    #[test]
+    fn the_processor_is_the_first_model_name() {
+        let text = "processor\t: 0\nvendor_id\t: GenuineIntel\nmodel name\t: Intel(R) Xeon(R) Processor\n\
+                    \nprocessor\t: 1\nmodel name\t: Other\n";
+        assert_eq!(
+            cpu_model(text).as_deref(),
+            Some("Intel(R) Xeon(R) Processor")
+        );
+        // No model name (some ARM kernels), or an empty one: none.
+        assert_eq!(cpu_model("processor\t: 0\nBogoMIPS\t: 50.00\n"), None);
+        assert_eq!(cpu_model("model name\t:   \n"), None);
+    }
 }
