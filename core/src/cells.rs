@@ -107,6 +107,16 @@ impl CellLattice {
     pub fn dims(&self) -> [usize; 3] {
         self.dims
     }
+
+    /// The lower corner of cell `[0, 0, 0]`.
+    pub fn origin(&self) -> DVec3 {
+        self.min
+    }
+
+    /// The size of a cell along each axis.
+    pub fn cell(&self) -> DVec3 {
+        self.cell
+    }
 }
 
 #[cfg(test)]

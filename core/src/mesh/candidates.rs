@@ -162,7 +162,7 @@ impl CandidateGrid {
                     bi / bdims[0] % bdims[1],
                     bi / (bdims[0] * bdims[1]),
                 );
-                let corner = min + DVec3::new(bx as f64, by as f64, bz as f64) * 2.0 * cell;
+                let corner = block_corner(min, cell, [bx, by, bz]);
                 let cb = corner + DVec3::splat(cell);
                 let mut out: [(i8, Vec<Candidate>); 8] = Default::default();
                 // Blocks the coarse grid proves far from the surface keep no
@@ -181,8 +181,7 @@ impl CandidateGrid {
                 };
                 let mut d2s = vec![0.0; block.len()];
                 for (k, o) in out.iter_mut().enumerate() {
-                    let off = DVec3::new((k & 1) as f64, (k >> 1 & 1) as f64, (k >> 2) as f64);
-                    let c = corner + (off + 0.5) * cell;
+                    let c = build_centre(corner, cell, k);
                     let mut best = (f64::INFINITY, 0usize);
                     for (d2, e) in d2s.iter_mut().zip(&block) {
                         *d2 = mesh.tris[e.slot as usize].distance_squared(c);
@@ -436,6 +435,47 @@ impl TriangleMesh {
             }
         }
         Some(out)
+    }
+}
+
+/// The lower corner of block `b` (2×2×2 cells of size `cell` from `min`).
+fn block_corner(min: DVec3, cell: f64, b: [usize; 3]) -> DVec3 {
+    min + DVec3::new(b[0] as f64, b[1] as f64, b[2] as f64) * 2.0 * cell
+}
+
+/// The centre of cell `k` (x fastest) of the block at `corner`, as the
+/// build computes it (its lists are exact for this point).
+fn build_centre(corner: DVec3, cell: f64, k: usize) -> DVec3 {
+    let off = DVec3::new((k & 1) as f64, (k >> 1 & 1) as f64, (k >> 2) as f64);
+    corner + (off + 0.5) * cell
+}
+
+#[cfg(test)]
+impl CandidateGrid {
+    /// Cell `xyz`'s list as triangle slots in stored order, its side, and
+    /// the centre and half diagonal the build used: for tests that check
+    /// the lists against their definition.
+    pub(crate) fn cell_list(&self, xyz: [usize; 3]) -> (Vec<u32>, i8, DVec3, f64) {
+        let i = self.cells.index(xyz);
+        let (a, b) = (
+            self.records[i] & START_MASK,
+            self.records[i + 1] & START_MASK,
+        );
+        let mask = (1u32 << self.slot_bits) - 1;
+        let slots = self.items[a as usize..b as usize]
+            .iter()
+            .map(|e| e & mask)
+            .collect();
+        let cell = self.cells.cell().x;
+        let b = [xyz[0] / 2, xyz[1] / 2, xyz[2] / 2];
+        let k = (xyz[0] & 1) | (xyz[1] & 1) << 1 | (xyz[2] & 1) << 2;
+        let c = build_centre(block_corner(self.cells.origin(), cell, b), cell, k);
+        (slots, side_of(self.records[i]), c, 0.5 * cell * 3f64.sqrt())
+    }
+
+    /// Cells along each axis.
+    pub(crate) fn dims(&self) -> [usize; 3] {
+        self.cells.dims()
     }
 }
 
