@@ -108,13 +108,16 @@ impl CellLattice {
         self.dims
     }
 
-    /// The lower corner of cell `[0, 0, 0]`.
-    pub fn origin(&self) -> DVec3 {
+    /// The lower corner of cell `[0, 0, 0]` (for tests that rebuild the
+    /// centres a build used).
+    #[cfg(test)]
+    pub(crate) fn origin(&self) -> DVec3 {
         self.min
     }
 
-    /// The size of a cell along each axis.
-    pub fn cell(&self) -> DVec3 {
+    /// The size of a cell along each axis (for tests, as `origin`).
+    #[cfg(test)]
+    pub(crate) fn cell(&self) -> DVec3 {
         self.cell
     }
 }

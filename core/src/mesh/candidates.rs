@@ -145,7 +145,7 @@ impl CandidateGrid {
         // Dimensions rounded up to even: cells are built in 2×2×2 blocks.
         let n = ((b.max + DVec3::splat(PAD * cell) - min) / cell / 2.0).ceil() * 2.0;
         let dims = [n.x as usize, n.y as usize, n.z as usize];
-        let r = 0.5 * cell * 3f64.sqrt();
+        let r = half_diagonal(cell);
         let lattice = CellLattice::new(min, DVec3::splat(cell), dims);
         let count = lattice.slots();
         let slack = |v: f64| v * (1.0 + 1e-9) + 1e-12 * extent;
@@ -200,13 +200,14 @@ impl CandidateGrid {
                     let reach2 = slack(u + 2.0 * r).powi(2);
                     // Counted first, so a list is one allocation of its
                     // size (collected through the filter, the lists grew
-                    // by doubling: 8 % of the seat's load in `realloc`),
+                    // by doubling: 6.5 % of the seat's load in `realloc`),
                     // and a list too long to keep none.
-                    let n = d2s.iter().filter(|d2| **d2 <= reach2).count();
+                    let kept = |d2: &f64| *d2 <= reach2;
+                    let n = d2s.iter().filter(|d2| kept(d2)).count();
                     let mut list = Vec::new();
                     if n <= MAX_LIST {
                         list.reserve_exact(n);
-                        list.extend(d2s.iter().zip(&block).filter(|(d2, _)| **d2 <= reach2).map(
+                        list.extend(d2s.iter().zip(&block).filter(|(d2, _)| kept(d2)).map(
                             |(d2, e)| Candidate {
                                 dc: f32_down(d2.sqrt()),
                                 slot: e.slot,
@@ -438,6 +439,12 @@ impl TriangleMesh {
     }
 }
 
+/// Half the diagonal of a cubic cell of side `cell`: no point of the cell
+/// is farther from its centre.
+fn half_diagonal(cell: f64) -> f64 {
+    0.5 * cell * 3f64.sqrt()
+}
+
 /// The lower corner of block `b` (2×2×2 cells of size `cell` from `min`).
 fn block_corner(min: DVec3, cell: f64, b: [usize; 3]) -> DVec3 {
     min + DVec3::new(b[0] as f64, b[1] as f64, b[2] as f64) * 2.0 * cell
@@ -470,7 +477,7 @@ impl CandidateGrid {
         let b = [xyz[0] / 2, xyz[1] / 2, xyz[2] / 2];
         let k = (xyz[0] & 1) | (xyz[1] & 1) << 1 | (xyz[2] & 1) << 2;
         let c = build_centre(block_corner(self.cells.origin(), cell, b), cell, k);
-        (slots, side_of(self.records[i]), c, 0.5 * cell * 3f64.sqrt())
+        (slots, side_of(self.records[i]), c, half_diagonal(cell))
     }
 
     /// Cells along each axis.
