@@ -38,6 +38,15 @@ struct Node4 {
     child: [u32; 4],
 }
 
+/// One child of a node, as [`WideBvh::children`] lists them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum WideChild {
+    /// A primitive's slot.
+    Prim(u32),
+    /// Another node's index.
+    Node(u32),
+}
+
 /// The collapsed tree. Node 0 is the root.
 #[derive(Clone, Debug)]
 pub(crate) struct WideBvh {
@@ -203,21 +212,50 @@ impl WideBvh {
 
     /// Calls `f` with every primitive whose box may meet `b` (boxes and `b`
     /// rounded outwards); stops and returns false as soon as `f` does.
-    pub fn overlapping<F: FnMut(u32) -> bool>(&self, b: &Aabb, f: F) -> bool {
-        let lo = [b.min.x, b.min.y, b.min.z].map(|v| Vec4::splat(down(v)));
-        let hi = [b.max.x, b.max.y, b.max.z].map(|v| Vec4::splat(up(v)));
+    pub fn overlapping<F: FnMut(u32) -> bool>(&self, b: &Aabb, mut f: F) -> bool {
+        let q = RoundedBox::new(b);
         self.walk(
-            |n| {
-                (n.lo[0].cmple(hi[0])
-                    & n.hi[0].cmpge(lo[0])
-                    & n.lo[1].cmple(hi[1])
-                    & n.hi[1].cmpge(lo[1])
-                    & n.lo[2].cmple(hi[2])
-                    & n.hi[2].cmpge(lo[2]))
-                .bitmask()
+            |n| (q.meets(n), 0),
+            |c| match c {
+                WideChild::Prim(slot) => f(slot),
+                WideChild::Node(_) => true, // (no lane is whole)
             },
-            f,
         )
+    }
+
+    /// Nodes in the tree (node 0 is the root), for tables kept per node.
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// The children of node `i`: a primitive's slot or another node. A
+    /// node's children have larger indices than the node (the build pushes
+    /// a node before its children), so a pass over the nodes from the last
+    /// to the first sees every child before its parent.
+    pub fn children(&self, i: usize) -> impl Iterator<Item = WideChild> + '_ {
+        self.nodes[i]
+            .child
+            .iter()
+            .filter(|&&c| c != EMPTY)
+            .map(|&c| {
+                if c & PRIM != 0 {
+                    WideChild::Prim(c & !PRIM)
+                } else {
+                    WideChild::Node(c)
+                }
+            })
+    }
+
+    /// As [`WideBvh::overlapping`], calling `visit` with each primitive
+    /// reached, but a node whose (rounded) box lies within `b`'s is handed
+    /// whole to `visit` as [`WideChild::Node`] instead of being opened: every primitive below it meets `b`, since a primitive's box
+    /// lies within each box above it (node boxes are unions of their
+    /// children's, and rounding outwards keeps the order), so the caller
+    /// can use a summary kept per node and visit the same primitives. Stops
+    /// and returns false as soon as `visit` does.
+    pub fn overlapping_nodes(&self, b: &Aabb, visit: impl FnMut(WideChild) -> bool) -> bool {
+        let q = RoundedBox::new(b);
+        self.walk(|n| (q.meets(n), q.holds(n)), visit)
     }
 
     /// First primitive whose box contains `p` and for which `test(slot)` is
@@ -230,15 +268,19 @@ impl WideBvh {
         let mut found = None;
         self.walk(
             |n| {
-                (px.cmpge(n.lo[0])
+                let lanes = (px.cmpge(n.lo[0])
                     & px.cmple(n.hi[0])
                     & py.cmpge(n.lo[1])
                     & py.cmple(n.hi[1])
                     & pz.cmpge(n.lo[2])
                     & pz.cmple(n.hi[2]))
-                .bitmask()
+                .bitmask();
+                (lanes, 0)
             },
-            |slot| {
+            |c| {
+                let WideChild::Prim(slot) = c else {
+                    return true; // (no lane is whole)
+                };
                 let hit = test(slot);
                 if hit {
                     found = Some(slot);
@@ -249,26 +291,40 @@ impl WideBvh {
         found
     }
 
-    /// Depth-first walk into the children that `lanes` selects (a bit mask
-    /// of a node's four lanes), calling `leaf` with each primitive reached;
-    /// stops and returns false as soon as `leaf` does.
+    /// Depth-first walk into the children that `lanes` selects (bit masks
+    /// of a node's four lanes: the lanes to enter, and among them the inner
+    /// ones to hand to `visit` whole instead of opening), calling `visit`
+    /// with each primitive reached and each whole node; stops and returns
+    /// false as soon as `visit` does.
     #[inline(always)]
-    fn walk(&self, lanes: impl Fn(&Node4) -> u32, mut leaf: impl FnMut(u32) -> bool) -> bool {
+    fn walk(
+        &self,
+        lanes: impl Fn(&Node4) -> (u32, u32),
+        mut visit: impl FnMut(WideChild) -> bool,
+    ) -> bool {
         let mut stack = Stack::<u32>::new();
         let mut ni = 0usize;
         loop {
             let n = &self.nodes[ni];
-            let mut mask = lanes(n);
+            let (mut mask, whole) = lanes(n);
             while mask != 0 {
                 let lane = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
                 let c = n.child[lane];
-                if c & PRIM != 0 {
-                    if !leaf(c & !PRIM) {
-                        return false;
-                    }
+                let reached = if c & PRIM != 0 {
+                    Some(WideChild::Prim(c & !PRIM))
+                } else if whole & (1 << lane) != 0 {
+                    Some(WideChild::Node(c))
                 } else {
-                    stack.push(c);
+                    None
+                };
+                match reached {
+                    Some(r) => {
+                        if !visit(r) {
+                            return false;
+                        }
+                    }
+                    None => stack.push(c),
                 }
             }
             match stack.pop() {
@@ -276,6 +332,47 @@ impl WideBvh {
                 None => return true,
             }
         }
+    }
+}
+
+/// A query box rounded outwards to `f32`, splat across the four lanes.
+struct RoundedBox {
+    lo: [Vec4; 3],
+    hi: [Vec4; 3],
+}
+
+impl RoundedBox {
+    fn new(b: &Aabb) -> RoundedBox {
+        RoundedBox {
+            lo: [b.min.x, b.min.y, b.min.z].map(|v| Vec4::splat(down(v))),
+            hi: [b.max.x, b.max.y, b.max.z].map(|v| Vec4::splat(up(v))),
+        }
+    }
+
+    /// Lanes of `n` whose boxes meet this one.
+    #[inline(always)]
+    fn meets(&self, n: &Node4) -> u32 {
+        let (lo, hi) = (&self.lo, &self.hi);
+        (n.lo[0].cmple(hi[0])
+            & n.hi[0].cmpge(lo[0])
+            & n.lo[1].cmple(hi[1])
+            & n.hi[1].cmpge(lo[1])
+            & n.lo[2].cmple(hi[2])
+            & n.hi[2].cmpge(lo[2]))
+        .bitmask()
+    }
+
+    /// Lanes of `n` whose boxes lie within this one.
+    #[inline(always)]
+    fn holds(&self, n: &Node4) -> u32 {
+        let (lo, hi) = (&self.lo, &self.hi);
+        (n.lo[0].cmpge(lo[0])
+            & n.hi[0].cmple(hi[0])
+            & n.lo[1].cmpge(lo[1])
+            & n.hi[1].cmple(hi[1])
+            & n.lo[2].cmpge(lo[2])
+            & n.hi[2].cmple(hi[2]))
+        .bitmask()
     }
 }
 

@@ -13,6 +13,7 @@
 mod boundary;
 mod csv;
 mod inp;
+mod ranges;
 mod tet_bvh;
 
 #[cfg(test)]
@@ -26,6 +27,7 @@ use crate::bounds::Aabb;
 use crate::interval::Interval;
 use crate::mesh::TriangleMesh;
 
+use self::ranges::NodeRanges;
 use self::tet_bvh::TetLocator;
 
 /// Why a simulation field could not be loaded or built. File errors name
@@ -199,6 +201,8 @@ pub struct SimField {
     /// Stored columns of dx, dy, dz when `len` is derived.
     len_from: Option<[usize; 3]>,
     locator: TetLocator,
+    /// Value ranges per node of the locator's tree, for `bounds`.
+    ranges: NodeRanges,
     boundary: TriangleMesh,
     warnings: Vec<String>,
 }
@@ -331,16 +335,13 @@ impl SimField {
         }
         let mut lo = [f64::INFINITY; 64];
         let mut hi = [f64::NEG_INFINITY; 64];
+        // One row of the range table per tetrahedron that meets `b`, and
+        // per tree node that lies within it (the same tetrahedra, see
+        // `ranges`).
         let mut count = 0;
-        let complete = self.locator.overlapping(b, |nodes| {
-            count += 1;
-            for n in nodes {
-                let row = &self.values[n as usize * s..(n as usize + 1) * s];
-                for (c, v) in row.iter().enumerate() {
-                    lo[c] = lo[c].min(*v);
-                    hi[c] = hi[c].max(*v);
-                }
-            }
+        let complete = self.locator.overlapping_nodes(b, |c| {
+            count += self.ranges.count(c);
+            self.ranges.merge(c, &mut lo[..s], &mut hi[..s]);
             count <= MAX_BOUND_TETS
         });
         if !complete || count == 0 {
@@ -540,6 +541,7 @@ fn build(
             .map(|w| format!("boundary surface: {w}")),
     );
     let locator = TetLocator::new(&nodes, &tets, &boundary);
+    let ranges = NodeRanges::new(&locator, &values, stride);
     Ok(SimField {
         nodes,
         tets,
@@ -548,6 +550,7 @@ fn build(
         stride,
         len_from,
         locator,
+        ranges,
         boundary,
         warnings,
     })

@@ -90,6 +90,58 @@ fn seat_bounds_hold_at_every_sample_of_random_boxes() {
     assert!(bounded > 150, "{bounded} boxes bounded");
 }
 
+/// `SimField::bounds` as it was before the per-node table: every
+/// tetrahedron's nodal rows read one by one.
+fn bounds_tet_by_tet(f: &SimField, b: &crate::bounds::Aabb) -> Option<Vec<(f64, f64)>> {
+    let s = f.stride;
+    let mut lo = vec![f64::INFINITY; s];
+    let mut hi = vec![f64::NEG_INFINITY; s];
+    let mut count = 0;
+    let complete = f.locator.overlapping(b, |nodes| {
+        count += 1;
+        for n in nodes {
+            for c in 0..s {
+                let v = f.values[n as usize * s + c];
+                lo[c] = lo[c].min(v);
+                hi[c] = hi[c].max(v);
+            }
+        }
+        count <= super::MAX_BOUND_TETS
+    });
+    (complete && count > 0).then(|| lo.into_iter().zip(hi).collect())
+}
+
+#[test]
+fn seat_bounds_from_the_node_table_equal_the_tetrahedra_one_by_one() {
+    let f = SimField::load(&seat("seat.inp"), &seat("seat_displacement_table.csv")).unwrap();
+    let bb = f.bbox();
+    let mut rng = Rng::new(23);
+    let mut iv = [crate::interval::Interval::point(0.0); 4];
+    let (mut bounded, mut too_many) = (0, 0);
+    for i in 0..3000 {
+        // From a fraction of one tetrahedron to more than MAX_BOUND_TETS.
+        let size = [0.2, 1.0, 3.0, 6.0, 10.0, 20.0][i % 6];
+        let c = rng.in_box(&bb);
+        let b = crate::bounds::Aabb::new(c - DVec3::splat(size), c + DVec3::splat(size));
+        let got = f.bounds(&b, &mut iv);
+        let want = bounds_tet_by_tet(&f, &b);
+        assert_eq!(got, want.is_some(), "box {b:?}");
+        let Some(want) = want else {
+            too_many += usize::from(f.locator.overlapping(&b, |_| false));
+            continue;
+        };
+        bounded += 1;
+        // The stored columns (dx, dy, dz), bit for bit.
+        assert_eq!(want.len(), 3);
+        for (k, (lo, hi)) in want.iter().enumerate() {
+            assert_eq!(iv[k].lo.to_bits(), lo.to_bits(), "box {b:?} column {k}");
+            assert_eq!(iv[k].hi.to_bits(), hi.to_bits(), "box {b:?} column {k}");
+        }
+    }
+    assert!(bounded > 1000, "{bounded} boxes bounded");
+    assert!(too_many < 3000 && bounded < 3000, "{too_many}");
+}
+
 #[test]
 fn seat_headerless_and_table_agree() {
     let a = SimField::load(&seat("seat.inp"), &seat("seat_displacement.csv")).unwrap();

@@ -40,7 +40,7 @@ use glam::DVec3;
 use crate::bounds::Aabb;
 use crate::mesh::TriangleMesh;
 use crate::mesh::bvh;
-use crate::mesh::wide::WideBvh;
+use crate::mesh::wide::{WideBvh, WideChild};
 
 /// Barycentric tolerance (dimensionless).
 const TOLERANCE: f64 = -1e-12;
@@ -194,11 +194,37 @@ impl TetLocator {
         loc
     }
 
-    /// Calls `f` with the nodes of every tetrahedron whose box meets `b`;
-    /// stops and returns false as soon as `f` does.
+    /// Calls `f` with the nodes of every tetrahedron whose box meets `b`,
+    /// one by one (the reference for [`TetLocator::overlapping_nodes`]).
+    #[cfg(test)]
     pub fn overlapping(&self, b: &Aabb, mut f: impl FnMut([u32; 4]) -> bool) -> bool {
         self.wide
             .overlapping(b, |slot| f(self.data[slot as usize].nodes))
+    }
+
+    /// The tree's nodes and their children (tetrahedra by slot), for a
+    /// table kept per node; see [`WideBvh::children`] for the order.
+    pub fn tree_nodes(&self) -> impl Iterator<Item = impl Iterator<Item = WideChild> + '_> + '_ {
+        (0..self.wide.node_count()).map(|i| self.wide.children(i))
+    }
+
+    /// Tetrahedra, one per slot (the tree's order).
+    pub fn slot_count(&self) -> usize {
+        self.data.len()
+    }
+
+    /// The four nodes of the tetrahedron in `slot`.
+    #[inline]
+    pub fn slot_nodes(&self, slot: u32) -> [u32; 4] {
+        self.data[slot as usize].nodes
+    }
+
+    /// Calls `f` with the slot of every tetrahedron whose box meets `b`,
+    /// except that a tree node whose box lies within `b` goes whole to `f`
+    /// (see [`WideBvh::overlapping_nodes`]); stops and returns false as soon
+    /// as `f` does.
+    pub fn overlapping_nodes(&self, b: &Aabb, f: impl FnMut(WideChild) -> bool) -> bool {
+        self.wide.overlapping_nodes(b, f)
     }
 
     /// About one cell per tetrahedron over the mesh box; each cell remembers
@@ -267,7 +293,7 @@ impl TetLocator {
     pub(super) fn unstarted_cells(&self) -> usize {
         let g = &self.grid;
         (0..g.start.len())
-            .filter(|&i| g.start[i] == NONE && !self.overlapping(&g.cell(i).0, |_| false))
+            .filter(|&i| g.start[i] == NONE && !self.wide.overlapping(&g.cell(i).0, |_| false))
             .count()
     }
 
