@@ -37,6 +37,7 @@ pub mod mesh;
 pub mod model;
 pub mod names;
 pub mod node;
+pub mod order;
 pub mod sampler;
 pub mod script;
 pub mod simfield;

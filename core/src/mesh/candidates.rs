@@ -289,7 +289,7 @@ impl CandidateGrid {
         tasks.into_par_iter().for_each(|(cells, out)| {
             let mut k = 0;
             for (_, l) in cells {
-                l.sort_unstable_by(|a, b| a.dc.total_cmp(&b.dc).then(a.slot.cmp(&b.slot)));
+                l.sort_unstable_by_key(|c| crate::order::f32_then_index(c.dc, c.slot));
                 let frame = l
                     .first()
                     .filter(|_| certified)

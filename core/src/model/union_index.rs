@@ -193,7 +193,7 @@ impl UnionIndex {
         }
         for c in 0..ncells {
             entries[offsets[c] as usize..offsets[c + 1] as usize]
-                .sort_unstable_by(|a, b| a.lo.total_cmp(&b.lo).then(a.child.cmp(&b.child)));
+                .sort_unstable_by_key(|e| crate::order::f32_then_index(e.lo, e.child));
         }
         let bvh = Bvh::build(boxes, &finite);
         Self {
