@@ -445,8 +445,20 @@ impl Grade {
 
 impl SimGrade {
     fn frac(&self, p: DVec3, out: &mut [f64]) {
+        // The seat's 13 slots in a 16-slot scratch array: zeroing 64 per
+        // sample was a 512-byte memset, 2 % of its mesh export's
+        // instructions.
+        if COORD_SLOTS + self.field.variable_count() <= 16 {
+            self.frac_in::<16>(p, out)
+        } else {
+            self.frac_in::<64>(p, out)
+        }
+    }
+
+    #[inline(always)]
+    fn frac_in<const N: usize>(&self, p: DVec3, out: &mut [f64]) {
         let n = COORD_SLOTS + self.field.variable_count();
-        let mut slots = [0.0; 64];
+        let mut slots = [0.0; N];
         let slots = &mut slots[..n];
         coord_slots(p, self.used, slots);
         if !self.field.sample(p, &mut slots[COORD_SLOTS..]) {

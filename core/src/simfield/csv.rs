@@ -28,6 +28,11 @@ const ID_NAMES: [&str; 4] = ["node_id", "id", "node", "nodeid"];
 /// warnings.
 pub(crate) type Columns = (Vec<(String, Vec<f64>)>, Vec<String>);
 
+/// Most value columns a results CSV may have besides the node id and x, y,
+/// z: with the derived `len` and the nine coordinate variables they fill
+/// the 64 expression slots a sample uses.
+pub(crate) const MAX_VALUE_COLUMNS: usize = 54;
+
 /// Reads the CSV at `path` for `mesh`.
 pub(crate) fn parse(path: &Path, mesh: &InpMesh) -> Result<Columns, SimFieldError> {
     let bytes = std::fs::read(path).map_err(|e| SimFieldError::Io {
@@ -83,6 +88,21 @@ pub(crate) fn parse(path: &Path, mesh: &InpMesh) -> Result<Columns, SimFieldErro
             .position(|n| ID_NAMES.iter().any(|id| n.eq_ignore_ascii_case(id)));
         if names.len() - id_col.is_some() as usize == 0 {
             return Err(csv_err(first_ln, "the header names no value column".into()));
+        }
+        let values = names
+            .iter()
+            .enumerate()
+            .filter(|&(k, n)| {
+                Some(k) != id_col && !["x", "y", "z"].contains(&n.to_ascii_lowercase().as_str())
+            })
+            .count();
+        if values > MAX_VALUE_COLUMNS {
+            return Err(csv_err(
+                first_ln,
+                format!(
+                    "the header names {values} value columns besides the node id and x, y, z; at most {MAX_VALUE_COLUMNS} are supported"
+                ),
+            ));
         }
         (names, id_col, lines.collect())
     };

@@ -524,6 +524,12 @@ fn build(
     if len_from.is_some() {
         names.push("len".into());
     }
+    if stride > csv::MAX_VALUE_COLUMNS {
+        return Err(other(format!(
+            "{stride} value columns besides x, y, z; at most {} are supported",
+            csv::MAX_VALUE_COLUMNS
+        )));
+    }
 
     let b = boundary::extract(&nodes, &tets);
     if b.overused_faces > 0 {

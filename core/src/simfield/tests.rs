@@ -385,6 +385,52 @@ fn tiny_deck_ids_continuations_and_skipped_types() {
     }
 }
 
+/// A field with `n` value columns `c0, c1, ...` (besides x, y, z), each
+/// linear in x, and dx, dy, dz when `with_len`.
+fn wide_csv(n: usize) -> String {
+    let ids = [5, 10, 2, 3, 4];
+    let xs = [1.0, 0.0, 1.0, 0.0, 0.0];
+    let mut text = String::from("node_id,x");
+    for k in 0..n {
+        text += &format!(",c{k}");
+    }
+    text += "\n";
+    for (id, x) in ids.iter().zip(xs) {
+        text += &format!("{id},{x}");
+        for k in 0..n {
+            text += &format!(",{}", x * k as f64);
+        }
+        text += "\n";
+    }
+    text
+}
+
+#[test]
+fn too_many_columns_is_an_error_not_a_panic() {
+    // 54 value columns load and sample (with the nine coordinates, 63 slots).
+    let inp = write("wide.inp", TINY_INP);
+    let csv = write("wide.csv", &wide_csv(54));
+    let f = SimField::load(&inp, &csv).unwrap();
+    assert_eq!(f.variable_count(), 54);
+    let mut out = vec![0.0; 54];
+    assert!(f.sample(DVec3::new(0.2, 0.2, 0.2), &mut out));
+    assert!((out[53] - 0.2 * 53.0).abs() < 1e-9, "{}", out[53]);
+    for p in [inp, csv] {
+        let _ = std::fs::remove_file(p);
+    }
+    // 55 are refused, naming the header's line.
+    expect_error(
+        TINY_INP,
+        &wide_csv(55),
+        Some(("csv", 1)),
+        "55 value columns besides the node id and x, y, z; at most 54",
+    );
+    let (nodes, tets) = two_tets();
+    let columns = (0..55).map(|k| (format!("c{k}"), vec![0.0; nodes.len()])).collect();
+    let e = SimField::from_parts(nodes, tets, columns).unwrap_err();
+    assert!(e.to_string().contains("55 value columns"), "{e}");
+}
+
 /// Asserts that loading fails with a message containing `what` (and the
 /// file:line prefix when `line` is given).
 fn expect_error(inp_text: &str, csv_text: &str, line: Option<(&str, usize)>, what: &str) {
