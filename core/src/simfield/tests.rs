@@ -426,7 +426,9 @@ fn too_many_columns_is_an_error_not_a_panic() {
         "55 value columns besides the node id and x, y, z; at most 54",
     );
     let (nodes, tets) = two_tets();
-    let columns = (0..55).map(|k| (format!("c{k}"), vec![0.0; nodes.len()])).collect();
+    let columns = (0..55)
+        .map(|k| (format!("c{k}"), vec![0.0; nodes.len()]))
+        .collect();
     let e = SimField::from_parts(nodes, tets, columns).unwrap_err();
     assert!(e.to_string().contains("55 value columns"), "{e}");
 }
