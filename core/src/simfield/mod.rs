@@ -531,22 +531,30 @@ fn build(
         )));
     }
 
-    let b = boundary::extract(&nodes, &tets);
-    if b.overused_faces > 0 {
+    // The boundary surface (its candidate grid is built in parallel) and
+    // the tetrahedra's tree (sequential) at once: the tree's build no
+    // longer waits for the surface's.
+    let (surface, mut locator) = rayon::join(
+        || {
+            let b = boundary::extract(&nodes, &tets);
+            let overused = b.overused_faces;
+            TriangleMesh::from_triangles(b.vertices, b.triangles).map(|m| (m, overused))
+        },
+        || TetLocator::unstarted(&nodes, &tets),
+    );
+    let (boundary, overused) = surface.map_err(|e| other(format!("boundary surface: {e}")))?;
+    if overused > 0 {
         warnings.push(format!(
-            "{} faces are shared by more than two tetrahedra (non-conforming mesh)",
-            b.overused_faces
+            "{overused} faces are shared by more than two tetrahedra (non-conforming mesh)"
         ));
     }
-    let boundary = TriangleMesh::from_triangles(b.vertices, b.triangles)
-        .map_err(|e| other(format!("boundary surface: {e}")))?;
     warnings.extend(
         boundary
             .warnings()
             .into_iter()
             .map(|w| format!("boundary surface: {w}")),
     );
-    let locator = TetLocator::new(&nodes, &tets, &boundary);
+    locator.start_walks(&boundary);
     let ranges = NodeRanges::new(&locator, &values, stride);
     Ok(SimField {
         nodes,

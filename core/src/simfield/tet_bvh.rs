@@ -143,9 +143,12 @@ pub(crate) fn signed_volume(p: [DVec3; 4]) -> f64 {
 }
 
 impl TetLocator {
-    /// Builds the locator. Tetrahedra must be non-degenerate and indices
-    /// valid (checked by the caller); `boundary` is the mesh's surface.
-    pub fn new(nodes: &[DVec3], tets: &[[u32; 4]], boundary: &TriangleMesh) -> TetLocator {
+    /// Builds the locator's tree and neighbour links, without the start
+    /// grid ([`TetLocator::start_walks`] adds it): they do not need the
+    /// boundary surface, so the field's build makes both at once.
+    /// Tetrahedra must be non-degenerate and indices valid (checked by the
+    /// caller).
+    pub fn unstarted(nodes: &[DVec3], tets: &[[u32; 4]]) -> TetLocator {
         let boxes: Vec<Aabb> = tets
             .iter()
             .map(|t| {
@@ -178,7 +181,7 @@ impl TetLocator {
             })
             .collect();
         link_neighbours(&mut data);
-        let mut loc = TetLocator {
+        TetLocator {
             wide,
             data,
             order,
@@ -189,9 +192,13 @@ impl TetLocator {
                 dims: [0; 3],
                 start: Vec::new(),
             },
-        };
-        loc.grid = loc.start_grid(boundary);
-        loc
+        }
+    }
+
+    /// Adds the start grid over `boundary` (the mesh's surface); until
+    /// then every point searches the tree.
+    pub fn start_walks(&mut self, boundary: &TriangleMesh) {
+        self.grid = self.start_grid(boundary);
     }
 
     /// Calls `f` with the nodes of every tetrahedron whose box meets `b`,
