@@ -74,6 +74,8 @@ pub(crate) fn parse(path: &Path) -> Result<InpMesh, SimFieldError> {
     // An element whose node list continues on the next line.
     let mut pending: Vec<String> = Vec::new();
     let mut pending_line = 0;
+    // The current data line's fields (one buffer for every line).
+    let mut fields: Vec<&str> = Vec::new();
 
     for (i, raw_line) in text.lines().enumerate() {
         let ln = i + 1;
@@ -138,7 +140,7 @@ pub(crate) fn parse(path: &Path) -> Result<InpMesh, SimFieldError> {
         match &block {
             Block::Skip => {}
             Block::Node => {
-                let fields: Vec<&str> = split_fields(line);
+                split_fields_into(line, &mut fields);
                 if fields.len() < 4 {
                     return Err(err(
                         ln,
@@ -178,40 +180,38 @@ pub(crate) fn parse(path: &Path) -> Result<InpMesh, SimFieldError> {
                 mesh.node_lines.push(ln);
             }
             Block::Tets { n } => {
-                if pending.is_empty() {
+                let n = *n;
+                // Most elements fit on one line: parsed from borrowed
+                // fields. One that continues collects owned fields.
+                let one_line = pending.is_empty();
+                if one_line {
                     pending_line = ln;
+                    split_fields_into(line, &mut fields);
+                } else {
+                    split_fields_into(line, &mut fields);
+                    pending.extend(fields.iter().map(|f| f.to_string()));
                 }
-                pending.extend(split_fields(line).into_iter().map(str::to_string));
-                if pending.len() < n + 1 && line.ends_with(',') {
+                let have = if one_line {
+                    fields.len()
+                } else {
+                    pending.len()
+                };
+                if have < n + 1 && line.ends_with(',') {
+                    if one_line {
+                        pending.extend(fields.iter().map(|f| f.to_string()));
+                    }
                     continue; // continuation line follows
                 }
-                let fields = std::mem::take(&mut pending);
-                if fields.len() != n + 1 {
-                    return Err(err(
-                        pending_line,
-                        format!(
-                            "expected an element line `id, n1, …, n{n}` ({} fields), found {} fields",
-                            n + 1,
-                            fields.len()
-                        ),
-                    ));
-                }
-                let id = parse_id(&fields[0]).ok_or_else(|| {
-                    err(
-                        pending_line,
-                        format!("element id `{}` is not a positive integer", fields[0]),
-                    )
-                })?;
-                let mut corners = [0u64; 4];
-                for (k, f) in fields[1..5].iter().enumerate() {
-                    corners[k] = parse_id(f).ok_or_else(|| {
-                        err(
-                            pending_line,
-                            format!("element {id}: node id `{f}` is not a positive integer"),
-                        )
-                    })?;
-                }
-                if *n == 10 {
+                let joined = std::mem::take(&mut pending);
+                let all: Vec<&str>;
+                let parts: &[&str] = if one_line {
+                    &fields
+                } else {
+                    all = joined.iter().map(String::as_str).collect();
+                    &all
+                };
+                let (id, corners) = element(parts, n).map_err(|m| err(pending_line, m))?;
+                if n == 10 {
                     c3d10 += 1;
                 }
                 raw.push((id, corners, pending_line));
@@ -272,14 +272,34 @@ pub(crate) fn parse(path: &Path) -> Result<InpMesh, SimFieldError> {
     Ok(mesh)
 }
 
-/// Comma-separated fields, trimmed, without the empty field a trailing comma
-/// leaves.
-fn split_fields(line: &str) -> Vec<&str> {
-    let mut f: Vec<&str> = line.split(',').map(str::trim).collect();
-    if f.last() == Some(&"") {
-        f.pop();
+/// Comma-separated fields of `line` into `out`, trimmed, without the empty
+/// field a trailing comma leaves.
+fn split_fields_into<'a>(line: &'a str, out: &mut Vec<&'a str>) {
+    out.clear();
+    out.extend(line.split(',').map(str::trim));
+    if out.last() == Some(&"") {
+        out.pop();
     }
-    f
+}
+
+/// An element's id and corner node ids from its fields (`id, n1, …, nn`),
+/// or what is wrong with them.
+fn element(fields: &[&str], n: usize) -> Result<(u64, [u64; 4]), String> {
+    if fields.len() != n + 1 {
+        return Err(format!(
+            "expected an element line `id, n1, …, n{n}` ({} fields), found {} fields",
+            n + 1,
+            fields.len()
+        ));
+    }
+    let id = parse_id(fields[0])
+        .ok_or_else(|| format!("element id `{}` is not a positive integer", fields[0]))?;
+    let mut corners = [0u64; 4];
+    for (k, f) in fields[1..5].iter().enumerate() {
+        corners[k] = parse_id(f)
+            .ok_or_else(|| format!("element {id}: node id `{f}` is not a positive integer"))?;
+    }
+    Ok((id, corners))
 }
 
 /// A node or element id: a positive integer (`12` or `12.0`).
