@@ -201,7 +201,8 @@ pub struct SimField {
     /// Stored columns of dx, dy, dz when `len` is derived.
     len_from: Option<[usize; 3]>,
     locator: TetLocator,
-    /// Value ranges per node of the locator's tree, for `bounds`.
+    /// Nodal value ranges per tetrahedron and per node of the locator's
+    /// tree, for `bounds`.
     ranges: NodeRanges,
     boundary: TriangleMesh,
     warnings: Vec<String>,
