@@ -202,8 +202,8 @@ pub struct SimField {
     len_from: Option<[usize; 3]>,
     locator: TetLocator,
     /// Nodal value ranges per tetrahedron and per node of the locator's
-    /// tree, for `bounds`.
-    ranges: NodeRanges,
+    /// tree, for `bounds` (none when the table would be too large).
+    ranges: Option<NodeRanges>,
     boundary: TriangleMesh,
     warnings: Vec<String>,
 }
@@ -336,15 +336,29 @@ impl SimField {
         }
         let mut lo = [f64::INFINITY; 64];
         let mut hi = [f64::NEG_INFINITY; 64];
-        // One row of the range table per tetrahedron that meets `b`, and
-        // per tree node that lies within it (the same tetrahedra, see
-        // `ranges`).
         let mut count = 0;
-        let complete = self.locator.overlapping_nodes(b, |c| {
-            count += self.ranges.count(c);
-            self.ranges.merge(c, &mut lo[..s], &mut hi[..s]);
-            count <= MAX_BOUND_TETS
-        });
+        let complete = match &self.ranges {
+            // One row of the range table per tetrahedron that meets `b`,
+            // and per tree node that lies within it (the same tetrahedra,
+            // see `ranges`).
+            Some(table) => self.locator.overlapping_nodes(b, |c| {
+                count += table.count(c);
+                table.merge(c, &mut lo[..s], &mut hi[..s]);
+                count <= MAX_BOUND_TETS
+            }),
+            // No table (too large): each tetrahedron's nodal rows.
+            None => self.locator.overlapping(b, |nodes| {
+                count += 1;
+                for n in nodes {
+                    let row = &self.values[n as usize * s..(n as usize + 1) * s];
+                    for (c, v) in row.iter().enumerate() {
+                        lo[c] = lo[c].min(*v);
+                        hi[c] = hi[c].max(*v);
+                    }
+                }
+                count <= MAX_BOUND_TETS
+            }),
+        };
         if !complete || count == 0 {
             return false;
         }

@@ -22,6 +22,12 @@ use crate::mesh::wide::WideChild;
 
 use super::tet_bvh::TetLocator;
 
+/// Most values in either half of a table (lows, highs): 4 M, 64 MB in
+/// all, a million tetrahedra with three columns (the seat: 50 thousand
+/// tetrahedra, 0.2 M values). Larger tables are not built and bounds read
+/// each tetrahedron's nodal rows, as before the table.
+pub(crate) const MAX_VALUES: usize = 1 << 22;
+
 /// Rows of `stride` ranges: tetrahedra by slot, then tree nodes.
 #[derive(Clone, Debug)]
 pub(crate) struct NodeRanges {
@@ -36,11 +42,15 @@ pub(crate) struct NodeRanges {
 
 impl NodeRanges {
     /// The table of `locator`'s tetrahedra and tree over `values`
-    /// (node-major, `stride` columns per mesh node).
-    pub fn new(locator: &TetLocator, values: &[f64], stride: usize) -> NodeRanges {
-        let children: Vec<Vec<WideChild>> = locator.tree_nodes().map(|c| c.collect()).collect();
+    /// (node-major, `stride` columns per mesh node), or `None` when it
+    /// would hold more than [`MAX_VALUES`] values a side.
+    pub fn new(locator: &TetLocator, values: &[f64], stride: usize) -> Option<NodeRanges> {
         let slots = locator.slot_count();
-        let rows = slots + children.len();
+        let rows = slots + locator.tree_nodes().len();
+        if rows.saturating_mul(stride) > MAX_VALUES {
+            return None;
+        }
+        let children: Vec<Vec<WideChild>> = locator.tree_nodes().map(|c| c.collect()).collect();
         let mut t = NodeRanges {
             stride,
             first_node: slots,
@@ -74,7 +84,7 @@ impl NodeRanges {
             t.hi[r].copy_from_slice(&hi);
             t.count[i] = count;
         }
-        t
+        Some(t)
     }
 
     /// Tetrahedra that `c` stands for: one, or those below a tree node.

@@ -90,33 +90,18 @@ fn seat_bounds_hold_at_every_sample_of_random_boxes() {
     assert!(bounded > 150, "{bounded} boxes bounded");
 }
 
-/// `SimField::bounds` as it was before the per-node table: every
-/// tetrahedron's nodal rows read one by one.
-fn bounds_tet_by_tet(f: &SimField, b: &crate::bounds::Aabb) -> Option<Vec<(f64, f64)>> {
-    let s = f.stride;
-    let mut lo = vec![f64::INFINITY; s];
-    let mut hi = vec![f64::NEG_INFINITY; s];
-    let mut count = 0;
-    let complete = f.locator.overlapping(b, |nodes| {
-        count += 1;
-        for n in nodes {
-            for c in 0..s {
-                let v = f.values[n as usize * s + c];
-                lo[c] = lo[c].min(v);
-                hi[c] = hi[c].max(v);
-            }
-        }
-        count <= super::MAX_BOUND_TETS
-    });
-    (complete && count > 0).then(|| lo.into_iter().zip(hi).collect())
-}
-
 #[test]
 fn seat_bounds_from_the_node_table_equal_the_tetrahedra_one_by_one() {
     let f = SimField::load(&seat("seat.inp"), &seat("seat_displacement_table.csv")).unwrap();
     let bb = f.bbox();
     let mut rng = Rng::new(23);
+    // The same field without its table: bounds from each tetrahedron's
+    // nodal rows (what a field too large for a table uses).
+    let mut one_by_one = f.clone();
+    one_by_one.ranges = None;
+    assert!(f.ranges.is_some());
     let mut iv = [crate::interval::Interval::point(0.0); 4];
+    let mut want_iv = iv;
     let (mut bounded, mut too_many) = (0, 0);
     for i in 0..3000 {
         // From a fraction of one tetrahedron to more than MAX_BOUND_TETS.
@@ -124,18 +109,17 @@ fn seat_bounds_from_the_node_table_equal_the_tetrahedra_one_by_one() {
         let c = rng.in_box(&bb);
         let b = crate::bounds::Aabb::new(c - DVec3::splat(size), c + DVec3::splat(size));
         let got = f.bounds(&b, &mut iv);
-        let want = bounds_tet_by_tet(&f, &b);
-        assert_eq!(got, want.is_some(), "box {b:?}");
-        let Some(want) = want else {
+        let want = one_by_one.bounds(&b, &mut want_iv);
+        assert_eq!(got, want, "box {b:?}");
+        if !want {
             too_many += usize::from(f.locator.overlapping(&b, |_| false));
             continue;
-        };
+        }
         bounded += 1;
-        // The stored columns (dx, dy, dz), bit for bit.
-        assert_eq!(want.len(), 3);
-        for (k, (lo, hi)) in want.iter().enumerate() {
-            assert_eq!(iv[k].lo.to_bits(), lo.to_bits(), "box {b:?} column {k}");
-            assert_eq!(iv[k].hi.to_bits(), hi.to_bits(), "box {b:?} column {k}");
+        // dx, dy, dz and len, bit for bit.
+        for (k, (g, w)) in iv.iter().zip(&want_iv).enumerate() {
+            assert_eq!(g.lo.to_bits(), w.lo.to_bits(), "box {b:?} variable {k}");
+            assert_eq!(g.hi.to_bits(), w.hi.to_bits(), "box {b:?} variable {k}");
         }
     }
     assert!(bounded > 1000, "{bounded} boxes bounded");

@@ -202,8 +202,7 @@ impl TetLocator {
     }
 
     /// Calls `f` with the nodes of every tetrahedron whose box meets `b`,
-    /// one by one (the reference for [`TetLocator::overlapping_nodes`]).
-    #[cfg(test)]
+    /// one by one; stops and returns false as soon as `f` does.
     pub fn overlapping(&self, b: &Aabb, mut f: impl FnMut([u32; 4]) -> bool) -> bool {
         self.wide
             .overlapping(b, |slot| f(self.data[slot as usize].nodes))
@@ -211,7 +210,9 @@ impl TetLocator {
 
     /// The tree's nodes and their children (tetrahedra by slot), for a
     /// table kept per node; see [`WideBvh::children`] for the order.
-    pub fn tree_nodes(&self) -> impl Iterator<Item = impl Iterator<Item = WideChild> + '_> + '_ {
+    pub fn tree_nodes(
+        &self,
+    ) -> impl ExactSizeIterator<Item = impl Iterator<Item = WideChild> + '_> + '_ {
         (0..self.wide.node_count()).map(|i| self.wide.children(i))
     }
 
