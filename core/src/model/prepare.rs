@@ -340,6 +340,7 @@ impl Preparer {
                 child,
                 ..
             } => {
+                too_many_expressions(n, exprs.len())?;
                 let (c, b) = self.child(n, child)?;
                 let used = exprs.iter().fold(0, |m, e| m | e.used_vars());
                 let mats = materials.iter().map(|m| self.slot(*m)).collect();
@@ -376,6 +377,7 @@ impl Preparer {
                 exprs,
                 materials,
             } => {
+                too_many_expressions(n, exprs.len())?;
                 let used = exprs.iter().fold(0, |m, e| m | e.used_vars());
                 let mats = materials.iter().map(|m| self.slot(*m)).collect();
                 let bbox = field.bbox();
@@ -452,6 +454,20 @@ impl Preparer {
             bbox,
         ))
     }
+}
+
+/// A grade evaluates its expressions into a scratch array of
+/// [`MAX_MATERIALS`] values (one per listed material; a material may be
+/// listed more than once, so the design's material limit does not bound
+/// them).
+fn too_many_expressions(n: &Node, count: usize) -> Result<(), PrepareError> {
+    if count > MAX_MATERIALS {
+        return Err(err(
+            n,
+            &format!("has {count} expressions; at most {MAX_MATERIALS} fit in one grade"),
+        ));
+    }
+    Ok(())
 }
 
 fn err(n: &Node, message: &str) -> PrepareError {

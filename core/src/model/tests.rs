@@ -555,6 +555,28 @@ fn prepare_errors() {
     })
     .unwrap();
     assert!(e.contains("collinear"), "{e}");
+    // More expressions than a grade's scratch array holds (one material
+    // listed 65 times): an error naming the node, not a panic when sampled.
+    let exprs = vec!["`0.5`"; 65].join(", ");
+    let mats = vec!["1"; 65].join(", ");
+    let src = format!("FGrade([{exprs}], [{mats}], true, Sphere())");
+    let d = run_script(&src, "t", &ScriptOptions::default()).unwrap();
+    let e = Model::prepare(&d.root, d.materials)
+        .map(|_| ())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("FGrade") && e.contains("65 expressions; at most 64"),
+        "{e}"
+    );
+    let exprs = vec!["`0.5`"; 64].join(", ");
+    let mats = vec!["1"; 64].join(", ");
+    let src = format!("FGrade([{exprs}], [{mats}], true, Sphere())");
+    let d = run_script(&src, "t", &ScriptOptions::default()).unwrap();
+    let m = Model::prepare(&d.root, d.materials).unwrap();
+    let mut f = vec![0.0; m.materials().len()];
+    assert!(m.eval_into(DVec3::ZERO, &mut f) < 0.0);
+    assert!((f.iter().sum::<f64>() - 1.0).abs() < 1e-12, "{f:?}");
 }
 
 #[test]
