@@ -32,20 +32,33 @@ pub enum GridError {
     Empty,
     /// The grid would have more voxels than the limit.
     #[error(
-        "{voxels} voxels ({nx} × {ny} × {nz}) is more than the limit of {limit}; use a larger voxel size"
+        "{} voxels ({} × {} × {}) is more than the limit of {limit}; use a larger voxel size",
+        count_text(*.voxels), count_text(*.nx), count_text(*.ny), count_text(*.nz)
     )]
     TooLarge {
-        /// Total voxels.
-        voxels: u128,
+        /// Total voxels (a float: a huge box's counts overflow integers).
+        voxels: f64,
         /// X count.
-        nx: u128,
+        nx: f64,
         /// Y count.
-        ny: u128,
+        ny: f64,
         /// Z count.
-        nz: u128,
+        nz: f64,
         /// The limit.
         limit: u128,
     },
+}
+
+/// A voxel count as an integer, or in scientific notation past 10¹⁵
+/// (where a float no longer holds every integer, and digits stop helping).
+fn count_text(v: f64) -> String {
+    if v.is_infinite() {
+        "more than 1e308".into()
+    } else if v < 1e15 {
+        format!("{v:.0}")
+    } else {
+        format!("{v:.3e}")
+    }
 }
 
 impl GridError {
@@ -75,16 +88,20 @@ impl Grid {
         }
         GridError::check_box(bbox)?;
         let n = (bbox.size() / voxel).ceil().max(DVec3::ONE);
+        let too_large = || GridError::TooLarge {
+            voxels: n.x * n.y * n.z,
+            nx: n.x,
+            ny: n.y,
+            nz: n.z,
+            limit: max_voxels,
+        };
+        // Each count below 2³², so the product is exact in u128.
+        if n.max_element() > u32::MAX as f64 {
+            return Err(too_large());
+        }
         let (nx, ny, nz) = (n.x as u128, n.y as u128, n.z as u128);
-        let voxels = nx * ny * nz;
-        if voxels > max_voxels || n.max_element() > u32::MAX as f64 {
-            return Err(GridError::TooLarge {
-                voxels,
-                nx,
-                ny,
-                nz,
-                limit: max_voxels,
-            });
+        if nx * ny * nz > max_voxels {
+            return Err(too_large());
         }
         let span = n * voxel;
         let origin = bbox.center() - span * 0.5;
@@ -115,5 +132,29 @@ impl Grid {
     #[inline]
     pub(super) fn centres_box(&self, i0: usize, i1: usize, j0: usize, j1: usize, k: usize) -> Aabb {
         Aabb::new(self.center(i0, j0, k), self.center(i1, j1, k))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn too_large_grids_say_how_large_without_overflowing() {
+        let b = Aabb::new(DVec3::ZERO, DVec3::splat(200.0));
+        let e = Grid::covering(&b, DVec3::splat(0.1), 1_000_000_000).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "8000000000 voxels (2000 × 2000 × 2000) is more than the limit of 1000000000; use a larger voxel size"
+        );
+        // A box of 10³⁰⁰ mm: counts past any integer type (this multiplied
+        // saturated u128s, which overflows in a debug build).
+        let huge = Aabb::new(DVec3::splat(-1e300), DVec3::splat(1e300));
+        let e = Grid::covering(&huge, DVec3::splat(0.5), 1 << 40)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("more than 1e308 voxels"), "{e}");
+        assert!(e.contains("(4.000e300 × 4.000e300 × 4.000e300)"), "{e}");
+        assert!(Grid::covering(&b, DVec3::splat(1.0), 1 << 40).is_ok());
     }
 }
