@@ -573,6 +573,12 @@ fn summary(
             *c as f64 * voxel_mm3
         ));
     }
+    if counts.iter().all(|(_, c)| *c == 0) {
+        notes.push(
+            "warning: no voxel centre is inside the design, so every slice is blank (the part is empty, or thinner than a voxel)"
+                .to_owned(),
+        );
+    }
     let o = est.grid.origin;
     Summary {
         kind: "png".into(),

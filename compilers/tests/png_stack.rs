@@ -48,6 +48,37 @@ fn within(count: u64, expected: f64, tol: f64) -> bool {
 }
 
 #[test]
+fn an_empty_design_gives_blank_slices_and_says_so() {
+    // A sphere minus a larger one: a bounding box, but nothing inside.
+    let m = model(
+        r#"let m = default_materials();
+Difference(Sphere(Vec3(0,0,0), 5, m.id("red")), Sphere(Vec3(0,0,0), 6, m.id("red")))"#,
+    );
+    let dir = tmp();
+    let s = export(&m, &params(0.5, Dither::Random), &dir.path().join("out")).unwrap();
+    assert!(s.counts.iter().all(|c| c.1 == 0), "{:?}", s.counts);
+    assert!(
+        s.notes
+            .iter()
+            .any(|n| n.starts_with("warning: no voxel centre is inside")),
+        "{:?}",
+        s.notes
+    );
+    // A part with voxels has no such warning.
+    let s = export(
+        &model(TWO_BOXES),
+        &params(0.5, Dither::Random),
+        &dir.path().join("two"),
+    )
+    .unwrap();
+    assert!(
+        !s.notes.iter().any(|n| n.starts_with("warning")),
+        "{:?}",
+        s.notes
+    );
+}
+
+#[test]
 fn graded_bar_counts_are_half_and_half() {
     let m = model(GRADED_BAR);
     let voxel: f64 = 0.1;

@@ -409,6 +409,20 @@ fn export_to_the_end(h: &mut Harness<'static, StudioApp>, button: &str) {
 }
 
 #[test]
+fn an_empty_slice_stack_is_reported_as_a_warning() {
+    // A sphere minus a larger one: a box to slice, nothing inside it.
+    let empty = "let m = default_materials();\nDifference(Sphere(Vec3(0,0,0), 5, m.id(\"red\")), Sphere(Vec3(0,0,0), 6, m.id(\"red\")))\n";
+    let (scratch, mut h) = studio(empty, "empty");
+    wait_idle(&mut h);
+    let out = scratch.path().join("stack");
+    set_output_folder(&mut h, &out);
+    set_png_voxel(&mut h, 0.5);
+    wait_label(&mut h, "Estimate:");
+    export_to_the_end(&mut h, "Export PNG stack");
+    h.get_by_label_contains("warning: no voxel centre is inside the design");
+}
+
+#[test]
 fn mesh_and_fea_exports_run_from_their_panels() {
     let (scratch, mut h) = studio(BAR, "mesh-fea");
     let dir = scratch.path();

@@ -149,7 +149,13 @@ impl Jobs {
                         JobState::Done(s) => {
                             ui.label(summary_text(s));
                             for n in &s.notes {
-                                ui.weak(n);
+                                // Warnings (an empty stack, say) stand out
+                                // from the figures.
+                                if n.starts_with("warning") {
+                                    ui.colored_label(ui.visuals().warn_fg_color, n);
+                                } else {
+                                    ui.weak(n);
+                                }
                             }
                             ui.horizontal(|ui| {
                                 if ui.button("Open folder").clicked()
