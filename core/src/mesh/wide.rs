@@ -248,11 +248,12 @@ impl WideBvh {
 
     /// As [`WideBvh::overlapping`], calling `visit` with each primitive
     /// reached, but a node whose (rounded) box lies within `b`'s is handed
-    /// whole to `visit` as [`WideChild::Node`] instead of being opened: every primitive below it meets `b`, since a primitive's box
-    /// lies within each box above it (node boxes are unions of their
-    /// children's, and rounding outwards keeps the order), so the caller
-    /// can use a summary kept per node and visit the same primitives. Stops
-    /// and returns false as soon as `visit` does.
+    /// whole to `visit` as [`WideChild::Node`] instead of being opened.
+    /// Every primitive below such a node meets `b`: a primitive's box lies
+    /// within each box above it (node boxes are unions of their children's,
+    /// and rounding outwards keeps the order), so a caller that keeps a
+    /// summary per node sees the same primitives. Stops and returns false
+    /// as soon as `visit` does.
     pub fn overlapping_nodes(&self, b: &Aabb, visit: impl FnMut(WideChild) -> bool) -> bool {
         let q = RoundedBox::new(b);
         self.walk(|n| (q.meets(n), q.holds(n)), visit)
