@@ -15,7 +15,7 @@
 //! single-precision arithmetic: a box is only skipped when its true distance
 //! exceeds the best one found, so results equal a pure `f64` traversal.
 
-use glam::{DVec3, Vec4};
+use glam::{BVec4A, DVec3, Vec4};
 
 use crate::bounds::Aabb;
 
@@ -263,21 +263,10 @@ impl WideBvh {
     /// true.
     #[inline(always)]
     pub fn find<F: FnMut(u32) -> bool>(&self, p: DVec3, mut test: F) -> Option<u32> {
-        let px = Vec4::splat(p.x as f32);
-        let py = Vec4::splat(p.y as f32);
-        let pz = Vec4::splat(p.z as f32);
+        let q = [p.x, p.y, p.z].map(|v| Vec4::splat(v as f32));
         let mut found = None;
         self.walk(
-            |n| {
-                let lanes = (px.cmpge(n.lo[0])
-                    & px.cmple(n.hi[0])
-                    & py.cmpge(n.lo[1])
-                    & py.cmple(n.hi[1])
-                    & pz.cmpge(n.lo[2])
-                    & pz.cmple(n.hi[2]))
-                .bitmask();
-                (lanes, 0)
-            },
+            |n| (every_axis(|a| q[a].cmpge(n.lo[a]) & q[a].cmple(n.hi[a])), 0),
             |c| {
                 let WideChild::Prim(slot) = c else {
                     return true; // (no lane is whole)
@@ -353,28 +342,20 @@ impl RoundedBox {
     /// Lanes of `n` whose boxes meet this one.
     #[inline(always)]
     fn meets(&self, n: &Node4) -> u32 {
-        let (lo, hi) = (&self.lo, &self.hi);
-        (n.lo[0].cmple(hi[0])
-            & n.hi[0].cmpge(lo[0])
-            & n.lo[1].cmple(hi[1])
-            & n.hi[1].cmpge(lo[1])
-            & n.lo[2].cmple(hi[2])
-            & n.hi[2].cmpge(lo[2]))
-        .bitmask()
+        every_axis(|a| n.lo[a].cmple(self.hi[a]) & n.hi[a].cmpge(self.lo[a]))
     }
 
     /// Lanes of `n` whose boxes lie within this one.
     #[inline(always)]
     fn holds(&self, n: &Node4) -> u32 {
-        let (lo, hi) = (&self.lo, &self.hi);
-        (n.lo[0].cmpge(lo[0])
-            & n.hi[0].cmple(hi[0])
-            & n.lo[1].cmpge(lo[1])
-            & n.hi[1].cmple(hi[1])
-            & n.lo[2].cmpge(lo[2])
-            & n.hi[2].cmple(hi[2]))
-        .bitmask()
+        every_axis(|a| n.lo[a].cmpge(self.lo[a]) & n.hi[a].cmple(self.hi[a]))
     }
+}
+
+/// The lanes for which `test(axis)` holds on all three axes.
+#[inline(always)]
+fn every_axis(test: impl Fn(usize) -> BVec4A) -> u32 {
+    (test(0) & test(1) & test(2)).bitmask()
 }
 
 /// Traversal stack: a small inline array (enough for any realistic tree:

@@ -92,9 +92,7 @@ pub(crate) fn parse(path: &Path, mesh: &InpMesh) -> Result<Columns, SimFieldErro
         let values = names
             .iter()
             .enumerate()
-            .filter(|&(k, n)| {
-                Some(k) != id_col && !["x", "y", "z"].contains(&n.to_ascii_lowercase().as_str())
-            })
+            .filter(|&(k, n)| Some(k) != id_col && super::coordinate_axis(n).is_none())
             .count();
         if values > MAX_VALUE_COLUMNS {
             return Err(csv_err(

@@ -181,36 +181,24 @@ pub(crate) fn parse(path: &Path) -> Result<InpMesh, SimFieldError> {
             }
             Block::Tets { n } => {
                 let n = *n;
-                // Most elements fit on one line: parsed from borrowed
-                // fields. One that continues collects owned fields.
-                let one_line = pending.is_empty();
-                if one_line {
+                split_fields_into(line, &mut fields);
+                if pending.is_empty() {
                     pending_line = ln;
-                    split_fields_into(line, &mut fields);
+                }
+                let parsed = if pending.is_empty() && !(fields.len() < n + 1 && line.ends_with(','))
+                {
+                    // One line (most elements): from the borrowed fields.
+                    element(&fields, n)
                 } else {
-                    split_fields_into(line, &mut fields);
+                    // Continued over lines: owned fields until complete.
                     pending.extend(fields.iter().map(|f| f.to_string()));
-                }
-                let have = if one_line {
-                    fields.len()
-                } else {
-                    pending.len()
-                };
-                if have < n + 1 && line.ends_with(',') {
-                    if one_line {
-                        pending.extend(fields.iter().map(|f| f.to_string()));
+                    if pending.len() < n + 1 && line.ends_with(',') {
+                        continue; // continuation line follows
                     }
-                    continue; // continuation line follows
-                }
-                let joined = std::mem::take(&mut pending);
-                let all: Vec<&str>;
-                let parts: &[&str] = if one_line {
-                    &fields
-                } else {
-                    all = joined.iter().map(String::as_str).collect();
-                    &all
+                    let owned = std::mem::take(&mut pending);
+                    element(&owned.iter().map(String::as_str).collect::<Vec<_>>(), n)
                 };
-                let (id, corners) = element(parts, n).map_err(|m| err(pending_line, m))?;
+                let (id, corners) = parsed.map_err(|m| err(pending_line, m))?;
                 if n == 10 {
                     c3d10 += 1;
                 }

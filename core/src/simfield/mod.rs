@@ -349,13 +349,7 @@ impl SimField {
             // No table (too large): each tetrahedron's nodal rows.
             None => self.locator.overlapping(b, |nodes| {
                 count += 1;
-                for n in nodes {
-                    let row = &self.values[n as usize * s..(n as usize + 1) * s];
-                    for (c, v) in row.iter().enumerate() {
-                        lo[c] = lo[c].min(*v);
-                        hi[c] = hi[c].max(*v);
-                    }
-                }
+                ranges::widen_by_tet(&self.values, s, nodes, &mut lo[..s], &mut hi[..s]);
                 count <= MAX_BOUND_TETS
             }),
         };
@@ -488,11 +482,9 @@ fn build(
                 "column `{name}`: value of node {i} is not finite"
             )));
         }
-        match name.to_ascii_lowercase().as_str() {
-            "x" => coords[0] = Some(vals),
-            "y" => coords[1] = Some(vals),
-            "z" => coords[2] = Some(vals),
-            _ => {
+        match coordinate_axis(&name) {
+            Some(a) => coords[a] = Some(vals),
+            None => {
                 names.push(name);
                 stored.push(vals);
             }
@@ -583,6 +575,14 @@ fn build(
         boundary,
         warnings,
     })
+}
+
+/// The axis of a coordinate column (`x`, `y`, `z` in any case): compared
+/// with the nodes, never a variable.
+fn coordinate_axis(name: &str) -> Option<usize> {
+    ["x", "y", "z"]
+        .iter()
+        .position(|a| name.eq_ignore_ascii_case(a))
 }
 
 /// Warns when CSV coordinates disagree with the mesh nodes by more than

@@ -23,8 +23,9 @@ use crate::mesh::wide::WideChild;
 use super::tet_bvh::TetLocator;
 
 /// Most values in either half of a table (lows, highs): 4 M, 64 MB in
-/// all, a million tetrahedra with three columns (the seat: 50 thousand
-/// tetrahedra, 0.2 M values). Larger tables are not built and bounds read
+/// all, about 950 thousand tetrahedra with three columns (a tree has about
+/// one node per two tetrahedra; the seat: 50,105 tetrahedra and 23,702
+/// nodes, 0.22 M values). Larger tables are not built and bounds read
 /// each tetrahedron's nodal rows, as before the table.
 pub(crate) const MAX_VALUES: usize = 1 << 22;
 
@@ -46,43 +47,37 @@ impl NodeRanges {
     /// would hold more than [`MAX_VALUES`] values a side.
     pub fn new(locator: &TetLocator, values: &[f64], stride: usize) -> Option<NodeRanges> {
         let slots = locator.slot_count();
-        let rows = slots + locator.tree_nodes().len();
+        let nodes = locator.tree_node_count();
+        let rows = slots + nodes;
         if rows.saturating_mul(stride) > MAX_VALUES {
             return None;
         }
-        let children: Vec<Vec<WideChild>> = locator.tree_nodes().map(|c| c.collect()).collect();
         let mut t = NodeRanges {
             stride,
             first_node: slots,
             lo: vec![f64::INFINITY; rows * stride],
             hi: vec![f64::NEG_INFINITY; rows * stride],
-            count: vec![0; children.len()],
+            count: vec![0; nodes],
         };
         for slot in 0..slots {
             let r = slot * stride..(slot + 1) * stride;
-            for m in locator.slot_nodes(slot as u32) {
-                let row = &values[m as usize * stride..(m as usize + 1) * stride];
-                widen(&mut t.lo[r.clone()], &mut t.hi[r.clone()], row, row);
-            }
+            let nodes = locator.slot_nodes(slot as u32);
+            widen_by_tet(values, stride, nodes, &mut t.lo[r.clone()], &mut t.hi[r]);
         }
         // Children have larger indices than their parents: last to first.
         let (mut lo, mut hi) = (vec![0.0; stride], vec![0.0; stride]);
-        for (i, list) in children.iter().enumerate().rev() {
+        for i in (0..nodes).rev() {
             lo.fill(f64::INFINITY);
             hi.fill(f64::NEG_INFINITY);
-            let mut count = 0u32;
-            for &c in list {
-                if let WideChild::Node(j) = c {
-                    count = count.saturating_add(t.count[j as usize]);
-                } else {
-                    count += 1;
-                }
+            let mut count = 0;
+            for c in locator.tree_children(i) {
+                count += t.count(c);
                 t.merge(c, &mut lo, &mut hi);
             }
             let r = (slots + i) * stride..(slots + i + 1) * stride;
             t.lo[r.clone()].copy_from_slice(&lo);
             t.hi[r].copy_from_slice(&hi);
-            t.count[i] = count;
+            t.count[i] = u32::try_from(count).unwrap_or(u32::MAX);
         }
         Some(t)
     }
@@ -106,6 +101,23 @@ impl NodeRanges {
         };
         let r = row * self.stride..(row + 1) * self.stride;
         widen(lo, hi, &self.lo[r.clone()], &self.hi[r]);
+    }
+}
+
+/// Widens `lo` and `hi` (`stride` columns) by the nodal rows of a
+/// tetrahedron's four `nodes` in `values` (node-major): the table's rows,
+/// and what a field without a table merges per tetrahedron.
+#[inline]
+pub(crate) fn widen_by_tet(
+    values: &[f64],
+    stride: usize,
+    nodes: [u32; 4],
+    lo: &mut [f64],
+    hi: &mut [f64],
+) {
+    for m in nodes {
+        let row = &values[m as usize * stride..(m as usize + 1) * stride];
+        widen(lo, hi, row, row);
     }
 }
 

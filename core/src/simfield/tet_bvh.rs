@@ -208,12 +208,15 @@ impl TetLocator {
             .overlapping(b, |slot| f(self.data[slot as usize].nodes))
     }
 
-    /// The tree's nodes and their children (tetrahedra by slot), for a
-    /// table kept per node; see [`WideBvh::children`] for the order.
-    pub fn tree_nodes(
-        &self,
-    ) -> impl ExactSizeIterator<Item = impl Iterator<Item = WideChild> + '_> + '_ {
-        (0..self.wide.node_count()).map(|i| self.wide.children(i))
+    /// Nodes of the tetrahedra's tree, for a table kept per node.
+    pub fn tree_node_count(&self) -> usize {
+        self.wide.node_count()
+    }
+
+    /// The children of tree node `i` (tetrahedra by slot); see
+    /// [`WideBvh::children`] for their order.
+    pub fn tree_children(&self, i: usize) -> impl Iterator<Item = WideChild> + '_ {
+        self.wide.children(i)
     }
 
     /// Tetrahedra, one per slot (the tree's order).
