@@ -332,7 +332,7 @@ impl CandidateGrid {
         let pc = p.distance(c) * (1.0 + 1e-12) + self.tiny;
         let mut slot = first & slot_mask;
         let t1 = &mesh.tris[slot as usize];
-        let (mut best, feature) = t1.distance_squared_feature(p);
+        let (mut best, feature) = t1.distance_squared_feature_face_first(p);
         let above = t1.n.dot(p - t1.a) > 0.0;
         // The entries that p's place relative to t₁ proves no nearer are
         // skipped unread.
