@@ -298,9 +298,9 @@ mod tests {
         }
     }
 
-    /// The face-first test answers as Ericson's order: the same feature
-    /// and the same bits wherever the two could disagree only at a region's
-    /// rounding-size boundary (none of these random points is on one).
+    /// The face-first test answers as Ericson's order: the same squared
+    /// distance, bit for bit, and the same feature. (The two could differ
+    /// only on a region boundary, by rounding; random points miss them.)
     #[test]
     fn face_first_agrees_with_ericson_order() {
         let mut rng = crate::xorshift::XorShift::new(5);
