@@ -336,6 +336,19 @@ fn bound_and_interval_are_consistent() {
         }
     }
     assert!(m.signed_distance(DVec3::NAN).is_nan());
+    // Non-finite points are answered NaN by the fallback: the candidate
+    // grid's lookup must reject them, also where the other coordinates
+    // lie inside its box.
+    let c = m.bbox.center();
+    for bad in [
+        DVec3::new(f64::NAN, c.y, c.z),
+        DVec3::new(c.x, f64::NAN, c.z),
+        DVec3::new(c.x, c.y, f64::INFINITY),
+        DVec3::new(f64::NEG_INFINITY, c.y, c.z),
+    ] {
+        assert!(m.signed_distance(bad).is_nan(), "{bad}");
+        assert!(m.distance(bad).is_nan(), "{bad}");
+    }
 }
 
 /// Cube [-1, 1]³ as 12 outward triangles; `skip` drops the two triangles of
