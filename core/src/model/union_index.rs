@@ -86,16 +86,22 @@ impl UnionIndex {
                 always.push(i as u32);
             }
         }
-        // About 16 cubic cells per finite child, at most 2 million cells.
-        // Finer grids list fewer candidates per cell but outgrow the caches:
-        // on the bunny's 3,286 struts, 64 cells per child and a three-cell
-        // margin evaluated Z-ordered points 15 % faster and random ones
-        // 1.7 times slower (DRAM misses on the longer lists), and took
-        // three times longer to build.
+        // About 32 cubic cells per finite child, at most 2 million cells.
+        // Finer grids list fewer candidates per cell (a point visits the
+        // children within `|p − centre|` of its cell's centre) but outgrow
+        // the caches and shrink the two-cell margin, beyond which points
+        // take the BVH. 32 rather than 16 (an Intel Xeon, alternating
+        // binaries): the bunny lattice's 0.1 mm slice stack +4.5 %, its
+        // Z-ordered points +3 %, the bunny's struts alone +5 to +10 % and
+        // the 600-strut lattice +6 %; random order on the struts −6 %, the
+        // 144-swatch sheet −3 %, and 12 ms more to prepare 3,286 struts.
+        // At 44 the margin (2.1 mm on the bunny lattice, less on its struts
+        // alone) falls below the bench's 2 mm band and the struts alone
+        // lose 17 %; see docs/PERFORMANCE.md, thirty-second session.
         let n = finite.len().max(1) as f64;
         let size = grid_box.size().max(DVec3::splat(1e-9));
         let volume = size.x * size.y * size.z;
-        let cell = (volume / (16.0 * n)).cbrt().max((volume / 2.0e6).cbrt());
+        let cell = (volume / (32.0 * n)).cbrt().max((volume / 2.0e6).cbrt());
         let dims = [
             ((size.x / cell).ceil() as usize).clamp(1, 1024),
             ((size.y / cell).ceil() as usize).clamp(1, 1024),
