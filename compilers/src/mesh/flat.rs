@@ -177,7 +177,7 @@ impl FlatMemo {
 /// through [`SampleAt`]. Keeping them cost 32 bytes a cube with one value
 /// a sample, 96 with three: tens of MB of fresh memory, faulted in page by
 /// page; without them a 10 M-voxel export of the cube ran 19 % faster and
-/// the graded bar's 7 % (alternating medians, docs/PERFORMANCE.md).
+/// the graded bar's 7 % (alternating medians, docs/performance/sessions-19-24.md).
 #[derive(Default)]
 pub(super) struct KeptCubes {
     cubes: Vec<u64>,

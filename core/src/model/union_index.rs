@@ -95,9 +95,10 @@ impl UnionIndex {
         // Z-ordered points +3 %, the bunny's struts alone +5 to +10 % and
         // the 600-strut lattice +6 %; random order on the struts −6 %, the
         // 144-swatch sheet −3 %, and 12 ms more to prepare 3,286 struts.
-        // At 44 the margin (2.1 mm on the bunny lattice, less on its struts
-        // alone) falls below the bench's 2 mm band and the struts alone
-        // lose 17 %; see docs/PERFORMANCE.md, thirty-second session.
+        // The margin is then 2.36 mm on the bunny lattice and 2.08 mm on
+        // its struts alone; at 44 the latter's (1.86 mm) falls below the
+        // bench's 2 mm band, its outside points take the BVH, and it loses
+        // 17 % (docs/PERFORMANCE.md, thirty-second session).
         let n = finite.len().max(1) as f64;
         let size = grid_box.size().max(DVec3::splat(1e-9));
         let volume = size.x * size.y * size.z;
