@@ -47,6 +47,32 @@ pub(crate) struct Tri {
     pub flat: bool,
 }
 
+/// `p − a` and its products with a triangle's edges (`d1 = ab·ap`,
+/// `d2 = ac·ap`, and their differences from `|ab|²`, `ab·ac`, `|ac|²`):
+/// what both orders of the region tests read.
+#[derive(Clone, Copy)]
+struct Projection {
+    ap: DVec3,
+    d1: f64,
+    d2: f64,
+    d3: f64,
+    d4: f64,
+    d5: f64,
+    d6: f64,
+}
+
+impl Projection {
+    /// The barycentric numerators `(va, vb, vc)` of the projection of `p`
+    /// onto the triangle's plane: all positive inside the face.
+    #[inline(always)]
+    fn numerators(&self) -> (f64, f64, f64) {
+        let va = self.d3 * self.d6 - self.d5 * self.d4;
+        let vb = self.d5 * self.d2 - self.d1 * self.d6;
+        let vc = self.d1 * self.d4 - self.d3 * self.d2;
+        (va, vb, vc)
+    }
+}
+
 impl Tri {
     /// Prepares triangle `(a, b, c)`.
     pub fn new(a: DVec3, b: DVec3, c: DVec3) -> Tri {
@@ -92,14 +118,63 @@ impl Tri {
         if self.flat {
             return (self.closest_flat(p).0.distance_squared(p), Feature::Edge(0));
         }
+        self.ericson_order(&self.projection(p))
+    }
+
+    /// As [`Tri::distance_squared_feature`], testing the face first: with
+    /// the three barycentric numerators of `p`'s projection all positive
+    /// it is inside the face, whose distance is the plane's (one branch
+    /// where Ericson's order takes six; a list's first triangle has the
+    /// point over its face three times in four).
+    #[inline(always)]
+    pub fn distance_squared_feature_face_first(&self, p: DVec3) -> (f64, Feature) {
+        if self.flat {
+            return self.distance_squared_feature(p);
+        }
+        let pr = self.projection(p);
+        let (va, vb, vc) = pr.numerators();
+        if (va > 0.0) & (vb > 0.0) & (vc > 0.0) {
+            let h = self.n.dot(pr.ap);
+            return (h * h, Feature::Face);
+        }
+        self.ericson_order(&pr)
+    }
+
+    /// `p − a` and its products with the edges, as Ericson's region tests
+    /// read them (Real-Time Collision Detection, §5.1.5).
+    #[inline(always)]
+    fn projection(&self, p: DVec3) -> Projection {
         let ap = p - self.a;
         let d1 = self.ab.dot(ap);
         let d2 = self.ac.dot(ap);
+        Projection {
+            ap,
+            d1,
+            d2,
+            d3: d1 - self.ab2,
+            d4: d2 - self.abac,
+            d5: d1 - self.abac,
+            d6: d2 - self.ac2,
+        }
+    }
+
+    /// Ericson's region tests in his order (vertices, then edges, then the
+    /// face) on a non-flat triangle: each numerator is computed when its
+    /// test is reached, so points off the face end after few of them.
+    #[inline(always)]
+    fn ericson_order(&self, pr: &Projection) -> (f64, Feature) {
+        let Projection {
+            ap,
+            d1,
+            d2,
+            d3,
+            d4,
+            d5,
+            d6,
+        } = *pr;
         if d1 <= 0.0 && d2 <= 0.0 {
             return (ap.dot(ap), Feature::Vertex(0));
         }
-        let d3 = d1 - self.ab2;
-        let d4 = d2 - self.abac;
         if d3 >= 0.0 && d4 <= d3 {
             let bp = ap - self.ab;
             return (bp.dot(bp), Feature::Vertex(1));
@@ -109,8 +184,6 @@ impl Tri {
             let q = ap - self.ab * (d1 / self.ab2);
             return (q.dot(q), Feature::Edge(0));
         }
-        let d5 = d1 - self.abac;
-        let d6 = d2 - self.ac2;
         if d6 >= 0.0 && d5 <= d6 {
             let cp = ap - self.ac;
             return (cp.dot(cp), Feature::Vertex(2));
@@ -130,32 +203,6 @@ impl Tri {
         }
         let h = self.n.dot(ap);
         (h * h, Feature::Face)
-    }
-
-    /// As [`Tri::distance_squared_feature`], testing the face first: with
-    /// the three barycentric numerators of `p`'s projection all positive
-    /// it is inside the face, whose distance is the plane's (one branch
-    /// where Ericson's order takes six; a list's first triangle has the
-    /// point over its face three times in four).
-    #[inline(always)]
-    pub fn distance_squared_feature_face_first(&self, p: DVec3) -> (f64, Feature) {
-        if !self.flat {
-            let ap = p - self.a;
-            let d1 = self.ab.dot(ap);
-            let d2 = self.ac.dot(ap);
-            let d3 = d1 - self.ab2;
-            let d4 = d2 - self.abac;
-            let d5 = d1 - self.abac;
-            let d6 = d2 - self.ac2;
-            let vc = d1 * d4 - d3 * d2;
-            let vb = d5 * d2 - d1 * d6;
-            let va = d3 * d6 - d5 * d4;
-            if (va > 0.0) & (vb > 0.0) & (vc > 0.0) {
-                let h = self.n.dot(ap);
-                return (h * h, Feature::Face);
-            }
-        }
-        self.distance_squared_feature(p)
     }
 
     /// Closest point on the triangle to `p` and the feature that holds it.
