@@ -91,11 +91,11 @@ impl UnionIndex {
         // children within `|p − centre|` of its cell's centre) but outgrow
         // the caches and shrink the two-cell margin, beyond which points
         // take the BVH. 32 rather than 16 (an Intel Xeon, alternating
-        // binaries): the bunny lattice's 0.1 mm slice stack +4.5 %, its
+        // binaries): the bunny lattice's 0.1 mm slice stack +4 to +6 %, its
         // Z-ordered points +3 %, the bunny's struts alone +5 to +10 % and
-        // the 600-strut lattice +6 %; random order on the struts −6 %, the
-        // 144-swatch sheet −3 %; preparing the 3,286 struts 14 ms longer
-        // (25 ms with the bunny's mesh).
+        // the 600-strut lattice +6 %; random order on the struts −5 to
+        // −8 %, the 144-swatch sheet −3.5 to −4 %; preparing the 3,286
+        // struts 14 ms longer (25 ms with the bunny's mesh).
         // The margin is then 2.36 mm on the bunny lattice and 2.08 mm on
         // its struts alone; at 44 the latter's (1.86 mm) falls below the
         // bench's 2 mm band, its outside points take the BVH, and it loses
