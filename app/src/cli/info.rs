@@ -96,7 +96,7 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
         args.designs.clone()
     };
     // What the figures are of: points/s depends on how densely the points
-    // fill the band (docs/performance/sessions-19-24.md, twenty-third session).
+    // fill the band (docs/PERFORMANCE.md, "How to measure").
     println!(
         "points/s: {} points within 2 mm of each design's surface, medians of up to 5 passes{}",
         args.points,

@@ -174,10 +174,9 @@ impl FlatMemo {
 /// index in the grid, below 2⁴⁴ voxels, shifted over a mask of the corners
 /// carrying its key's label `x`), not its samples: the fallback is rare
 /// (a region whose triangulation fails a check) and takes them again
-/// through [`SampleAt`]. Keeping them cost 32 bytes a cube with one value
-/// a sample, 96 with three: tens of MB of fresh memory, faulted in page by
-/// page; without them a 10 M-voxel export of the cube ran 19 % faster and
-/// the graded bar's 7 % (alternating medians, docs/performance/sessions-19-24.md).
+/// through [`SampleAt`]. Keeping them would cost 32 bytes a cube with one
+/// value a sample, 96 with three: fresh memory faulted in page by page on
+/// every flat face.
 #[derive(Default)]
 pub(super) struct KeptCubes {
     cubes: Vec<u64>,

@@ -90,16 +90,8 @@ impl UnionIndex {
         // Finer grids list fewer candidates per cell (a point visits the
         // children within `|p − centre|` of its cell's centre) but outgrow
         // the caches and shrink the two-cell margin, beyond which points
-        // take the BVH. 32 rather than 16 (an Intel Xeon, alternating
-        // binaries): the bunny lattice's 0.1 mm slice stack +4 to +6 %, its
-        // Z-ordered points +3 %, the bunny's struts alone +5 to +10 % and
-        // the 600-strut lattice +6 %; random order on the struts −5 to
-        // −8 %, the 144-swatch sheet −3.5 to −4 %; preparing the 3,286
-        // struts 14 ms longer (25 ms with the bunny's mesh).
-        // The margin is then 2.36 mm on the bunny lattice and 2.08 mm on
-        // its struts alone; at 44 the latter's (1.86 mm) falls below the
-        // bench's 2 mm band, its outside points take the BVH, and it loses
-        // 17 % (docs/PERFORMANCE.md, thirty-second session).
+        // take the BVH. Why 32 and not 16 or 44: docs/PERFORMANCE.md,
+        // "Large unions".
         let n = finite.len().max(1) as f64;
         let size = grid_box.size().max(DVec3::splat(1e-9));
         let volume = size.x * size.y * size.z;
