@@ -571,3 +571,108 @@ fn frame_times_while_the_bunny_lattice_bakes() {
     img.save(dir.join("bunny.png")).expect("bunny.png");
     println!("  picture: {}", dir.join("bunny.png").display());
 }
+
+/// Opening a different file frames its part, not the part that was on
+/// screen before (the camera used to be fitted to the old model while the
+/// new script was still running).
+#[test]
+fn opening_a_file_frames_the_new_design() {
+    let (scratch, mut h) = studio(
+        "Sphere(Vec3(0, 0, 0), 2.0, default_materials().id(\"red\"))",
+        "frame",
+    );
+    wait_idle(&mut h);
+    let small = h.state().viewport().settings.camera.distance;
+    let big = scratch.path().join("big.rhai");
+    std::fs::write(
+        &big,
+        "RectPrism(Vec3(100, 0, 0), Vec3(80, 60, 40), default_materials().id(\"blue\"))",
+    )
+    .expect("write big.rhai");
+    let ctx = h.ctx.clone();
+    h.state_mut().open_path(&ctx, big);
+    wait_for(&mut h, "the big design", |a| {
+        a.is_idle() && bbox_x(a).is_some_and(|x| (x - 80.0).abs() < 1e-6)
+    });
+    h.run_steps(3);
+    let cam = h.state().viewport().settings.camera;
+    assert!(
+        (cam.target.x - 100.0).abs() < 1.0,
+        "camera still aimed at the old part: {cam:?}"
+    );
+    assert!(
+        cam.distance > 10.0 * small,
+        "camera distance {} for a 108 mm part (was {small} for the sphere)",
+        cam.distance
+    );
+}
+
+/// Undoing back to the saved text, and then quitting, leaves no recovery
+/// file: the next start must not offer "Restore unsaved work".
+#[test]
+fn a_clean_document_leaves_no_recovery_file() {
+    let (scratch, mut h) = studio(BAR, "recovery-clean");
+    let dir = scratch.path();
+    wait_idle(&mut h);
+    let saved = dir.join("bar.rhai");
+    assert!(h.state_mut().save_to(saved.clone()));
+    type_at_end(&mut h, " // edit");
+    let rec = dir.join("data/recovery.rhai");
+    let t = Instant::now();
+    while !rec.exists() {
+        h.step();
+        assert!(t.elapsed() < Duration::from_secs(20), "no recovery file");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    h.run_steps(3);
+    assert_eq!(h.state().text(), BAR, "undo did not restore the saved text");
+    assert!(!h.state().is_dirty());
+    assert!(!rec.exists(), "recovery file kept for a clean document");
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Q);
+    h.run_steps(2);
+    drop(h);
+    let mut h2 = harness(StudioOptions::for_tests(dir.join("data"), BAR));
+    h2.step();
+    assert!(
+        h2.state().modal().is_none(),
+        "a clean exit offered: {:?}",
+        h2.state().modal()
+    );
+}
+
+/// Text and Enter arriving in one frame (a fast typist) keep their order:
+/// `bbbb⏎cccc` with each pair of keys in one frame gives two lines.
+#[test]
+fn keys_in_one_frame_keep_their_order() {
+    let (_dir, mut h) = studio("", "key-order");
+    wait_idle(&mut h);
+    let editor = h.get_by_role(Role::MultilineTextInput);
+    editor.focus();
+    h.step();
+    let enter = |pressed| egui::Event::Key {
+        key: egui::Key::Enter,
+        physical_key: None,
+        pressed,
+        repeat: false,
+        modifiers: egui::Modifiers::NONE,
+    };
+    let frames: Vec<Vec<egui::Event>> = vec![
+        vec![egui::Event::Text("b".into()), egui::Event::Text("b".into())],
+        vec![egui::Event::Text("b".into()), egui::Event::Text("b".into())],
+        vec![egui::Event::Text("b".into()), enter(true), enter(false)],
+        vec![
+            egui::Event::Text("c".into()),
+            enter(true),
+            egui::Event::Text("c".into()),
+            enter(true),
+        ],
+        vec![egui::Event::Text("c".into()), egui::Event::Text("c".into())],
+    ];
+    for events in frames {
+        h.input_mut().events.extend(events);
+        h.step();
+    }
+    h.run_steps(4);
+    assert_eq!(h.state().text(), "bbbbb\nc\nc\ncc");
+}

@@ -14,6 +14,7 @@ const SAVE_AS: KeyboardShortcut =
     KeyboardShortcut::new(Modifiers::COMMAND.plus(Modifiers::SHIFT), Key::S);
 const OPEN: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::O);
 const NEW: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::N);
+const QUIT: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::Q);
 const ZOOM_IN: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::Plus);
 const ZOOM_IN_EQUALS: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::Equals);
 const ZOOM_OUT: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::Minus);
@@ -110,6 +111,11 @@ impl StudioApp {
     }
 
     fn quit(&mut self, ctx: &egui::Context) {
+        // A clean document leaves no recovery file behind: the next start
+        // must not offer work that was never lost.
+        if !self.is_dirty() {
+            self.recovery.clear();
+        }
         self.allow_close = true;
         ctx.send_viewport_cmd(ViewportCommand::Close);
     }
@@ -226,6 +232,9 @@ impl StudioApp {
         }
         if pressed(&NEW) {
             self.request(ctx, Pending::New);
+        }
+        if pressed(&QUIT) {
+            self.request(ctx, Pending::Quit);
         }
         if pressed(&ZOOM_IN) || pressed(&ZOOM_IN_EQUALS) {
             self.settings.zoom(1.0);

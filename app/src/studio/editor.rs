@@ -52,6 +52,10 @@ pub struct Editor {
     jump: Option<(Range<usize>, bool)>,
     /// Lines to tint (errors).
     pub marks: Vec<LineMark>,
+    /// Input events held back to the next frame so that a key the editor
+    /// handles itself (Tab, Enter) is applied after the text typed before
+    /// it in the same frame (see [`Editor::order_keys`]).
+    deferred: Vec<egui::Event>,
 }
 
 /// What happened in the editor this frame.
@@ -70,6 +74,7 @@ impl Editor {
             find: FindBar::default(),
             jump: None,
             marks: Vec::new(),
+            deferred: Vec::new(),
         }
     }
 
@@ -170,8 +175,10 @@ impl Editor {
     fn handle_keys(&mut self, ui: &egui::Ui) -> bool {
         let ctx = ui.ctx();
         if !ctx.memory(|m| m.has_focus(self.id)) {
+            self.deferred.clear();
             return false;
         }
+        self.order_keys(ctx);
         let sel = self.selection(ctx);
         let edit = if ctx.input_mut(|i| i.consume_key(Modifiers::SHIFT, Key::Tab)) {
             Some(textops::dedent(&self.text, sel))
@@ -188,6 +195,59 @@ impl Editor {
                 true
             }
             None => false,
+        }
+    }
+
+    /// Keep the frame's input in typing order. The editor takes Tab and
+    /// Enter before the `TextEdit` sees the frame's events, so when a fast
+    /// typist's `b` and Enter arrive in one frame the newline would land
+    /// before the `b`. Events held back last frame go first; then, if an
+    /// editing event (text, paste, another key) comes before this frame's
+    /// first Tab or Enter, that key and everything after it wait for the
+    /// next frame, and the `TextEdit` applies the earlier ones now; so does
+    /// a second Tab or Enter (one is handled a frame).
+    fn order_keys(&mut self, ctx: &egui::Context) {
+        let held = std::mem::take(&mut self.deferred);
+        let own_key = |e: &egui::Event| {
+            matches!(
+                e,
+                egui::Event::Key {
+                    key: Key::Tab | Key::Enter,
+                    pressed: true,
+                    ..
+                }
+            )
+        };
+        let editing = |e: &egui::Event| {
+            matches!(
+                e,
+                egui::Event::Text(_)
+                    | egui::Event::Paste(_)
+                    | egui::Event::Key { pressed: true, .. }
+            )
+        };
+        ctx.input_mut(|i| {
+            if !held.is_empty() {
+                i.events.splice(0..0, held);
+            }
+            let Some(k) = i.events.iter().position(own_key) else {
+                return;
+            };
+            // The editor handles one own key a frame: a second one waits too.
+            let cut = if i.events[..k].iter().any(editing) {
+                Some(k)
+            } else {
+                i.events[k + 1..]
+                    .iter()
+                    .position(own_key)
+                    .map(|j| k + 1 + j)
+            };
+            if let Some(c) = cut {
+                self.deferred = i.events.split_off(c);
+            }
+        });
+        if !self.deferred.is_empty() {
+            ctx.request_repaint();
         }
     }
 

@@ -279,7 +279,16 @@ impl Recovery {
         let (Some(tp), Some(mp)) = (self.text_path(), self.meta_path()) else {
             return false;
         };
-        if !dirty || self.last_text.as_deref() == Some(text) {
+        if !dirty {
+            // Back to the saved text (undo, or a save elsewhere): the
+            // recovery file this run wrote no longer holds unsaved work. A
+            // file left by an earlier run stays until the user answers.
+            if self.last_text.is_some() {
+                self.clear();
+            }
+            return false;
+        }
+        if self.last_text.as_deref() == Some(text) {
             return false;
         }
         if let Some(t) = self.last_write {

@@ -89,6 +89,9 @@ pub struct Viewport {
     /// Keep the part framed (after opening, and while panels settle)
     /// until the user moves the camera.
     auto_fit: bool,
+    /// A new file or example was loaded: fit its first model, not the
+    /// model still on screen from the previous file.
+    fit_pending: bool,
     fitted_size: egui::Vec2,
     view: StandardView,
     has_gpu: bool,
@@ -116,6 +119,7 @@ impl Viewport {
             uploaded: Arc::new(AtomicU64::new(0)),
             stale: false,
             auto_fit: true,
+            fit_pending: false,
             fitted_size: egui::Vec2::ZERO,
             view: StandardView::Iso,
             has_gpu,
@@ -131,6 +135,10 @@ impl Viewport {
     /// Show a new model: start baking it (the previous bake stays on screen
     /// until the first level arrives).
     pub fn set_model(&mut self, ctx: &egui::Context, model: Arc<Model>) {
+        if std::mem::take(&mut self.fit_pending) {
+            self.auto_fit = true;
+            self.fitted_size = egui::Vec2::ZERO;
+        }
         let n = model.materials().len();
         // Opacity is per position in `materials()`: keep it only while the
         // design uses the same materials.
@@ -162,10 +170,16 @@ impl Viewport {
         self.hovered = None;
     }
 
-    /// Fit the camera to the next model (after opening a file).
+    /// Fit the camera to the next model that arrives (after opening a
+    /// file or an example). Until then the previous design stays on
+    /// screen with its camera: fitting now would frame the old part.
     pub fn fit_next(&mut self) {
-        self.auto_fit = true;
-        self.fitted_size = egui::Vec2::ZERO;
+        if self.model.is_none() {
+            self.auto_fit = true;
+            self.fitted_size = egui::Vec2::ZERO;
+        } else {
+            self.fit_pending = true;
+        }
     }
 
     /// The model on screen.
