@@ -62,7 +62,7 @@ pub use bake::{BakeError, MAX_CHANNELS, VolumeBake, bake};
 pub use camera::{Camera, StandardView};
 pub use gpu::{RENDER_SHADER, Renderer, THIN_BIAS_VOXELS};
 pub use offscreen::{Offscreen, render_offscreen};
-pub use probe::{ProbeHit, probe};
+pub use probe::{HitSurface, ProbeHit, probe, probe_drawn};
 pub use progressive::{DEFAULT_LEVELS, ProgressiveBaker};
 pub use settings::{CutPlane, ViewMode, ViewSettings};
 pub use upscale::BLIT_SHADER;

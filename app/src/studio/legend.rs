@@ -60,6 +60,7 @@ pub fn probe_ui(ui: &mut egui::Ui, m: &Model, hovered: Option<&Probe>, pinned: O
             continue;
         };
         let q = p.hit.point;
+        ui.weak(p.hit.surface.describe());
         ui.monospace(format!("x {:.3}  y {:.3}  z {:.3} mm", q.x, q.y, q.z));
         ui.monospace(format!(
             "distance {:.4} mm (depth {:.2} mm)",

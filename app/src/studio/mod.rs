@@ -519,7 +519,18 @@ impl StudioApp {
             .show(ui, |ui| self.viewport.legend_ui(ui));
         egui::CollapsingHeader::new("Probe")
             .default_open(true)
-            .show(ui, |ui| self.viewport.probe_ui(ui));
+            .show(ui, |ui| {
+                // A fixed height, so the panels below do not jump as the
+                // read-out under the cursor changes length.
+                let h = ui.text_style_height(&egui::TextStyle::Monospace) * 16.0;
+                egui::ScrollArea::vertical()
+                    .id_salt("probe-scroll")
+                    .max_height(h)
+                    .show(ui, |ui| {
+                        ui.set_min_height(h);
+                        self.viewport.probe_ui(ui);
+                    });
+            });
         egui::CollapsingHeader::new("Export")
             .default_open(true)
             .show(ui, |ui| {

@@ -9,17 +9,16 @@ use std::sync::mpsc::{Receiver, Sender, channel};
 
 use egui::Pos2;
 use volcad_core::Model;
-use volcad_render::{Camera, CutPlane, ProbeHit, Vec2};
+use volcad_render::{ProbeHit, Vec2, ViewSettings};
 
 /// One probe to run.
 #[derive(Clone)]
 pub struct ProbeRequest {
     /// The model on screen.
     pub model: Arc<Model>,
-    /// The camera at the time of the request.
-    pub camera: Camera,
-    /// The cut plane, if any (the probe sees the cut face).
-    pub cut: Option<CutPlane>,
+    /// The view at the time of the request: camera, cut plane, mode and
+    /// hidden materials (the probe reads what the picture draws).
+    pub view: ViewSettings,
     /// Cursor in normalized device coordinates (−1..1, y up).
     pub ndc: Vec2,
     /// Viewport width / height.
@@ -41,13 +40,7 @@ pub struct Probe {
 
 /// Run one probe (the worker's job; also handy in tests).
 pub fn run(req: &ProbeRequest) -> Option<Probe> {
-    let hit = volcad_render::probe(
-        &req.model,
-        &req.camera,
-        req.cut.as_ref(),
-        req.ndc,
-        req.aspect,
-    )?;
+    let hit = volcad_render::probe_drawn(&req.model, &req.view, req.ndc, req.aspect)?;
     let surface_distance = req.model.distance(hit.point);
     Some(Probe {
         pos: req.pos,
@@ -153,11 +146,10 @@ mod tests {
         )
         .unwrap();
         let model = Arc::new(Model::prepare(&d.root, d.materials.clone()).unwrap());
-        let camera = Camera::fit(&model.bbox(), volcad_render::StandardView::Top);
+        let camera = volcad_render::Camera::fit(&model.bbox(), volcad_render::StandardView::Top);
         let req = ProbeRequest {
             model,
-            camera,
-            cut: None,
+            view: ViewSettings::plain(camera),
             ndc: Vec2::ZERO,
             aspect: 1.0,
             pos: Pos2::ZERO,
@@ -188,5 +180,89 @@ mod tests {
             std::thread::sleep(std::time::Duration::from_millis(5));
         }
         assert!(hover.flatten().is_some() && pinned.flatten().is_some());
+    }
+
+    /// A red core inside a blue skin, probed from the top through the
+    /// centre.
+    fn core_and_skin(view: impl FnOnce(&Model) -> ViewSettings) -> Probe {
+        let d = run_script(
+            r#"let m = default_materials();
+               Union(false, [Sphere(Vec3(0, 0, 0), 5.0, m.id("red")),
+                             Sphere(Vec3(0, 0, 0), 10.0, m.id("blue"))])"#,
+            "t.rhai",
+            &ScriptOptions::default(),
+        )
+        .unwrap();
+        let model = Arc::new(Model::prepare(&d.root, d.materials.clone()).unwrap());
+        let req = ProbeRequest {
+            view: view(&model),
+            model,
+            ndc: Vec2::ZERO,
+            aspect: 1.0,
+            pos: Pos2::ZERO,
+        };
+        run(&req).expect("the centre ray hits the part")
+    }
+
+    fn top(model: &Model) -> ViewSettings {
+        ViewSettings::plain(volcad_render::Camera::fit(
+            &model.bbox(),
+            volcad_render::StandardView::Top,
+        ))
+    }
+
+    #[test]
+    fn probe_looks_through_hidden_materials() {
+        let shown = core_and_skin(top);
+        assert!((shown.hit.point.z - 10.0).abs() < 0.01, "{:?}", shown.hit);
+        assert_eq!(shown.hit.surface, volcad_render::HitSurface::Part);
+        let hidden = core_and_skin(|m| {
+            let blue = m
+                .materials()
+                .iter()
+                .position(|&id| m.table().name(id) == "blue")
+                .unwrap();
+            let mut v = top(m);
+            v.material_opacity = vec![1.0; m.materials().len()];
+            v.material_opacity[blue] = 0.0;
+            v
+        });
+        assert!((hidden.hit.point.z - 5.0).abs() < 0.02, "{:?}", hidden.hit);
+        assert_eq!(hidden.hit.surface, volcad_render::HitSurface::Region);
+        assert_eq!(hidden.hit.fractions.len(), 1);
+        assert!(
+            hidden.surface_distance < -4.9,
+            "{}",
+            hidden.surface_distance
+        );
+    }
+
+    #[test]
+    fn probe_stops_on_the_cut_face_and_at_the_iso_level() {
+        let cut = core_and_skin(|m| {
+            let mut v = top(m);
+            v.cut = Some(volcad_render::CutPlane {
+                axis: 2,
+                offset: 0.0,
+                keep_below: true,
+            });
+            v
+        });
+        assert!(cut.hit.point.z.abs() < 0.01, "{:?}", cut.hit);
+        assert_eq!(cut.hit.surface, volcad_render::HitSurface::Cut);
+        let iso = core_and_skin(|m| {
+            let red = m
+                .materials()
+                .iter()
+                .position(|&id| m.table().name(id) == "red")
+                .unwrap();
+            let mut v = top(m);
+            v.mode = volcad_render::ViewMode::Iso {
+                material_index: red,
+                level: 0.5,
+            };
+            v
+        });
+        assert!((iso.hit.point.z - 5.0).abs() < 0.02, "{:?}", iso.hit);
     }
 }

@@ -450,8 +450,7 @@ impl Viewport {
         };
         let request = |p: Pos2| super::probe::ProbeRequest {
             model: model.clone(),
-            camera: self.settings.camera,
-            cut: self.settings.cut,
+            view: self.settings.clone(),
             ndc: ndc(p),
             aspect,
             pos: p,

@@ -14,6 +14,7 @@ mod file_cache;
 mod files_api;
 mod leaves_api;
 mod nodes_api;
+pub mod reference;
 mod values;
 
 use std::collections::HashMap;
@@ -258,6 +259,25 @@ pub fn run_script(source: &str, name: &str, opts: &ScriptOptions) -> Result<Desi
 }
 
 /// Every material id in the tree must be in the table.
+/// The names of every function the script engine registers (sorted,
+/// once each): the language reference is checked against them.
+pub fn registered_functions() -> Vec<String> {
+    let ctx = RunContext {
+        base_dir: None,
+        overrides: Arc::new(HashMap::new()),
+        state: Arc::new(Mutex::new(RunState::default())),
+    };
+    let engine = build_engine(&ctx, &ScriptOptions::default());
+    let mut names: Vec<String> = engine
+        .gen_fn_signatures(false)
+        .iter()
+        .filter_map(|s| s.split('(').next().map(str::to_owned))
+        .collect();
+    names.sort();
+    names.dedup();
+    names
+}
+
 fn check_materials(root: &Node, table: &MaterialTable, name: &str) -> Result<(), ScriptError> {
     let mut seen = std::collections::HashSet::new();
     let mut stack = vec![root];

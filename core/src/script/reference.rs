@@ -1,0 +1,621 @@
+//! The language reference: every script function a design can call, its
+//! forms with argument names and types, a one-line description and an
+//! example; and the math strings' variables, operators and functions.
+//!
+//! The studio's Help window, its hover tooltips and its completion read
+//! this table. It cannot drift from the engine: a test lists every
+//! function the engine registers and fails for one without an entry (and
+//! for an entry the engine does not have), and runs every example.
+
+/// What kind of thing a reference entry is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Group {
+    /// A solid: distance and a material.
+    Geometry,
+    /// Lattices and periodic structures.
+    Lattice,
+    /// Combining children.
+    Boolean,
+    /// Moving, scaling, offsetting a child.
+    Transform,
+    /// Materials and grading.
+    Material,
+    /// Files beside the design.
+    Data,
+    /// A method called on a node (`node.add_child(x)`).
+    Method,
+    /// Vectors, parameters and other values.
+    Value,
+}
+
+impl Group {
+    /// The heading in the reference.
+    pub fn title(self) -> &'static str {
+        match self {
+            Group::Geometry => "Geometry",
+            Group::Lattice => "Lattices",
+            Group::Boolean => "Booleans",
+            Group::Transform => "Transforms",
+            Group::Material => "Materials",
+            Group::Data => "Data",
+            Group::Method => "Node methods",
+            Group::Value => "Values",
+        }
+    }
+}
+
+/// One script function.
+#[derive(Clone, Copy, Debug)]
+pub struct FnDoc {
+    /// The name a script calls.
+    pub name: &'static str,
+    /// Its group.
+    pub group: Group,
+    /// Every form, with argument names and types.
+    pub forms: &'static [&'static str],
+    /// One line on what it does.
+    pub summary: &'static str,
+    /// What completion inserts.
+    pub skeleton: &'static str,
+    /// A complete script that uses it (the test runs it).
+    pub example: &'static str,
+}
+
+/// One name a math string may use.
+#[derive(Clone, Copy, Debug)]
+pub struct MathDoc {
+    /// The variable, operator or function.
+    pub name: &'static str,
+    /// What it is.
+    pub summary: &'static str,
+}
+
+macro_rules! f {
+    ($name:literal, $group:ident, [$($form:literal),+], $summary:literal, $skeleton:literal, $example:literal) => {
+        FnDoc {
+            name: $name,
+            group: Group::$group,
+            forms: &[$($form),+],
+            summary: $summary,
+            skeleton: $skeleton,
+            example: $example,
+        }
+    };
+}
+
+/// Every script function, in reference order.
+pub static FUNCTIONS: &[FnDoc] = &[
+    f!(
+        "Sphere",
+        Geometry,
+        ["Sphere(center: Vec3, radius: float, material: int)"],
+        "A ball: exact distance |p − c| − r.",
+        "Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\"))",
+        "let m = default_materials(); Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\"))"
+    ),
+    f!(
+        "RectPrism",
+        Geometry,
+        ["RectPrism(center: Vec3, size: Vec3, material: int)"],
+        "A box with full side lengths `size` (exact Euclidean distance).",
+        "RectPrism(Vec3(0, 0, 0), Vec3(10, 10, 10), m.id(\"red\"))",
+        "let m = default_materials(); RectPrism(Vec3(0, 0, 0), Vec3(15, 10, 5), m.id(\"gray\"))"
+    ),
+    f!(
+        "Cylinder",
+        Geometry,
+        ["Cylinder(center: Vec3, radius: float, height: float, material: int)"],
+        "A cylinder along z, centred on `center`.",
+        "Cylinder(Vec3(0, 0, 0), 5.0, 10.0, m.id(\"red\"))",
+        "let m = default_materials(); Cylinder(Vec3(0, 0, 0), 5.0, 10.0, m.id(\"blue\"))"
+    ),
+    f!(
+        "Strut",
+        Geometry,
+        ["Strut(start: Vec3, end: Vec3, radius: float, material: int)"],
+        "A capsule of `radius` around the segment from `start` to `end`.",
+        "Strut(Vec3(0, 0, 0), Vec3(0, 0, 10), 1.0, m.id(\"red\"))",
+        "let m = default_materials(); Strut(Vec3(0, 0, 0), Vec3(0, 0, 10), 1.0, m.id(\"red\"))"
+    ),
+    f!(
+        "PolygonExtrude",
+        Geometry,
+        ["PolygonExtrude(points: [Vec3], height: float, symmetric: bool, material: int)"],
+        "A polygon in the xy plane extruded along z (from 0, or centred when symmetric).",
+        "PolygonExtrude([Vec3(0, 0, 0), Vec3(10, 0, 0), Vec3(0, 10, 0)], 5.0, false, m.id(\"red\"))",
+        "let m = default_materials(); PolygonExtrude([Vec3(0, 0, 0), Vec3(10, 0, 0), Vec3(0, 10, 0)], 5.0, false, m.id(\"red\"))"
+    ),
+    f!(
+        "Function",
+        Geometry,
+        [
+            "Function(expr: string)",
+            "Function(expr: string, material: int)",
+            "Function(expr: string, material: int, min: Vec3, max: Vec3)"
+        ],
+        "The solid where a math string of x, y, z is ≤ 0, clipped to its box.",
+        "Function(\"x^2 + y^2 + z^2 - 25\", m.id(\"red\"), Vec3(-6, -6, -6), Vec3(6, 6, 6))",
+        "let m = default_materials(); Function(\"x^2 + y^2 + z^2 - 25\", m.id(\"red\"), Vec3(-6, -6, -6), Vec3(6, 6, 6))"
+    ),
+    f!(
+        "Mesh",
+        Data,
+        ["Mesh(path: string)", "Mesh(path: string, material: int)"],
+        "A closed triangle mesh (OBJ, STL) as exact signed distance.",
+        "Mesh(\"part.obj\", m.id(\"red\"))",
+        ""
+    ),
+    f!(
+        "SimulationField",
+        Data,
+        ["SimulationField(inp: string, csv: string, exprs: [string], materials: [int])"],
+        "FEA results on a tetrahedral mesh (.inp + nodal CSV) graded into fractions by math strings.",
+        "SimulationField(\"mesh.inp\", \"result.csv\", [\"len\", \"1 - len\"], [m.id(\"red\"), m.id(\"blue\")])",
+        ""
+    ),
+    f!(
+        "read_csv",
+        Data,
+        ["read_csv(path: string) -> [map]"],
+        "Rows of a CSV file beside the design, each a map by column name.",
+        "read_csv(\"data.csv\")",
+        ""
+    ),
+    f!(
+        "Gyroid",
+        Lattice,
+        ["Gyroid(cell: float or Vec3, wall: float, material: int)"],
+        "Schoen's gyroid sheet of wall thickness `wall` (infinite: clip it).",
+        "Gyroid(10.0, 1.0, m.id(\"red\"))",
+        "let m = default_materials(); Intersection(false, [Gyroid(10.0, 1.0, m.id(\"red\")), Sphere(Vec3(0, 0, 0), 10.0, m.id(\"red\"))])"
+    ),
+    f!(
+        "SchwarzP",
+        Lattice,
+        ["SchwarzP(cell: float or Vec3, wall: float, material: int)"],
+        "Schwarz P sheet (infinite: clip it).",
+        "SchwarzP(10.0, 1.0, m.id(\"red\"))",
+        "let m = default_materials(); Intersection(false, [SchwarzP(10.0, 1.0, m.id(\"red\")), Sphere(Vec3(0, 0, 0), 10.0, m.id(\"red\"))])"
+    ),
+    f!(
+        "Diamond",
+        Lattice,
+        ["Diamond(cell: float or Vec3, wall: float, material: int)"],
+        "Schwarz D (diamond) sheet (infinite: clip it).",
+        "Diamond(10.0, 1.0, m.id(\"red\"))",
+        "let m = default_materials(); Intersection(false, [Diamond(10.0, 1.0, m.id(\"red\")), Sphere(Vec3(0, 0, 0), 10.0, m.id(\"red\"))])"
+    ),
+    f!(
+        "GraphLattice",
+        Lattice,
+        [
+            "GraphLattice(type: LatticeType, cell: Vec3, radius: float, material: int)",
+            "GraphLattice(edges: [[Vec3, Vec3]], radius: float, material: int)"
+        ],
+        "One unit cell of struts (LatticeType::BodyCenteredCubic, FaceCenteredCubic, Cubic, KelvinCell, Octet) or of your own edges; Tile repeats it.",
+        "GraphLattice(LatticeType::BodyCenteredCubic, Vec3(5, 5, 5), 0.5, m.id(\"red\"))",
+        "let m = default_materials(); GraphLattice(LatticeType::BodyCenteredCubic, Vec3(5, 5, 5), 0.5, m.id(\"red\"))"
+    ),
+    f!(
+        "Tile",
+        Lattice,
+        [
+            "Tile(child: Node)",
+            "Tile(cx: float, cy: float, cz: float, child: Node)",
+            "Tile()"
+        ],
+        "Repeats its child periodically (cell = the child's box, or cx, cy, cz); clip it with Intersection.",
+        "Tile(5.0, 5.0, 5.0, cell)",
+        "let m = default_materials(); let cell = GraphLattice(LatticeType::Cubic, Vec3(5, 5, 5), 0.5, m.id(\"red\")); Intersection(false, [Tile(cell), Sphere(Vec3(0, 0, 0), 10.0, m.id(\"red\"))])"
+    ),
+    f!(
+        "Union",
+        Boolean,
+        [
+            "Union(blend: bool, children: [Node])",
+            "Union(k: float, blend: bool, children: [Node])",
+            "Union()"
+        ],
+        "The children together; `blend` averages fractions where they overlap (else the first child's); `k` rounds the joins.",
+        "Union(false, [a, b])",
+        "let m = default_materials(); Union(false, [Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\")), Sphere(Vec3(6, 0, 0), 5.0, m.id(\"blue\"))])"
+    ),
+    f!(
+        "Intersection",
+        Boolean,
+        [
+            "Intersection(blend: bool, children: [Node])",
+            "Intersection(k: float, blend: bool, children: [Node])",
+            "Intersection()"
+        ],
+        "Where every child is; fractions of the first child (or averaged with `blend`).",
+        "Intersection(false, [a, b])",
+        "let m = default_materials(); Intersection(false, [Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\")), RectPrism(Vec3(0, 0, 0), Vec3(8, 8, 8), m.id(\"red\"))])"
+    ),
+    f!(
+        "Difference",
+        Boolean,
+        [
+            "Difference(left: Node, right: Node)",
+            "Difference(k: float, left: Node, right: Node)",
+            "Difference()"
+        ],
+        "`left` with `right` removed (`k` rounds the edge).",
+        "Difference(a, b)",
+        "let m = default_materials(); Difference(RectPrism(Vec3(0, 0, 0), Vec3(10, 10, 10), m.id(\"red\")), Sphere(Vec3(0, 0, 0), 6.0, m.id(\"red\")))"
+    ),
+    f!(
+        "Translate",
+        Transform,
+        [
+            "Translate(x: float, y: float, z: float, child: Node)",
+            "Translate(offset: Vec3, child: Node)",
+            "Translate()"
+        ],
+        "Moves its child.",
+        "Translate(0.0, 0.0, 10.0, child)",
+        "let m = default_materials(); Translate(0.0, 0.0, 10.0, Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\")))"
+    ),
+    f!(
+        "Scale",
+        Transform,
+        [
+            "Scale(sx: float, sy: float, sz: float, child: Node)",
+            "Scale(s: Vec3, child: Node)",
+            "Scale()"
+        ],
+        "Scales its child about the origin (distances stay a valid bound).",
+        "Scale(2.0, 1.0, 1.0, child)",
+        "let m = default_materials(); Scale(2.0, 1.0, 1.0, Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\")))"
+    ),
+    f!(
+        "Rotate",
+        Transform,
+        [
+            "Rotate(pitch: float, yaw: float, roll: float, around: Vec3, child: Node)",
+            "Rotate(pitch: float, yaw: float, roll: float, child: Node)",
+            "Rotate()"
+        ],
+        "Rotates its child (degrees about x, y, z) around a point.",
+        "Rotate(0.0, 0.0, 45.0, Vec3(0, 0, 0), child)",
+        "let m = default_materials(); Rotate(0.0, 0.0, 45.0, Vec3(0, 0, 0), RectPrism(Vec3(0, 0, 0), Vec3(10, 4, 2), m.id(\"red\")))"
+    ),
+    f!(
+        "Offset",
+        Transform,
+        [
+            "Offset(distance: float, child: Node)",
+            "Offset(distance: float)",
+            "Offset()"
+        ],
+        "Grows (> 0) or shrinks (< 0) its child by a distance.",
+        "Offset(1.0, child)",
+        "let m = default_materials(); Offset(1.0, RectPrism(Vec3(0, 0, 0), Vec3(10, 10, 10), m.id(\"red\")))"
+    ),
+    f!(
+        "Shell",
+        Transform,
+        [
+            "Shell(thickness: float, child: Node)",
+            "Shell(thickness: float)",
+            "Shell()"
+        ],
+        "A wall of `thickness` inside its child's surface.",
+        "Shell(1.0, child)",
+        "let m = default_materials(); Shell(1.0, Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\")))"
+    ),
+    f!(
+        "FGrade",
+        Material,
+        [
+            "FGrade(exprs: [string], materials: [int], prob: bool, child: Node)",
+            "FGrade(exprs: [string], materials: [int], prob: bool)"
+        ],
+        "Grades its child: one math string per material gives its fraction (normalised); `prob` keeps mixes, else the largest wins.",
+        "FGrade([\"x/15+0.5\", \"-x/15+0.5\"], [m.id(\"red\"), m.id(\"blue\")], true, child)",
+        "let m = default_materials(); FGrade([\"x/15+0.5\", \"-x/15+0.5\"], [m.id(\"red\"), m.id(\"blue\")], true, RectPrism(Vec3(0, 0, 0), Vec3(15, 10, 5), m.id(\"gray\")))"
+    ),
+    f!(
+        "Blend",
+        Material,
+        ["Blend(radius: float, child: Node)", "Blend(radius: float)"],
+        "Smooths its child's fractions over a neighbourhood of `radius`.",
+        "Blend(1.0, child)",
+        "let m = default_materials(); Blend(1.0, Union(false, [RectPrism(Vec3(-2.5, 0, 0), Vec3(5, 5, 5), m.id(\"red\")), RectPrism(Vec3(2.5, 0, 0), Vec3(5, 5, 5), m.id(\"blue\"))]))"
+    ),
+    f!(
+        "default_materials",
+        Material,
+        ["default_materials() -> Materials"],
+        "pyvcad's default table of named colours.",
+        "default_materials()",
+        "let m = default_materials(); Sphere(Vec3(0, 0, 0), 1.0, m.id(\"red\"))"
+    ),
+    f!(
+        "j750_materials",
+        Material,
+        ["j750_materials() -> Materials"],
+        "The Stratasys J750 resin table.",
+        "j750_materials()",
+        "let m = j750_materials(); Sphere(Vec3(0, 0, 0), 1.0, m.id(\"VeroCyan\"))"
+    ),
+    f!(
+        "load_materials",
+        Material,
+        ["load_materials(path: string) -> Materials"],
+        "A material table from a pyvcad JSON file beside the design.",
+        "load_materials(\"materials.json\")",
+        ""
+    ),
+    f!(
+        "id",
+        Method,
+        ["materials.id(name: string) -> int"],
+        "A material's id by name (an unknown name lists the nearest).",
+        "m.id(\"red\")",
+        "let m = default_materials(); Sphere(Vec3(0, 0, 0), 1.0, m.id(\"red\"))"
+    ),
+    f!(
+        "name",
+        Method,
+        ["materials.name(id: int) -> string"],
+        "A material's name by id.",
+        "m.name(1)",
+        "let m = default_materials(); let n = m.name(m.id(\"red\")); Sphere(Vec3(0, 0, 0), 1.0, m.id(n))"
+    ),
+    f!(
+        "color",
+        Method,
+        ["materials.color(id: int) -> [int]"],
+        "A material's RGBA colour.",
+        "m.color(m.id(\"red\"))",
+        "let m = default_materials(); let c = m.color(m.id(\"red\")); Sphere(Vec3(0, 0, 0), 1.0, m.id(\"red\"))"
+    ),
+    f!(
+        "contains",
+        Method,
+        ["materials.contains(name: string) -> bool"],
+        "Whether the table has a material of that name.",
+        "m.contains(\"red\")",
+        "let m = default_materials(); let k = if m.contains(\"red\") { \"red\" } else { \"blue\" }; Sphere(Vec3(0, 0, 0), 1.0, m.id(k))"
+    ),
+    f!(
+        "num_materials",
+        Method,
+        ["materials.num_materials() -> int"],
+        "How many materials the table holds (void not counted).",
+        "m.num_materials()",
+        "let m = default_materials(); let n = m.num_materials(); Sphere(Vec3(0, 0, 0), 1.0, m.id(\"red\"))"
+    ),
+    f!(
+        "add_child",
+        Method,
+        ["node.add_child(child: Node) -> bool"],
+        "Appends a child to a Union, Intersection or Tile.",
+        "u.add_child(child)",
+        "let m = default_materials(); let u = Union(false, []); u.add_child(Sphere(Vec3(0, 0, 0), 1.0, m.id(\"red\"))); u"
+    ),
+    f!(
+        "set_child",
+        Method,
+        ["node.set_child(child: Node)"],
+        "Sets the child of a one-child node (transforms, FGrade, Blend, ...).",
+        "n.set_child(child)",
+        "let m = default_materials(); let t = Translate(); t.set_child(Sphere(Vec3(0, 0, 0), 1.0, m.id(\"red\"))); t"
+    ),
+    f!(
+        "set_left",
+        Method,
+        ["node.set_left(child: Node)"],
+        "Sets the left operand of a Difference.",
+        "d.set_left(child)",
+        "let m = default_materials(); let d = Difference(); d.set_left(Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\"))); d.set_right(Sphere(Vec3(3, 0, 0), 3.0, m.id(\"red\"))); d"
+    ),
+    f!(
+        "set_right",
+        Method,
+        ["node.set_right(child: Node)"],
+        "Sets the right operand of a Difference (what is removed).",
+        "d.set_right(child)",
+        "let m = default_materials(); let d = Difference(); d.set_left(Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\"))); d.set_right(Sphere(Vec3(3, 0, 0), 3.0, m.id(\"red\"))); d"
+    ),
+    f!(
+        "num_children",
+        Method,
+        ["node.num_children() -> int"],
+        "How many children a node has.",
+        "u.num_children()",
+        "let m = default_materials(); let u = Union(false, [Sphere(Vec3(0, 0, 0), 1.0, m.id(\"red\"))]); let n = u.num_children(); u"
+    ),
+    f!(
+        "type",
+        Method,
+        ["node.type() -> string"],
+        "The node's type name (\"Sphere\", \"Union\", ...).",
+        "n.type()",
+        "let m = default_materials(); let s = Sphere(Vec3(0, 0, 0), 1.0, m.id(\"red\")); let t = s.type(); s"
+    ),
+    f!(
+        "Vec3",
+        Value,
+        ["Vec3(x: float, y: float, z: float)", "Vec3()"],
+        "A point or vector in millimetres; `+ - *` and `.x .y .z`.",
+        "Vec3(0, 0, 0)",
+        "let m = default_materials(); let c = Vec3(1, 2, 3) + Vec3(1, 0, 0) * 2.0; Sphere(c, 1.0, m.id(\"red\"))"
+    ),
+    f!(
+        "length",
+        Value,
+        ["v.length() -> float"],
+        "A vector's length.",
+        "v.length()",
+        "let m = default_materials(); let r = Vec3(3, 4, 0).length(); Sphere(Vec3(0, 0, 0), r, m.id(\"red\"))"
+    ),
+    f!(
+        "distance",
+        Value,
+        ["distance(a: Vec3, b: Vec3) -> float"],
+        "The distance between two points.",
+        "distance(a, b)",
+        "let m = default_materials(); let r = distance(Vec3(0, 0, 0), Vec3(3, 4, 0)); Sphere(Vec3(0, 0, 0), r, m.id(\"red\"))"
+    ),
+    f!(
+        "param",
+        Value,
+        ["param(name: string, default: float, min: float, max: float) -> float"],
+        "A slider in the studio (and `--param name=value` on the command line).",
+        "param(\"radius\", 5.0, 1.0, 10.0)",
+        "let m = default_materials(); let r = param(\"radius\", 5.0, 1.0, 10.0); Sphere(Vec3(0, 0, 0), r, m.id(\"red\"))"
+    ),
+    f!(
+        "pad",
+        Value,
+        ["pad(array, length: int, value)"],
+        "Rhai's array padding, checked against the script's memory budget first.",
+        "a.pad(10, 0)",
+        "let m = default_materials(); let a = []; a.pad(3, 1.0); Sphere(Vec3(0, 0, 0), a[0], m.id(\"red\"))"
+    ),
+    f!(
+        "blob",
+        Value,
+        ["blob(length: int) -> Blob"],
+        "Rhai's byte buffer, checked against the script's memory budget first.",
+        "blob(16)",
+        "let m = default_materials(); let b = blob(4); Sphere(Vec3(0, 0, 0), 1.0, m.id(\"red\"))"
+    ),
+];
+
+/// The names math strings (FGrade, Function, SimulationField) understand.
+pub static MATH: &[MathDoc] = &[
+    MathDoc {
+        name: "x y z",
+        summary: "the point, in the node's local frame (mm)",
+    },
+    MathDoc {
+        name: "rho phic",
+        summary: "cylindrical radius and angle about z",
+    },
+    MathDoc {
+        name: "r theta phis",
+        summary: "spherical radius, polar and azimuth angles",
+    },
+    MathDoc {
+        name: "d",
+        summary: "the child's signed distance (FGrade)",
+    },
+    MathDoc {
+        name: "dx dy dz len",
+        summary: "interpolated displacement and its length (SimulationField; every CSV column too)",
+    },
+    MathDoc {
+        name: "+ - * / % ^",
+        summary: "arithmetic; ^ is power, right-associative",
+    },
+    MathDoc {
+        name: "< <= > >= == !=",
+        summary: "comparisons (1 or 0)",
+    },
+    MathDoc {
+        name: "and or not",
+        summary: "logic",
+    },
+    MathDoc {
+        name: "c ? a : b, if(c, a, b)",
+        summary: "choice",
+    },
+    MathDoc {
+        name: "min max sum avg",
+        summary: "of any number of arguments",
+    },
+    MathDoc {
+        name: "clamp(lo, x, hi)",
+        summary: "x limited to [lo, hi]",
+    },
+    MathDoc {
+        name: "sin cos tan asin acos atan atan2",
+        summary: "trigonometry (radians)",
+    },
+    MathDoc {
+        name: "sinh cosh tanh",
+        summary: "hyperbolic functions",
+    },
+    MathDoc {
+        name: "exp log log10 log2 sqrt abs",
+        summary: "exponentials, logarithms, roots",
+    },
+    MathDoc {
+        name: "floor ceil round trunc frac sgn",
+        summary: "rounding",
+    },
+    MathDoc {
+        name: "pi e epsilon inf",
+        summary: "constants",
+    },
+];
+
+/// The entry for `name`, if it is a script function.
+pub fn lookup(name: &str) -> Option<&'static FnDoc> {
+    FUNCTIONS.iter().find(|f| f.name == name)
+}
+
+/// Entries whose name or summary contains `query` (case-insensitive).
+pub fn search(query: &str) -> impl Iterator<Item = &'static FnDoc> {
+    let q = query.to_lowercase();
+    FUNCTIONS.iter().filter(move |f| {
+        q.is_empty() || f.name.to_lowercase().contains(&q) || f.summary.to_lowercase().contains(&q)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::script::{ScriptOptions, registered_functions, run_script};
+
+    /// Rhai's own functions (operators, string and array methods) are not
+    /// ours to document.
+    fn ours(name: &str) -> bool {
+        !matches!(
+            name,
+            "to_string" | "to_debug" | "+" | "-" | "*" | "/" | "==" | "!=" | "x" | "y" | "z"
+        ) && !name.starts_with("get$")
+            && !name.starts_with("set$")
+    }
+
+    #[test]
+    fn every_registered_function_has_an_entry_and_no_entry_is_stale() {
+        let names = registered_functions();
+        let missing: Vec<_> = names
+            .iter()
+            .filter(|n| ours(n) && lookup(n).is_none())
+            .collect();
+        assert!(
+            missing.is_empty(),
+            "functions without a reference entry: {missing:?}"
+        );
+        let stale: Vec<_> = FUNCTIONS
+            .iter()
+            .filter(|f| !names.iter().any(|n| n == f.name))
+            .map(|f| f.name)
+            .collect();
+        assert!(
+            stale.is_empty(),
+            "entries the engine does not have: {stale:?}"
+        );
+    }
+
+    #[test]
+    fn every_example_runs() {
+        for f in FUNCTIONS.iter().filter(|f| !f.example.is_empty()) {
+            if let Err(e) = run_script(f.example, "example.rhai", &ScriptOptions::default()) {
+                panic!("{}'s example fails: {e}", f.name);
+            }
+        }
+    }
+
+    #[test]
+    fn search_finds_by_name_and_summary() {
+        assert!(search("sphere").any(|f| f.name == "Sphere"));
+        assert!(search("rounds the joins").any(|f| f.name == "Union"));
+        assert_eq!(search("").count(), FUNCTIONS.len());
+    }
+}
