@@ -676,3 +676,61 @@ fn keys_in_one_frame_keep_their_order() {
     h.run_steps(4);
     assert_eq!(h.state().text(), "bbbbb\nc\nc\ncc");
 }
+
+/// F1 opens the language reference; its search filters the entries.
+#[test]
+fn the_language_reference_opens_and_searches() {
+    let (_dir, mut h) = studio(BAR, "reference");
+    wait_idle(&mut h);
+    h.key_press(egui::Key::F1);
+    h.run_steps(2);
+    assert!(h.state().reference.open);
+    assert!(h.query_by_label("GraphLattice").is_some());
+    assert!(h.query_by_label("Sphere").is_some());
+    h.state_mut().reference.query = "lattice".into();
+    h.run_steps(2);
+    assert!(h.query_by_label("GraphLattice").is_some());
+    assert!(
+        h.query_by_label("Sphere").is_none(),
+        "search did not filter"
+    );
+}
+
+/// Typing two letters of a node name lists it; Enter inserts the
+/// skeleton. Inside `id("…")` the design's material names are offered.
+#[test]
+fn completion_inserts_node_skeletons_and_material_names() {
+    let (_dir, mut h) = studio(BAR, "completion");
+    wait_idle(&mut h);
+    type_at_end(&mut h, ";\nlet s = Sph");
+    h.run_steps(2);
+    let items: Vec<String> = h
+        .state()
+        .editor_completion()
+        .iter()
+        .map(|i| i.label.clone())
+        .collect();
+    assert_eq!(
+        items.first().map(String::as_str),
+        Some("Sphere"),
+        "{items:?}"
+    );
+    h.key_press(egui::Key::Enter);
+    h.run_steps(2);
+    assert!(
+        h.state()
+            .text()
+            .ends_with("let s = Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\"))"),
+        "{}",
+        h.state().text()
+    );
+    type_at_end(&mut h, ";\nm.id(\"bl");
+    h.run_steps(2);
+    let items: Vec<String> = h
+        .state()
+        .editor_completion()
+        .iter()
+        .map(|i| i.label.clone())
+        .collect();
+    assert!(items.iter().any(|i| i == "blue"), "{items:?}");
+}

@@ -233,6 +233,9 @@ impl StudioApp {
         if pressed(&NEW) {
             self.request(ctx, Pending::New);
         }
+        if ctx.input_mut(|i| i.consume_key(Modifiers::NONE, Key::F1)) {
+            self.reference.open = !self.reference.open;
+        }
         if pressed(&QUIT) {
             self.request(ctx, Pending::Quit);
         }
@@ -336,6 +339,14 @@ impl StudioApp {
                 }
             });
             ui.menu_button("Help", |ui| {
+                if ui
+                    .add(egui::Button::new("Language reference").shortcut_text("F1"))
+                    .clicked()
+                {
+                    self.reference.open = true;
+                }
+                ui.weak("In the editor: Ctrl+Space completes; hover a name for its forms.");
+                ui.separator();
                 ui.label(format!("Volcad Studio {}", env!("CARGO_PKG_VERSION")));
                 ui.weak("Volumetric multi-material design: edit the Rhai script,\nthe preview follows; export from the right panel.");
                 ui.weak("Viewport: drag to orbit, right/middle/Shift-drag to pan,\nscroll to zoom, double-click or F to fit, click to pin the probe.");

@@ -15,6 +15,7 @@ use egui::text::{CCursor, CCursorRange};
 use egui::{Color32, FontId, Id, Key, KeyboardShortcut, Modifiers, Rect, Shape, TextEdit};
 use egui_extras::syntax_highlighting::SyntectSettings;
 
+use super::completion::{Completion, Vocabulary};
 use super::highlight;
 use super::textops::{self, Edit};
 
@@ -56,6 +57,10 @@ pub struct Editor {
     /// handles itself (Tab, Enter) is applied after the text typed before
     /// it in the same frame (see [`Editor::order_keys`]).
     deferred: Vec<egui::Event>,
+    /// The completion list.
+    pub completion: Completion,
+    /// Material and parameter names of the last good design.
+    pub vocabulary: Vocabulary,
 }
 
 /// What happened in the editor this frame.
@@ -75,6 +80,8 @@ impl Editor {
             jump: None,
             marks: Vec::new(),
             deferred: Vec::new(),
+            completion: Completion::default(),
+            vocabulary: Vocabulary::default(),
         }
     }
 
@@ -267,6 +274,13 @@ impl Editor {
         if self.find.open {
             self.find_bar_ui(ui);
         }
+        let focused = ui.ctx().memory(|m| m.has_focus(self.id));
+        if focused && let Some(choice) = self.completion.keys(ui.ctx()) {
+            let edit = choice.edit(&self.text);
+            self.apply(ui.ctx(), edit);
+            out.changed = true;
+        }
+        let forced = focused && ui.input_mut(|i| i.consume_key(Modifiers::COMMAND, Key::Space));
         out.changed |= self.handle_keys(ui);
 
         // A jump that takes the focus waits out a frame with a click (the
@@ -327,7 +341,8 @@ impl Editor {
                         .layouter(&mut layouter)
                         .show(ui);
                     out.changed |= output.response.changed();
-                    let _ = output.response.response.clone().labelled_by(label);
+                    let response = output.response.response.clone().labelled_by(label);
+                    self.complete_and_explain(ui, &output, &response, forced);
                     let lines = line_rects(&output.galley, output.galley_pos);
                     let right = ui.clip_rect().right().max(output.response.rect.right());
                     let mut tints = Vec::new();
@@ -383,6 +398,43 @@ impl Editor {
                 });
             });
         out
+    }
+
+    /// After the text was laid out: update and draw the completion list
+    /// at the cursor, and explain the name under the mouse.
+    fn complete_and_explain(
+        &mut self,
+        ui: &egui::Ui,
+        output: &egui::text_edit::TextEditOutput,
+        response: &egui::Response,
+        forced: bool,
+    ) {
+        let focused = ui.ctx().memory(|m| m.has_focus(self.id));
+        match output.cursor_range.filter(|_| focused) {
+            Some(range) => {
+                let cursor = range.primary.index.0;
+                let typed = output.response.changed();
+                if typed || forced || self.completion.is_open() {
+                    self.completion
+                        .update(&self.text, cursor, typed, forced, &self.vocabulary);
+                }
+                let at = output
+                    .galley
+                    .pos_from_cursor(range.primary)
+                    .translate(output.galley_pos.to_vec2());
+                self.completion.ui(ui.ctx(), at.left_bottom());
+            }
+            None => self.completion.close(),
+        }
+        if let Some(p) = response.hover_pos() {
+            let c = output.galley.cursor_from_pos(p - output.galley_pos);
+            let word = textops::word_at(&self.text, c.index.0);
+            if let Some(f) = volcad_core::script::reference::lookup(&word) {
+                response.clone().on_hover_ui_at_pointer(|ui| {
+                    super::reference::entry_ui(ui, f);
+                });
+            }
+        }
     }
 
     fn paint_gutter_and_messages(

@@ -21,6 +21,7 @@
 #![warn(missing_docs)]
 
 mod commands;
+pub mod completion;
 pub mod editor;
 pub mod examples;
 mod export_panel;
@@ -32,6 +33,7 @@ pub mod live;
 pub mod params;
 pub mod probe;
 pub mod problems;
+pub mod reference;
 mod screenshot;
 pub mod settings;
 pub mod textops;
@@ -195,6 +197,8 @@ pub struct StudioApp {
     live: LiveRunner,
     good: Option<GoodDesign>,
     error: Option<LiveError>,
+    /// Help → Language reference.
+    pub reference: reference::ReferenceWindow,
     params: ParamPanel,
     viewport: Viewport,
     bottom: BottomPanel,
@@ -251,6 +255,7 @@ impl StudioApp {
             doc,
             good: None,
             error: None,
+            reference: reference::ReferenceWindow::default(),
             params: ParamPanel::default(),
             bottom,
             jobs: Jobs::default(),
@@ -312,6 +317,16 @@ impl StudioApp {
                     prepare_time.as_secs_f64() * 1e3
                 ));
                 self.viewport.set_model(ctx, model.clone());
+                self.editor.vocabulary = completion::Vocabulary {
+                    materials: model
+                        .table()
+                        .materials()
+                        .iter()
+                        .skip(1)
+                        .map(|m| m.name.clone())
+                        .collect(),
+                    params: params.iter().map(|p| p.name.clone()).collect(),
+                };
                 self.editor.marks.clear();
                 self.error = None;
                 self.good = Some(GoodDesign {
@@ -370,6 +385,11 @@ impl StudioApp {
     /// True when nothing is pending: no script run, no bake level left.
     pub fn is_idle(&self) -> bool {
         !self.live.is_busy() && !self.viewport.is_baking()
+    }
+
+    /// The completion list showing in the editor (tests).
+    pub fn editor_completion(&self) -> &[completion::Item] {
+        self.editor.completion.items()
     }
 
     /// The editor text (tests).
@@ -522,7 +542,7 @@ impl StudioApp {
             .show(ui, |ui| {
                 // A fixed height, so the panels below do not jump as the
                 // read-out under the cursor changes length.
-                let h = ui.text_style_height(&egui::TextStyle::Monospace) * 16.0;
+                let h = ui.text_style_height(&egui::TextStyle::Monospace) * 8.0;
                 egui::ScrollArea::vertical()
                     .id_salt("probe-scroll")
                     .max_height(h)
@@ -616,6 +636,7 @@ impl eframe::App for StudioApp {
         self.shortcuts(&ctx);
         self.panels(ui);
         self.modal_ui(&ctx);
+        self.reference.ui(&ctx);
         let dirty = self.is_dirty();
         self.recovery
             .tick(&ctx, &self.editor.text, dirty, self.doc.path.as_deref());

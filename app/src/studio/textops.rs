@@ -12,6 +12,22 @@ pub fn char_to_byte(text: &str, ci: usize) -> usize {
     text.char_indices().nth(ci).map_or(text.len(), |(b, _)| b)
 }
 
+/// The identifier (letters, digits, `_`) around char index `at`.
+pub fn word_at(text: &str, at: usize) -> String {
+    let chars: Vec<char> = text.chars().collect();
+    let ident = |c: &char| c.is_alphanumeric() || *c == '_';
+    let at = at.min(chars.len());
+    let start = chars[..at]
+        .iter()
+        .rposition(|c| !ident(c))
+        .map_or(0, |i| i + 1);
+    let end = chars[at..]
+        .iter()
+        .position(|c| !ident(c))
+        .map_or(chars.len(), |i| at + i);
+    chars[start..end].iter().collect()
+}
+
 /// Char index of byte offset `b`.
 pub fn byte_to_char(text: &str, b: usize) -> usize {
     text[..b.min(text.len())].chars().count()
