@@ -259,7 +259,10 @@ fn screenshot_for_the_docs() {
     opts.bake_levels = vec![64, 128];
     let mut h = harness(opts);
     wait_idle(&mut h);
-    h.run_steps(2);
+    // The language reference open over the editor, searched for lattices.
+    h.key_press(egui::Key::F1);
+    h.state_mut().reference.query = "lattice".into();
+    h.run_steps(3);
     let img = h.render().expect("render");
     let out = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/images/studio.png");
     std::fs::create_dir_all(out.parent().unwrap()).unwrap();

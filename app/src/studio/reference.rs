@@ -43,7 +43,10 @@ impl ReferenceWindow {
         let mut open = self.open;
         egui::Window::new("Language reference")
             .open(&mut open)
-            .default_size([520.0, 560.0])
+            .default_size([460.0, 520.0])
+            // Over the editor, where the script being written is, not
+            // over the part.
+            .default_pos([24.0, 90.0])
             .vscroll(false)
             .show(ctx, |ui| {
                 ui.horizontal(|ui| {
