@@ -737,3 +737,36 @@ fn completion_inserts_node_skeletons_and_material_names() {
         .collect();
     assert!(items.iter().any(|i| i == "blue"), "{items:?}");
 }
+
+/// With no desktop dialog (no xdg-desktop-portal, as here), Save As opens
+/// the built-in file browser, and saving through it writes the file.
+#[test]
+fn save_as_falls_back_to_the_built_in_file_browser() {
+    let (scratch, mut h) = studio(BAR, "dialog");
+    let file = scratch.path().join("a.rhai");
+    std::fs::write(&file, BAR).expect("write a.rhai");
+    let ctx = h.ctx.clone();
+    h.state_mut().open_path(&ctx, file.clone());
+    wait_idle(&mut h);
+    type_at_end(&mut h, " // saved by the built-in dialog");
+    h.key_press_modifiers(
+        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+        egui::Key::S,
+    );
+    h.run_steps(3);
+    assert!(
+        h.query_by_label("Save design as").is_some(),
+        "no built-in dialog; log:\n{}",
+        h.state().log_lines().join("\n")
+    );
+    h.get_by_label("Save").click();
+    h.run_steps(3);
+    let saved = std::fs::read_to_string(&file).expect("read a.rhai");
+    assert!(
+        saved.ends_with("// saved by the built-in dialog"),
+        "{saved}"
+    );
+    assert!(!h.state().is_dirty());
+    let log = h.state().log_lines().join("\n");
+    assert!(log.contains("built-in file browser"), "{log}");
+}

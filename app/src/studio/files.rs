@@ -1,10 +1,5 @@
-//! Files: the open document, file dialogs on worker threads, and the
-//! recovery file that autosaves unsaved text.
-//!
-//! Dialogs: `rfd`'s blocking dialogs run on a short-lived thread each and
-//! answer through a channel that the UI drains every frame (under Xvfb with
-//! no portal they answer "cancelled"). Tests never open dialogs: they type
-//! paths into fields or call the app's methods.
+//! Files: the open document and the recovery file that autosaves unsaved
+//! text (file dialogs are in `dialogs.rs`).
 //!
 //! Recovery: every few seconds while the text differs from the saved file,
 //! `recovery.rhai` (the text) and `recovery.json` (which file it belongs to)
@@ -13,10 +8,11 @@
 //! studio offers to restore them.
 
 use std::path::{Path, PathBuf};
-use std::sync::mpsc::{Receiver, Sender, channel};
 use std::time::{Duration, Instant, SystemTime};
 
 use serde::{Deserialize, Serialize};
+
+pub use super::dialogs::{DialogAnswer, DialogPurpose, Dialogs};
 
 /// The document in the editor.
 #[derive(Clone, Debug, Default)]
@@ -94,105 +90,6 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 /// Read a script file.
 pub fn read_script(path: &Path) -> Result<String, String> {
     std::fs::read_to_string(path).map_err(|e| format!("could not open {}: {e}", path.display()))
-}
-
-/// What a dialog was opened for.
-#[derive(Clone, Debug, PartialEq)]
-pub enum DialogPurpose {
-    /// File → Open.
-    Open,
-    /// File → Save As (then maybe continue with a pending action).
-    SaveAs,
-    /// An export panel's output folder (panel index).
-    ExportFolder(usize),
-}
-
-/// A dialog's answer.
-#[derive(Debug)]
-pub struct DialogAnswer {
-    /// What it was for.
-    pub purpose: DialogPurpose,
-    /// The chosen path (`None`: cancelled or no dialog available).
-    pub path: Option<PathBuf>,
-}
-
-/// Native file dialogs on worker threads.
-pub struct Dialogs {
-    tx: Sender<DialogAnswer>,
-    rx: Receiver<DialogAnswer>,
-    open: usize,
-}
-
-impl Default for Dialogs {
-    fn default() -> Self {
-        let (tx, rx) = channel();
-        Self { tx, rx, open: 0 }
-    }
-}
-
-impl Dialogs {
-    /// True while a dialog is showing.
-    pub fn is_open(&self) -> bool {
-        self.open > 0
-    }
-
-    /// Show a dialog for `purpose` (starting in `dir`) on a worker thread.
-    pub fn show(
-        &mut self,
-        ctx: &egui::Context,
-        purpose: DialogPurpose,
-        dir: Option<PathBuf>,
-        file_name: Option<String>,
-    ) {
-        let tx = self.tx.clone();
-        let ctx = ctx.clone();
-        self.open += 1;
-        let p = purpose.clone();
-        let spawned = std::thread::Builder::new()
-            .name("volcad-dialog".into())
-            .spawn(move || {
-                let mut d = rfd::FileDialog::new();
-                if let Some(dir) = dir {
-                    d = d.set_directory(dir);
-                }
-                let path = match &p {
-                    DialogPurpose::Open => {
-                        d.add_filter("Rhai design script", &["rhai"]).pick_file()
-                    }
-                    DialogPurpose::SaveAs => {
-                        let d = d.add_filter("Rhai design script", &["rhai"]);
-                        let d = match file_name {
-                            Some(n) => d.set_file_name(n),
-                            None => d,
-                        };
-                        d.save_file().map(|p| {
-                            if p.extension().is_none() {
-                                p.with_extension("rhai")
-                            } else {
-                                p
-                            }
-                        })
-                    }
-                    DialogPurpose::ExportFolder(_) => d.pick_folder(),
-                };
-                let _ = tx.send(DialogAnswer { purpose: p, path });
-                ctx.request_repaint();
-            });
-        if spawned.is_err() {
-            self.open -= 1;
-            let _ = self.tx.send(DialogAnswer {
-                purpose,
-                path: None,
-            });
-        }
-    }
-
-    /// The next answer, if any (call each frame).
-    pub fn poll(&mut self) -> Option<DialogAnswer> {
-        let a = self.rx.try_recv().ok()?;
-        self.open = self.open.saturating_sub(1);
-        Some(a)
-    }
 }
 
 /// What `recovery.json` records.

@@ -20,8 +20,10 @@
 //! modals), `screenshot` (the `--screenshot` smoke test).
 #![warn(missing_docs)]
 
+mod browser;
 mod commands;
 pub mod completion;
+pub mod dialogs;
 pub mod editor;
 pub mod examples;
 mod export_panel;
@@ -442,8 +444,11 @@ impl StudioApp {
         for line in self.jobs.poll(ctx) {
             self.bottom.log(line);
         }
-        while let Some(a) = self.dialogs.poll() {
+        while let Some(a) = self.dialogs.poll(ctx) {
             self.on_dialog(ctx, a);
+        }
+        if let Some(note) = self.dialogs.take_notice() {
+            self.bottom.log(note);
         }
     }
 
