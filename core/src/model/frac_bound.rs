@@ -97,6 +97,8 @@ impl PNode {
             PNode::Union(n) | PNode::Intersection(n) => {
                 n.blend || n.children.iter().any(|c| c.varying_fractions())
             }
+            // Which child holds p changes, as in a union.
+            PNode::Sum { children, .. } => children.iter().any(|c| c.varying_fractions()),
             PNode::Difference { a, .. } => a.varying_fractions(),
             PNode::FGrade(g) => {
                 g.exprs.iter().any(|e| e.constant().is_none()) || g.child.varying_fractions()
@@ -118,6 +120,7 @@ impl PNode {
             PNode::Union(n) | PNode::Intersection(n) => {
                 n.children.iter().any(|c| c.averages_fractions())
             }
+            PNode::Sum { children, .. } => children.iter().any(|c| c.averages_fractions()),
             PNode::Difference { a, .. } => a.averages_fractions(),
             PNode::FGrade(g) => g.child.averages_fractions(),
             PNode::Blend { .. } => true,

@@ -53,6 +53,11 @@ impl PNode {
                 around,
                 child,
             } => child.frac(*to_local * (p - *around) + *around, out),
+            PNode::Mirror {
+                point,
+                normal,
+                child,
+            } => child.frac(super::pnode::reflect(p, *point, *normal), out),
             PNode::Scale { inv, child, .. } => child.frac(p * *inv, out),
             PNode::Union(u) => u.union_frac(p, out),
             PNode::Intersection(n) => {
@@ -68,6 +73,12 @@ impl PNode {
             PNode::FGrade(g) => g.frac(p, out),
             PNode::Blend { r, child } => blend_frac(child, *r, p, out),
             PNode::SimField(s) => s.frac(p, out),
+            // pyvcad: the first child containing p, whatever the sum.
+            PNode::Sum { children, .. } => {
+                if let Some(c) = children.iter().find(|c| c.contains(p)) {
+                    c.frac(p, out);
+                }
+            }
             _ => {} // leaves: above
         }
     }
@@ -82,7 +93,8 @@ impl PNode {
             | PNode::Scale { child, .. }
             | PNode::Offset { child, .. }
             | PNode::Shell { child, .. }
-            | PNode::Tile { child, .. } => Some(child),
+            | PNode::Tile { child, .. }
+            | PNode::Mirror { child, .. } => Some(child),
             _ => None,
         }
     }
@@ -99,7 +111,8 @@ impl PNode {
             | PNode::Function { m, .. }
             | PNode::Tpms { m, .. }
             | PNode::Lattice { m, .. }
-            | PNode::Mesh { m, .. } => Some(*m),
+            | PNode::Mesh { m, .. }
+            | PNode::Shape { m, .. } => Some(*m),
             _ => None,
         }
     }

@@ -13,6 +13,7 @@ mod fractions;
 mod pnode;
 mod prepare;
 pub mod sdf;
+mod shapes;
 mod strut_grid;
 mod tpms;
 mod union_index;
