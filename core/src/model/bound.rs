@@ -158,9 +158,11 @@ impl PNode {
             | PNode::Prism { .. }
             | PNode::Lattice { .. }
             | PNode::Shape { .. } => lipschitz(self, b),
-            PNode::Mirror { point, normal, child } => {
-                child.interval(&b.transformed(&reflection(*normal), *point))
-            }
+            PNode::Mirror {
+                point,
+                normal,
+                child,
+            } => child.interval(&b.transformed(&reflection(*normal), *point)),
             PNode::Sum { iso, children } => {
                 let mut i = Interval::point(*iso);
                 for c in children {

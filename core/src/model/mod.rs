@@ -34,6 +34,17 @@ use pnode::PNode;
 
 pub use prepare::rotation;
 
+/// Check a `PolygonRevolve` half-profile as prepare will (for errors at
+/// the script call): the reason it is refused, if it is.
+pub fn check_revolve(
+    vertices: &[DVec3],
+    axis_start: DVec3,
+    axis_end: DVec3,
+    sweep_degrees: f64,
+) -> Result<(), String> {
+    shapes::Revolve::build(vertices, axis_start, axis_end, sweep_degrees).map(|_| ())
+}
+
 /// Most distinct materials one design may use (fractions live on the stack).
 pub const MAX_MATERIALS: usize = 64;
 

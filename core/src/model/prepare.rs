@@ -8,8 +8,8 @@ use std::sync::Arc;
 
 use glam::{DMat3, DVec2, DVec3};
 
-use super::shapes::{Beam, Cone, Revolve, Shape};
 use super::pnode::{Capsule, Grade, LineCapsule, NAry, PNode, Prism, SimGrade, Slot};
+use super::shapes::{Beam, Cone, Revolve, Shape};
 use super::strut_grid::StrutGrid;
 use super::tpms::Tpms;
 use super::union_index::UnionIndex;
@@ -406,14 +406,29 @@ impl Preparer {
     fn build_shape(&mut self, n: &Node, kind: &NodeKind) -> Result<(PNode, Aabb), PrepareError> {
         let shape = |s: Shape, m: MaterialId, this: &Self| {
             let b = s.bbox();
-            (PNode::Shape { s: Box::new(s), m: this.slot(m) }, b)
+            (
+                PNode::Shape {
+                    s: Box::new(s),
+                    m: this.slot(m),
+                },
+                b,
+            )
         };
         Ok(match kind {
-            NodeKind::Cone { angle, height, material } => {
-                shape(Shape::Cone(Cone::new(*angle, *height)), *material, self)
-            }
-            NodeKind::Torus { major, minor, material } => shape(
-                Shape::Torus { major: *major, minor: *minor },
+            NodeKind::Cone {
+                angle,
+                height,
+                material,
+            } => shape(Shape::Cone(Cone::new(*angle, *height)), *material, self),
+            NodeKind::Torus {
+                major,
+                minor,
+                material,
+            } => shape(
+                Shape::Torus {
+                    major: *major,
+                    minor: *minor,
+                },
                 *material,
                 self,
             ),
@@ -441,25 +456,45 @@ impl Preparer {
                 if radius_a == radius_b && rounded(cap_a) && rounded(cap_b) {
                     // Equal radii with round ends: a capsule, exactly.
                     let s = Capsule::new(*a, *b, *radius_a);
-                    (PNode::Strut { s, m: self.slot(*material) }, s.bbox())
+                    (
+                        PNode::Strut {
+                            s,
+                            m: self.slot(*material),
+                        },
+                        s.bbox(),
+                    )
                 } else if a == b {
-                    return Err(err(n, "start and end are the same point; a tapered strut needs a length"));
+                    return Err(err(
+                        n,
+                        "start and end are the same point; a tapered strut needs a length",
+                    ));
                 } else {
                     let beam = Beam::new(*a, *b, *radius_a, *radius_b, *cap_a, *cap_b);
                     shape(Shape::Beam(beam), *material, self)
                 }
             }
-            NodeKind::Mirror { point, normal, child } => {
+            NodeKind::Mirror {
+                point,
+                normal,
+                child,
+            } => {
                 let (c, b) = self.child(n, child)?;
                 let m = super::bound::reflection(*normal);
                 (
-                    PNode::Mirror { point: *point, normal: *normal, child: c },
+                    PNode::Mirror {
+                        point: *point,
+                        normal: *normal,
+                        child: c,
+                    },
                     b.transformed(&m, *point),
                 )
             }
             NodeKind::Sum { iso, children } => {
                 if children.is_empty() {
-                    return Err(err(n, "has no children; add some with add_child or pass a list"));
+                    return Err(err(
+                        n,
+                        "has no children; add some with add_child or pass a list",
+                    ));
                 }
                 let mut nodes = Vec::with_capacity(children.len());
                 let mut bbox = Aabb::EMPTY;
@@ -470,7 +505,13 @@ impl Preparer {
                 }
                 // Outside every child's box each dᵢ > 0, so Σdᵢ + iso ≤ 0
                 // needs every dᵢ ≤ −iso: within −iso of every box.
-                (PNode::Sum { iso: *iso, children: nodes }, bbox.expand((-iso).max(0.0)))
+                (
+                    PNode::Sum {
+                        iso: *iso,
+                        children: nodes,
+                    },
+                    bbox.expand((-iso).max(0.0)),
+                )
             }
             // Identity never gets here (`prepare` answers it with its
             // child); the other kinds are built in `build`.

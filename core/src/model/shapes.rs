@@ -241,10 +241,7 @@ impl Revolve {
         sweep_degrees: f64,
     ) -> Result<Revolve, String> {
         if vertices.len() < 3 {
-            return Err(format!(
-                "needs at least 3 vertices, got {}",
-                vertices.len()
-            ));
+            return Err(format!("needs at least 3 vertices, got {}", vertices.len()));
         }
         if !(sweep_degrees > 0.0 && sweep_degrees <= 360.0) {
             return Err(format!(

@@ -14,6 +14,7 @@ mod file_cache;
 mod files_api;
 mod leaves_api;
 mod nodes_api;
+mod shapes_api;
 mod values;
 
 use std::collections::HashMap;
@@ -408,6 +409,7 @@ fn build_engine(ctx: &RunContext, opts: &ScriptOptions) -> Engine {
     register_lattice_types(&mut engine);
     leaves_api::register_leaves(&mut engine);
     nodes_api::register_composites(&mut engine);
+    shapes_api::register_shapes(&mut engine);
     nodes_api::register_methods(&mut engine);
     files_api::register(&mut engine, ctx);
     bulk::register(&mut engine, opts.max_heap);
