@@ -65,7 +65,9 @@ impl PNode {
             PNode::Union(u) if !u.blend && u.smooth <= 0.0 => u.union_bounds(b, out),
             PNode::Union(u) if !u.blend => u.smooth_union_bounds(b, out),
             PNode::Blend { r, child } => {
-                let grown = Aabb::new(b.min - DVec3::splat(*r), b.max + DVec3::splat(*r));
+                // The stencil reaches r per axis (r·(1 + 1e-12): its offsets are rounded).
+                let reach = DVec3::splat(*r * (1.0 + 1e-12));
+                let grown = Aabb::new(b.min - reach, b.max + reach);
                 if !child.frac_bounds(&grown, out) {
                     return false;
                 }
