@@ -79,6 +79,14 @@ fn check_exact(m: &Model, brute: &Brute, seed: u64) {
     );
 }
 
+/// A design whose distance is exact: brute force and intervals.
+fn check_shape(src: &str, brute: &Brute, seed: u64) -> Model {
+    let m = model(src);
+    check_exact(&m, brute, seed);
+    check_intervals(&m, seed + 1);
+    m
+}
+
 /// Every sample of a box lies in the model's interval over that box.
 fn check_intervals(m: &Model, seed: u64) {
     let outer = m.bbox().expand(2.0);
@@ -93,6 +101,15 @@ fn check_intervals(m: &Model, seed: u64) {
                 i.lo <= d && d <= i.hi,
                 "{d} at {p} outside {i:?} over {b:?}"
             );
+        }
+    }
+}
+
+/// `f(u, t)` for `nu` angles u in [0, 2π) and `nt + 1` values t in [0, 1].
+fn around(nu: usize, nt: usize, mut f: impl FnMut(f64, f64)) {
+    for i in 0..nu {
+        for k in 0..=nt {
+            f(TAU * i as f64 / nu as f64, k as f64 / nt as f64);
         }
     }
 }
@@ -119,9 +136,7 @@ fn torus_brute(big: f64, small: f64) -> Brute {
 
 #[test]
 fn torus_matches_brute_force_and_bounds() {
-    let m = model("Torus(4.0, 1.5)");
-    check_exact(&m, &torus_brute(4.0, 1.5), 1);
-    check_intervals(&m, 2);
+    check_shape("Torus(4.0, 1.5)", &torus_brute(4.0, 1.5), 1);
     let d = model("Torus()");
     // pyvcad's default torus: major 2, minor 1; the tube centre is 1 deep.
     assert!((d.distance(DVec3::new(2.0, 0.0, 0.0)) + 1.0).abs() < 1e-12);
@@ -131,15 +146,11 @@ fn cone_brute(angle: f64, h: f64) -> Brute {
     let r = h * angle.tan();
     let mut surface = Vec::new();
     let (nu, nt) = (720, 240);
-    for i in 0..nu {
-        let u = TAU * i as f64 / nu as f64;
-        for k in 0..=nt {
-            let t = k as f64 / nt as f64;
-            // Side (apex to rim) and base disc.
-            surface.push(DVec3::new(r * t * u.cos(), r * t * u.sin(), -h * t));
-            surface.push(DVec3::new(r * t * u.cos(), r * t * u.sin(), -h));
-        }
-    }
+    around(nu, nt, |u, t| {
+        // Side (apex to rim) and base disc.
+        surface.push(DVec3::new(r * t * u.cos(), r * t * u.sin(), -h * t));
+        surface.push(DVec3::new(r * t * u.cos(), r * t * u.sin(), -h));
+    });
     let tan = angle.tan();
     Brute {
         surface,
@@ -153,9 +164,7 @@ fn cone_brute(angle: f64, h: f64) -> Brute {
 
 #[test]
 fn cone_matches_brute_force_and_bounds() {
-    let m = model("Cone(0.5, 6.0)");
-    check_exact(&m, &cone_brute(0.5, 6.0), 3);
-    check_intervals(&m, 4);
+    check_shape("Cone(0.5, 6.0)", &cone_brute(0.5, 6.0), 3);
     let e = script_error("Cone(30, 5)");
     assert!(e.contains("radians") && e.contains("nodes.rhai:1:"), "{e}");
 }
@@ -237,16 +246,12 @@ fn revolve_script(sweep: f64) -> String {
 
 #[test]
 fn full_revolve_matches_brute_force_and_bounds() {
-    let m = model(&revolve_script(360.0));
-    check_exact(&m, &revolve_brute(TAU), 5);
-    check_intervals(&m, 6);
+    check_shape(&revolve_script(360.0), &revolve_brute(TAU), 5);
 }
 
 #[test]
 fn partial_revolve_matches_brute_force_and_bounds() {
-    let m = model(&revolve_script(270.0));
-    check_exact(&m, &revolve_brute(1.5 * PI), 7);
-    check_intervals(&m, 8);
+    let m = check_shape(&revolve_script(270.0), &revolve_brute(1.5 * PI), 7);
     // The cut-away quarter (x > 0, y < 0) is empty; the opposite one full.
     assert!(m.distance(DVec3::new(4.0, -4.0, 0.0)) > 0.0);
     assert!(m.distance(DVec3::new(-4.0, 4.0, 0.0)) < 0.0);

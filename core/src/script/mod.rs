@@ -560,18 +560,17 @@ fn register_materials(engine: &mut Engine, ctx: &RunContext) {
 }
 
 fn register_lattice_types(engine: &mut Engine) {
-    engine.register_type_with_name::<LatticeType>("LatticeType");
-    let mut module = rhai::Module::new();
-    for (name, t) in [
-        ("BodyCenteredCubic", LatticeType::BodyCenteredCubic),
-        ("FaceCenteredCubic", LatticeType::FaceCenteredCubic),
-        ("Cubic", LatticeType::Cubic),
-        ("KelvinCell", LatticeType::KelvinCell),
-        ("Octet", LatticeType::Octet),
-    ] {
-        module.set_var(name, t);
-    }
-    engine.register_static_module("LatticeType", module.into());
+    shapes_api::register_enum(
+        engine,
+        "LatticeType",
+        [
+            ("BodyCenteredCubic", LatticeType::BodyCenteredCubic),
+            ("FaceCenteredCubic", LatticeType::FaceCenteredCubic),
+            ("Cubic", LatticeType::Cubic),
+            ("KelvinCell", LatticeType::KelvinCell),
+            ("Octet", LatticeType::Octet),
+        ],
+    );
 }
 
 #[cfg(test)]

@@ -141,6 +141,20 @@ fn register_revolve(engine: &mut Engine) {
     );
 }
 
+/// A script type named `name` whose values are `name::Variant`.
+pub(super) fn register_enum<T: Clone + Send + Sync + 'static, const N: usize>(
+    engine: &mut Engine,
+    name: &str,
+    values: [(&str, T); N],
+) {
+    engine.register_type_with_name::<T>(name);
+    let mut module = rhai::Module::new();
+    for (variant, v) in values {
+        module.set_var(variant, v);
+    }
+    engine.register_static_module(name, module.into());
+}
+
 fn cap_mode(v: &Dynamic, what: &str, pos: Position) -> RResult<CapMode> {
     v.clone().try_cast::<CapMode>().map_or_else(
         || {
@@ -160,16 +174,15 @@ fn cap_mode(v: &Dynamic, what: &str, pos: Position) -> RResult<CapMode> {
 /// pyvcad 3's tapered form. pyvcad 2's `Strut(start, end, r, m)` keeps its
 /// meaning: a fourth argument that is an integer is the material.
 fn register_tapered_strut(engine: &mut Engine) {
-    engine.register_type_with_name::<CapMode>("CapMode");
-    let mut module = rhai::Module::new();
-    for (name, mode) in [
-        ("Sphere", CapMode::Sphere),
-        ("HemiSphere", CapMode::HemiSphere),
-        ("Butt", CapMode::Butt),
-    ] {
-        module.set_var(name, mode);
-    }
-    engine.register_static_module("CapMode", module.into());
+    register_enum(
+        engine,
+        "CapMode",
+        [
+            ("Sphere", CapMode::Sphere),
+            ("HemiSphere", CapMode::HemiSphere),
+            ("Butt", CapMode::Butt),
+        ],
+    );
 
     engine.register_fn(
         "Strut",
