@@ -110,7 +110,7 @@ impl PNode {
     }
 
     /// True when some part's fractions are averages over many samples of
-    /// a child (a `Blend`: 125 evaluations a point).
+    /// a child (a `Blend`: 125 or 216 evaluations a point).
     pub fn averages_fractions(&self) -> bool {
         if self.leaf_material().is_some() {
             return false;
