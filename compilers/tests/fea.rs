@@ -202,7 +202,7 @@ fn bricks_of_the_graded_bar_run_in_calculix() {
     assert_eq!(counts.len(), 2);
     // x > 2.5 is pure VeroCyan: 5 of 15 columns; x < −2.5 pure Agilus30.
     assert!(
-        counts["VeroCyan"] > 250 && counts["Agilus30"] > 250,
+        counts["VeroCyan"] > 250 && counts["Agilus30Clr"] > 250,
         "{counts:?}"
     );
     let (nodes, elems) = check_deck(&dir.join("model.inp"));

@@ -41,6 +41,10 @@ pub struct Material {
     /// Density in g/cm³.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub density_g_cm3: Option<f64>,
+    /// Other names scripts may use for this material (names of an older
+    /// table), resolved to this entry's id.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub aliases: Vec<String>,
 }
 
 impl Material {
@@ -111,7 +115,10 @@ pub struct MaterialTable {
 
 /// pyvcad's default table (`configs/default.json`): red, green, blue, ...
 pub const DEFAULT_JSON: &str = include_str!("../../assets/materials/default.json");
-/// A Stratasys J750-class table (Vero colours, VeroClear, Agilus30) with elastic properties.
+/// pyvcad's J750 table (`configs/j750.json`: 33 materials, ids and colours
+/// as pyvcad 2.3.4 has them), with elastic properties for the Vero and
+/// Agilus30 families and the names of our older table as aliases
+/// (VeroMagenta, VeroWhite, Agilus30).
 pub const J750_JSON: &str = include_str!("../../assets/materials/j750.json");
 
 impl MaterialTable {
@@ -130,6 +137,7 @@ impl MaterialTable {
             youngs_modulus_mpa: None,
             poisson_ratio: None,
             density_g_cm3: None,
+            aliases: Vec::new(),
         }];
         materials.extend(file.materials.into_iter().filter(|m| m.name != "void"));
         if materials.len() > 256 {
@@ -140,7 +148,12 @@ impl MaterialTable {
         }
         let mut by_name = HashMap::new();
         for (id, m) in materials.iter().enumerate() {
-            // Later entries win, as in pyvcad.
+            for alias in &m.aliases {
+                by_name.insert(alias.clone(), id as MaterialId);
+            }
+        }
+        for (id, m) in materials.iter().enumerate() {
+            // Later entries win, as in pyvcad; a real name beats an alias.
             by_name.insert(m.name.clone(), id as MaterialId);
         }
         Ok(Self {
@@ -229,12 +242,8 @@ impl MaterialTable {
             .materials
             .iter()
             .skip(1)
-            .map(|m| {
-                (
-                    edit_distance(&wanted, &m.name.to_lowercase()),
-                    m.name.as_str(),
-                )
-            })
+            .flat_map(|m| std::iter::once(&m.name).chain(&m.aliases))
+            .map(|name| (edit_distance(&wanted, &name.to_lowercase()), name.as_str()))
             .collect();
         scored.sort();
         scored.dedup_by(|a, b| a.1 == b.1);
@@ -307,6 +316,65 @@ mod tests {
         assert_eq!(t.len(), 3);
         assert_eq!(t.id("a").unwrap(), 2);
         assert_eq!(t.id("void").unwrap(), 0);
+    }
+
+    /// pyvcad 2.3.4's `j750_materials`: `name(i)` for i = 1..=33 and a few
+    /// `color(i)` values.
+    #[test]
+    fn j750_is_pyvcads_table() {
+        let t = MaterialTable::j750();
+        let names = [
+            "VeroCyan",
+            "VeroMgnt",
+            "VeroYellow",
+            "VeroBlack",
+            "VeroPureWht",
+            "VeroClear",
+            "VeroBlue",
+            "VeroGrey",
+            "Agilus30Cyn",
+            "Agilus30Mgn",
+            "Agilus30Ylw",
+            "Agilus30Blk",
+            "Agilus30Wht",
+            "Agilus30Clr",
+            "AirVoid",
+            "M.Cleanser",
+            "FullCure705",
+            "FullCure720",
+            "SUP706",
+            "Tango+",
+            "TangoBlack+",
+            "VeroCY-V",
+            "VeroMGT-V",
+            "VeroYL-V",
+            "VUltraBlack",
+            "VUltraWhite",
+            "VerUltraClr",
+            "VeroFlexCY",
+            "VeroFlexMGT",
+            "VeroFlexYL",
+            "VeroFlexBK",
+            "VeroFlexWT",
+            "VeroFlexCLR",
+        ];
+        assert_eq!(t.len(), 34);
+        for (i, n) in names.iter().enumerate() {
+            assert_eq!(t.name(i as MaterialId + 1), *n);
+            assert_eq!(t.id(n).unwrap(), i as MaterialId + 1);
+        }
+        assert_eq!(t.get(1).unwrap().rgba(), [0, 255, 255, 255]);
+        assert_eq!(t.get(14).unwrap().rgba(), [244, 250, 252, 50]);
+        assert_eq!(t.get(16).unwrap().rgba(), [64, 160, 255, 220]);
+        // Our older names resolve to pyvcad's entries.
+        assert_eq!(t.id("VeroMagenta").unwrap(), 2);
+        assert_eq!(t.id("VeroWhite").unwrap(), 5);
+        assert_eq!(t.id("Agilus30").unwrap(), 14);
+        let e = t.id("VeroMagneta").unwrap_err().to_string();
+        assert!(
+            e.contains("\"VeroMagenta\"") || e.contains("\"VeroMgnt\""),
+            "{e}"
+        );
     }
 
     #[test]

@@ -55,6 +55,18 @@ pub enum TpmsType {
     Diamond,
 }
 
+/// How a tapered strut's end is closed (pyvcad 3's `CapMode`, the 3MF
+/// beam-lattice extension's `ST_CapMode`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum CapMode {
+    /// A full sphere of the end's radius.
+    Sphere,
+    /// The outward half of that sphere.
+    HemiSphere,
+    /// Flat: the frustum ends in its disc.
+    Butt,
+}
+
 /// A handle to a node of the design tree.
 #[derive(Clone, Debug)]
 pub struct Node {
@@ -180,6 +192,51 @@ pub enum NodeKind {
         exprs: Vec<Arc<Expr>>,
         materials: Vec<MaterialId>,
     },
+    /// Cone with its apex at the origin opening down −Z: aperture half-angle
+    /// `angle` (radians), base disc at z = −height.
+    Cone {
+        angle: f64,
+        height: f64,
+        material: MaterialId,
+    },
+    /// Torus about the Z axis at the origin: ring radius `major`, tube
+    /// radius `minor`.
+    Torus {
+        major: f64,
+        minor: f64,
+        material: MaterialId,
+    },
+    /// A planar half-profile revolved about the axis from `axis_start` to
+    /// `axis_end` by `sweep_degrees` (right-hand rule about that direction).
+    PolygonRevolve {
+        vertices: Vec<DVec3>,
+        axis_start: DVec3,
+        axis_end: DVec3,
+        sweep_degrees: f64,
+        material: MaterialId,
+    },
+    /// Strut with a radius and a cap at each end (a frustum between `a` and
+    /// `b`); pyvcad's name is `Strut` too.
+    TaperedStrut {
+        a: DVec3,
+        b: DVec3,
+        radius_a: f64,
+        radius_b: f64,
+        cap_a: CapMode,
+        cap_b: CapMode,
+        material: MaterialId,
+    },
+    /// Reflection of the child across the plane through `point` with unit
+    /// `normal`.
+    Mirror {
+        point: DVec3,
+        normal: DVec3,
+        child: Option<Node>,
+    },
+    /// The child unchanged: a frame of its own for the expressions above it.
+    Identity { child: Option<Node> },
+    /// `Σ dᵢ + iso`; fractions of the first child containing the point.
+    Sum { iso: f64, children: Vec<Node> },
 }
 
 impl NodeKind {
@@ -207,6 +264,13 @@ impl NodeKind {
             NodeKind::Blend { .. } => "Blend",
             NodeKind::Mesh { .. } => "Mesh",
             NodeKind::SimulationField { .. } => "SimulationField",
+            NodeKind::Cone { .. } => "Cone",
+            NodeKind::Torus { .. } => "Torus",
+            NodeKind::PolygonRevolve { .. } => "PolygonRevolve",
+            NodeKind::TaperedStrut { .. } => "Strut",
+            NodeKind::Mirror { .. } => "Mirror",
+            NodeKind::Identity { .. } => "Identity",
+            NodeKind::Sum { .. } => "Sum",
         }
     }
 
@@ -222,7 +286,11 @@ impl NodeKind {
             | NodeKind::Function { material, .. }
             | NodeKind::Tpms { material, .. }
             | NodeKind::GraphLattice { material, .. }
-            | NodeKind::Mesh { material, .. } => std::slice::from_ref(material),
+            | NodeKind::Mesh { material, .. }
+            | NodeKind::Cone { material, .. }
+            | NodeKind::Torus { material, .. }
+            | NodeKind::PolygonRevolve { material, .. }
+            | NodeKind::TaperedStrut { material, .. } => std::slice::from_ref(material),
             NodeKind::FGrade { materials, .. } | NodeKind::SimulationField { materials, .. } => {
                 materials
             }
@@ -240,10 +308,12 @@ impl NodeKind {
             | NodeKind::Shell { child, .. }
             | NodeKind::Tile { child, .. }
             | NodeKind::FGrade { child, .. }
-            | NodeKind::Blend { child, .. } => child.iter().collect(),
-            NodeKind::Union { children, .. } | NodeKind::Intersection { children, .. } => {
-                children.iter().collect()
-            }
+            | NodeKind::Blend { child, .. }
+            | NodeKind::Mirror { child, .. }
+            | NodeKind::Identity { child } => child.iter().collect(),
+            NodeKind::Union { children, .. }
+            | NodeKind::Intersection { children, .. }
+            | NodeKind::Sum { children, .. } => children.iter().collect(),
             NodeKind::Difference { left, right, .. } => left.iter().chain(right.iter()).collect(),
             _ => Vec::new(),
         }
@@ -259,7 +329,9 @@ impl NodeKind {
             | NodeKind::Shell { child, .. }
             | NodeKind::Tile { child, .. }
             | NodeKind::FGrade { child, .. }
-            | NodeKind::Blend { child, .. } => Some(child),
+            | NodeKind::Blend { child, .. }
+            | NodeKind::Mirror { child, .. }
+            | NodeKind::Identity { child } => Some(child),
             _ => None,
         }
     }

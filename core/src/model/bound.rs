@@ -95,6 +95,11 @@ fn tile_box(b: &Aabb, cell: DVec3) -> Aabb {
     }
 }
 
+/// The reflection `I − 2nnᵀ` across a plane with unit normal `n`.
+pub fn reflection(n: DVec3) -> glam::DMat3 {
+    glam::DMat3::IDENTITY - 2.0 * glam::DMat3::from_cols(n * n.x, n * n.y, n * n.z)
+}
+
 /// Intervals of the coordinate slots over `b` (x y z rho phic r theta phis d).
 pub fn coord_intervals(b: &Aabb, d: Interval) -> [Interval; COORD_SLOTS] {
     let x = Interval::new(b.min.x, b.max.x);
@@ -123,14 +128,18 @@ impl PNode {
             | PNode::Prism { .. }
             | PNode::Lattice { .. }
             | PNode::Mesh { .. }
-            | PNode::SimField(_) => true,
+            | PNode::SimField(_)
+            | PNode::Shape { .. } => true,
+            // A sum of n distances changes up to n times as fast.
+            PNode::Sum { children, .. } => children.len() == 1 && children[0].is_lipschitz(),
             PNode::Function { .. } | PNode::Tpms { .. } | PNode::Tile { .. } => false,
             PNode::Translate { child, .. }
             | PNode::Rotate { child, .. }
             | PNode::Scale { child, .. }
             | PNode::Offset { child, .. }
             | PNode::Shell { child, .. }
-            | PNode::Blend { child, .. } => child.is_lipschitz(),
+            | PNode::Blend { child, .. }
+            | PNode::Mirror { child, .. } => child.is_lipschitz(),
             PNode::FGrade(g) => g.child.is_lipschitz(),
             PNode::Union(n) | PNode::Intersection(n) => n.lipschitz,
             PNode::Difference { a, b, smooth } => {
@@ -145,7 +154,23 @@ impl PNode {
             PNode::Sphere { .. } | PNode::Box { .. } | PNode::Cylinder { .. } => {
                 primitive(self, b).unwrap_or_else(|| lipschitz(self, b))
             }
-            PNode::Strut { .. } | PNode::Prism { .. } | PNode::Lattice { .. } => lipschitz(self, b),
+            PNode::Strut { .. }
+            | PNode::Prism { .. }
+            | PNode::Lattice { .. }
+            | PNode::Shape { .. } => lipschitz(self, b),
+            PNode::Mirror {
+                point,
+                normal,
+                child,
+            } => child.interval(&b.transformed(&reflection(*normal), *point)),
+            PNode::Sum { iso, children } => {
+                let mut i = Interval::point(*iso);
+                for c in children {
+                    let ci = c.interval(b);
+                    i = Interval::new(i.lo + ci.lo, i.hi + ci.hi);
+                }
+                i
+            }
             PNode::Mesh { mesh, .. } => mesh_interval(mesh, b),
             PNode::SimField(g) => mesh_interval(g.field.boundary_mesh(), b),
             PNode::Function {
@@ -243,7 +268,7 @@ impl PNode {
                     }
                 }),
             },
-            PNode::Blend { .. } => false,
+            PNode::Blend { .. } | PNode::Sum { .. } => false,
             _ => true, // leaves: above
         }
     }
@@ -258,6 +283,7 @@ impl PNode {
                 to_local, around, ..
             } => b.transformed(to_local, *around),
             PNode::Scale { inv, .. } => b.scaled(*inv),
+            PNode::Mirror { point, normal, .. } => b.transformed(&reflection(*normal), *point),
             PNode::Tile { cell, .. } => tile_box(b, *cell),
             _ => *b, // offset, shell: the same points
         };

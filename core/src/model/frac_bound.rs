@@ -65,7 +65,9 @@ impl PNode {
             PNode::Union(u) if !u.blend && u.smooth <= 0.0 => u.union_bounds(b, out),
             PNode::Union(u) if !u.blend => u.smooth_union_bounds(b, out),
             PNode::Blend { r, child } => {
-                let grown = Aabb::new(b.min - DVec3::splat(*r), b.max + DVec3::splat(*r));
+                // The stencil reaches r per axis (r·(1 + 1e-12): its offsets are rounded).
+                let reach = DVec3::splat(*r * (1.0 + 1e-12));
+                let grown = Aabb::new(b.min - reach, b.max + reach);
                 if !child.frac_bounds(&grown, out) {
                     return false;
                 }
@@ -97,6 +99,8 @@ impl PNode {
             PNode::Union(n) | PNode::Intersection(n) => {
                 n.blend || n.children.iter().any(|c| c.varying_fractions())
             }
+            // Which child holds p changes, as in a union.
+            PNode::Sum { children, .. } => children.iter().any(|c| c.varying_fractions()),
             PNode::Difference { a, .. } => a.varying_fractions(),
             PNode::FGrade(g) => {
                 g.exprs.iter().any(|e| e.constant().is_none()) || g.child.varying_fractions()
@@ -106,7 +110,7 @@ impl PNode {
     }
 
     /// True when some part's fractions are averages over many samples of
-    /// a child (a `Blend`: 125 evaluations a point).
+    /// a child (a `Blend`: 125 or 216 evaluations a point).
     pub fn averages_fractions(&self) -> bool {
         if self.leaf_material().is_some() {
             return false;
@@ -118,6 +122,7 @@ impl PNode {
             PNode::Union(n) | PNode::Intersection(n) => {
                 n.children.iter().any(|c| c.averages_fractions())
             }
+            PNode::Sum { children, .. } => children.iter().any(|c| c.averages_fractions()),
             PNode::Difference { a, .. } => a.averages_fractions(),
             PNode::FGrade(g) => g.child.averages_fractions(),
             PNode::Blend { .. } => true,

@@ -53,6 +53,11 @@ impl PNode {
                 around,
                 child,
             } => child.frac(*to_local * (p - *around) + *around, out),
+            PNode::Mirror {
+                point,
+                normal,
+                child,
+            } => child.frac(super::pnode::reflect(p, *point, *normal), out),
             PNode::Scale { inv, child, .. } => child.frac(p * *inv, out),
             PNode::Union(u) => u.union_frac(p, out),
             PNode::Intersection(n) => {
@@ -68,6 +73,12 @@ impl PNode {
             PNode::FGrade(g) => g.frac(p, out),
             PNode::Blend { r, child } => blend_frac(child, *r, p, out),
             PNode::SimField(s) => s.frac(p, out),
+            // pyvcad: the first child containing p, whatever the sum.
+            PNode::Sum { children, .. } => {
+                if let Some(c) = children.iter().find(|c| c.contains(p)) {
+                    c.frac(p, out);
+                }
+            }
             _ => {} // leaves: above
         }
     }
@@ -82,7 +93,8 @@ impl PNode {
             | PNode::Scale { child, .. }
             | PNode::Offset { child, .. }
             | PNode::Shell { child, .. }
-            | PNode::Tile { child, .. } => Some(child),
+            | PNode::Tile { child, .. }
+            | PNode::Mirror { child, .. } => Some(child),
             _ => None,
         }
     }
@@ -99,7 +111,8 @@ impl PNode {
             | PNode::Function { m, .. }
             | PNode::Tpms { m, .. }
             | PNode::Lattice { m, .. }
-            | PNode::Mesh { m, .. } => Some(*m),
+            | PNode::Mesh { m, .. }
+            | PNode::Shape { m, .. } => Some(*m),
             _ => None,
         }
     }
@@ -505,19 +518,39 @@ fn normalised<const N: usize>(set: &ExprSet, mats: &[Slot], slots: &[f64], out: 
     }
 }
 
-/// pyvcad's Blend: the average of the child's fractions over the 5×5×5
-/// stencil `{−r, −0.6r, −0.2r, 0.2r, 0.6r}³` around `p`, over the samples
-/// that have material. (pyvcad's stencil is asymmetric; we keep it for
-/// compatibility and document it in docs/PYVCAD.md.)
+/// pyvcad 2.3.4's Blend stencil along one axis: offsets `−r + i·s` for
+/// `i = 0 ..= ⌊2r / s⌋` with the step `s = 0.4·r` held in single precision.
+/// Measured on pyvcad 2.3.4 (a red/blue step scanned in x at 200 radii
+/// from 0.05 to 10; tests/blend.rs): 6 offsets {−r, −0.6r, −0.2r, 0.2r,
+/// 0.6r, r} where the rounded step is at or below 0.4·r, 5 (without +r,
+/// the asymmetric stencil older notes describe) where it rounds up.
+pub fn blend_offsets(r: f64) -> ([f64; 6], usize) {
+    let step = f64::from((0.4 * r) as f32);
+    let n = if step > 0.0 {
+        ((2.0 * r / step).floor() as usize + 1).min(6)
+    } else {
+        1
+    };
+    let mut o = [0.0; 6];
+    for (i, v) in o.iter_mut().enumerate().take(n) {
+        *v = -r + i as f64 * step;
+    }
+    (o, n)
+}
+
+/// pyvcad's Blend: the average of the child's fractions over the
+/// [`blend_offsets`] stencil (per axis, all combinations) around `p`, over
+/// the samples that have material.
 fn blend_frac(child: &PNode, r: f64, p: DVec3, out: &mut [f64]) {
-    const S: [f64; 5] = [-1.0, -0.6, -0.2, 0.2, 0.6];
+    let (s, n) = blend_offsets(r);
+    let s = &s[..n];
     let k = out.len();
     let mut tmp = [0.0; MAX_MATERIALS];
     let mut count = 0u32;
-    for dx in S {
-        for dy in S {
-            for dz in S {
-                let q = p + DVec3::new(dx, dy, dz) * r;
+    for &dx in s {
+        for &dy in s {
+            for &dz in s {
+                let q = p + DVec3::new(dx, dy, dz);
                 // One walk for the distance and the fractions (a union
                 // finds the child that holds q while taking the minimum).
                 tmp[..k].fill(0.0);

@@ -13,6 +13,7 @@ mod fractions;
 mod pnode;
 mod prepare;
 pub mod sdf;
+mod shapes;
 mod strut_grid;
 mod tpms;
 mod union_index;
@@ -32,6 +33,17 @@ use crate::node::Node;
 use pnode::PNode;
 
 pub use prepare::rotation;
+
+/// Check a `PolygonRevolve` half-profile as prepare will (for errors at
+/// the script call): the reason it is refused, if it is.
+pub fn check_revolve(
+    vertices: &[DVec3],
+    axis_start: DVec3,
+    axis_end: DVec3,
+    sweep_degrees: f64,
+) -> Result<(), String> {
+    shapes::Revolve::build(vertices, axis_start, axis_end, sweep_degrees).map(|_| ())
+}
 
 /// Most distinct materials one design may use (fractions live on the stack).
 pub const MAX_MATERIALS: usize = 64;

@@ -194,6 +194,22 @@ pub enum PNode {
         m: Slot,
     },
     SimField(Box<SimGrade>),
+    /// Cone, torus, revolve or tapered strut (see `shapes`).
+    Shape {
+        s: Box<super::shapes::Shape>,
+        m: Slot,
+    },
+    /// `child(p − 2n·(n·(p − point)))`: reflection across a plane.
+    Mirror {
+        point: DVec3,
+        normal: DVec3,
+        child: Arc<PNode>,
+    },
+    /// `Σ dᵢ + iso` (pyvcad's Sum).
+    Sum {
+        iso: f64,
+        children: Vec<Arc<PNode>>,
+    },
 }
 
 /// Union or intersection over many children.
@@ -346,6 +362,13 @@ impl PNode {
             PNode::Blend { child, .. } => child.dist(p),
             PNode::Mesh { mesh, .. } => mesh.signed_distance(p),
             PNode::SimField(s) => s.field.signed_distance(p),
+            PNode::Shape { s, .. } => s.dist(p),
+            PNode::Mirror {
+                point,
+                normal,
+                child,
+            } => child.dist(reflect(p, *point, *normal)),
+            PNode::Sum { iso, children } => children.iter().map(|c| c.dist(p)).sum::<f64>() + *iso,
         }
     }
 }
@@ -435,6 +458,12 @@ impl NAry {
             0.0
         }
     }
+}
+
+/// `p` reflected across the plane through `point` with unit `normal`.
+#[inline]
+pub fn reflect(p: DVec3, point: DVec3, normal: DVec3) -> DVec3 {
+    p - normal * (2.0 * normal.dot(p - point))
 }
 
 /// pyvcad's Tile mapping: `p − c·floor(p/c) − c/2` puts the child's origin

@@ -9,13 +9,14 @@ use std::sync::Arc;
 use glam::{DMat3, DVec2, DVec3};
 
 use super::pnode::{Capsule, Grade, LineCapsule, NAry, PNode, Prism, SimGrade, Slot};
+use super::shapes::{Beam, Cone, Revolve, Shape};
 use super::strut_grid::StrutGrid;
 use super::tpms::Tpms;
 use super::union_index::UnionIndex;
 use super::{MAX_MATERIALS, PrepareError};
 use crate::bounds::Aabb;
 use crate::material::MaterialId;
-use crate::node::{Node, NodeKind};
+use crate::node::{CapMode, Node, NodeKind};
 
 /// Unions with at least this many sharp children get a spatial index.
 const INDEX_MIN_CHILDREN: usize = 8;
@@ -76,6 +77,11 @@ impl Preparer {
     pub(super) fn prepare(&mut self, n: &Node) -> Result<(Arc<PNode>, Aabb), PrepareError> {
         if let Some(hit) = self.cache.get(&n.ptr()) {
             return Ok(hit.clone());
+        }
+        // Identity only marks a frame in the script's tree: it prepares to
+        // its child itself.
+        if let NodeKind::Identity { child } = n.kind() {
+            return self.child(n, child);
         }
         let out = self.build(n)?;
         let out = (Arc::new(out.0), out.1);
@@ -391,6 +397,129 @@ impl Preparer {
                     })),
                     bbox,
                 )
+            }
+            kind => self.build_shape(n, kind)?,
+        })
+    }
+
+    /// The nodes of `shapes` and the Mirror and Sum composites.
+    fn build_shape(&mut self, n: &Node, kind: &NodeKind) -> Result<(PNode, Aabb), PrepareError> {
+        let shape = |s: Shape, m: MaterialId, this: &Self| {
+            let b = s.bbox();
+            (
+                PNode::Shape {
+                    s: Box::new(s),
+                    m: this.slot(m),
+                },
+                b,
+            )
+        };
+        Ok(match kind {
+            NodeKind::Cone {
+                angle,
+                height,
+                material,
+            } => shape(Shape::Cone(Cone::new(*angle, *height)), *material, self),
+            NodeKind::Torus {
+                major,
+                minor,
+                material,
+            } => shape(
+                Shape::Torus {
+                    major: *major,
+                    minor: *minor,
+                },
+                *material,
+                self,
+            ),
+            NodeKind::PolygonRevolve {
+                vertices,
+                axis_start,
+                axis_end,
+                sweep_degrees,
+                material,
+            } => {
+                let r = Revolve::build(vertices, *axis_start, *axis_end, *sweep_degrees)
+                    .map_err(|m| err(n, &m))?;
+                shape(Shape::Revolve(Box::new(r)), *material, self)
+            }
+            NodeKind::TaperedStrut {
+                a,
+                b,
+                radius_a,
+                radius_b,
+                cap_a,
+                cap_b,
+                material,
+            } => {
+                let rounded = |c: &CapMode| *c != CapMode::Butt;
+                if radius_a == radius_b && rounded(cap_a) && rounded(cap_b) {
+                    // Equal radii with round ends: a capsule, exactly.
+                    let s = Capsule::new(*a, *b, *radius_a);
+                    (
+                        PNode::Strut {
+                            s,
+                            m: self.slot(*material),
+                        },
+                        s.bbox(),
+                    )
+                } else if a == b {
+                    return Err(err(
+                        n,
+                        "start and end are the same point; a tapered strut needs a length",
+                    ));
+                } else {
+                    let beam = Beam::new(*a, *b, *radius_a, *radius_b, *cap_a, *cap_b);
+                    shape(Shape::Beam(beam), *material, self)
+                }
+            }
+            NodeKind::Mirror {
+                point,
+                normal,
+                child,
+            } => {
+                let (c, b) = self.child(n, child)?;
+                let m = super::bound::reflection(*normal);
+                (
+                    PNode::Mirror {
+                        point: *point,
+                        normal: *normal,
+                        child: c,
+                    },
+                    b.transformed(&m, *point),
+                )
+            }
+            NodeKind::Sum { iso, children } => {
+                if children.is_empty() {
+                    return Err(err(
+                        n,
+                        "has no children; add some with add_child or pass a list",
+                    ));
+                }
+                let mut nodes = Vec::with_capacity(children.len());
+                let mut bbox = Aabb::EMPTY;
+                for c in children {
+                    let (p, b) = self.prepare(c)?;
+                    nodes.push(p);
+                    bbox = bbox.union(&b);
+                }
+                // Outside every child's box each dᵢ > 0, so Σdᵢ + iso ≤ 0
+                // needs every dᵢ ≤ −iso: within −iso of every box.
+                (
+                    PNode::Sum {
+                        iso: *iso,
+                        children: nodes,
+                    },
+                    bbox.expand((-iso).max(0.0)),
+                )
+            }
+            // Identity never gets here (`prepare` answers it with its
+            // child); the other kinds are built in `build`.
+            other => {
+                return Err(err(
+                    n,
+                    &format!("{} cannot be prepared here", other.type_name()),
+                ));
             }
         })
     }

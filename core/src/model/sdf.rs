@@ -74,16 +74,38 @@ pub fn smooth_max(a: f64, b: f64, k: f64) -> f64 {
 
 /// Exact signed distance to a simple 2D polygon (Quilez, "sdPolygon"):
 /// distance to the nearest edge, negative inside by the crossing-number test.
+#[inline]
 pub fn polygon_2d(p: DVec2, v: &[DVec2]) -> f64 {
+    polygon_2d_edges(p, v, None)
+}
+
+/// [`polygon_2d`] where only the edges with `surface[i]` true (edge `i`
+/// runs from vertex `i − 1` to vertex `i`) are surface: the inside test
+/// still uses every edge. A revolved profile's edges on the axis are inside
+/// the solid, not on its surface.
+#[inline]
+pub fn polygon_2d_surface(p: DVec2, v: &[DVec2], surface: &[bool]) -> f64 {
+    polygon_2d_edges(p, v, Some(surface))
+}
+
+#[inline(always)]
+fn polygon_2d_edges(p: DVec2, v: &[DVec2], surface: Option<&[bool]>) -> f64 {
     let n = v.len();
-    let mut d = (p - v[0]).length_squared();
+    // Every edge holds its end points, so starting from vertex 0 changes
+    // nothing when every edge counts.
+    let mut d = match surface {
+        None => (p - v[0]).length_squared(),
+        Some(_) => f64::INFINITY,
+    };
     let mut s = 1.0;
     let mut j = n - 1;
     for i in 0..n {
         let e = v[j] - v[i];
         let w = p - v[i];
-        let b = w - e * (w.dot(e) / e.length_squared()).clamp(0.0, 1.0);
-        d = d.min(b.length_squared());
+        if surface.is_none_or(|m| m[i]) {
+            let b = w - e * (w.dot(e) / e.length_squared()).clamp(0.0, 1.0);
+            d = d.min(b.length_squared());
+        }
         let c = [p.y >= v[i].y, p.y < v[j].y, e.x * w.y > e.y * w.x];
         if (c[0] && c[1] && c[2]) || (!c[0] && !c[1] && !c[2]) {
             s = -s;

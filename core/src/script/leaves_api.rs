@@ -157,10 +157,16 @@ pub fn register_leaves(engine: &mut Engine) {
         "Strut",
         move |c: Ctx, a: Dynamic, b: Dynamic, r: Dynamic| strut(&c, &a, &b, &r, None),
     );
+    // A fourth argument that is not an integer material id is pyvcad 3's
+    // end radius (a tapered strut, `shapes_api`).
     engine.register_fn(
         "Strut",
         move |c: Ctx, a: Dynamic, b: Dynamic, r: Dynamic, m: Dynamic| {
-            strut(&c, &a, &b, &r, Some(&m))
+            if m.is_int() {
+                strut(&c, &a, &b, &r, Some(&m))
+            } else {
+                super::shapes_api::tapered(&c, &[&a, &b, &r, &m])
+            }
         },
     );
 

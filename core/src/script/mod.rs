@@ -15,6 +15,7 @@ mod files_api;
 mod leaves_api;
 mod nodes_api;
 pub mod reference;
+mod shapes_api;
 mod values;
 
 use std::collections::HashMap;
@@ -428,6 +429,7 @@ fn build_engine(ctx: &RunContext, opts: &ScriptOptions) -> Engine {
     register_lattice_types(&mut engine);
     leaves_api::register_leaves(&mut engine);
     nodes_api::register_composites(&mut engine);
+    shapes_api::register_shapes(&mut engine);
     nodes_api::register_methods(&mut engine);
     files_api::register(&mut engine, ctx);
     bulk::register(&mut engine, opts.max_heap);
@@ -578,18 +580,17 @@ fn register_materials(engine: &mut Engine, ctx: &RunContext) {
 }
 
 fn register_lattice_types(engine: &mut Engine) {
-    engine.register_type_with_name::<LatticeType>("LatticeType");
-    let mut module = rhai::Module::new();
-    for (name, t) in [
-        ("BodyCenteredCubic", LatticeType::BodyCenteredCubic),
-        ("FaceCenteredCubic", LatticeType::FaceCenteredCubic),
-        ("Cubic", LatticeType::Cubic),
-        ("KelvinCell", LatticeType::KelvinCell),
-        ("Octet", LatticeType::Octet),
-    ] {
-        module.set_var(name, t);
-    }
-    engine.register_static_module("LatticeType", module.into());
+    shapes_api::register_enum(
+        engine,
+        "LatticeType",
+        [
+            ("BodyCenteredCubic", LatticeType::BodyCenteredCubic),
+            ("FaceCenteredCubic", LatticeType::FaceCenteredCubic),
+            ("Cubic", LatticeType::Cubic),
+            ("KelvinCell", LatticeType::KelvinCell),
+            ("Octet", LatticeType::Octet),
+        ],
+    );
 }
 
 #[cfg(test)]

@@ -410,14 +410,16 @@ pub fn register_methods(engine: &mut Engine) {
         "add_child",
         |c: Ctx, n: &mut Node, child: Node| -> RResult<bool> {
             match n.kind_mut() {
-                NodeKind::Union { children, .. } | NodeKind::Intersection { children, .. } => {
+                NodeKind::Union { children, .. }
+                | NodeKind::Intersection { children, .. }
+                | NodeKind::Sum { children, .. } => {
                     children.push(child);
                     Ok(true)
                 }
                 k => fail(
                     c.call_position(),
                     format!(
-                        "{}: add_child is for Union and Intersection; use set_child",
+                        "{}: add_child is for Union, Intersection and Sum; use set_child",
                         k.type_name()
                     ),
                 ),
