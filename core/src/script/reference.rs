@@ -112,10 +112,81 @@ pub static FUNCTIONS: &[FnDoc] = &[
     f!(
         "Strut",
         Geometry,
-        ["Strut(start: Vec3, end: Vec3, radius: float, material: int)"],
-        "A capsule of `radius` around the segment from `start` to `end`.",
+        [
+            "Strut(start: Vec3, end: Vec3, radius: float, material: int)",
+            "Strut(start: Vec3, end: Vec3, start_radius: float, end_radius: float[, start_cap: CapMode[, end_cap: CapMode]][, material: int])"
+        ],
+        "A capsule around the segment from `start` to `end`, or tapered between two radii with CapMode::Sphere, HemiSphere or Butt ends.",
         "Strut(Vec3(0, 0, 0), Vec3(0, 0, 10), 1.0, m.id(\"red\"))",
         "let m = default_materials(); Strut(Vec3(0, 0, 0), Vec3(0, 0, 10), 1.0, m.id(\"red\"))"
+    ),
+    f!(
+        "Cone",
+        Geometry,
+        [
+            "Cone(angle: float, height: float)",
+            "Cone(angle: float, height: float, material: int)"
+        ],
+        "A cone with its apex at the origin opening down to z = −height; `angle` is the half-angle in radians.",
+        "Cone(0.5, 10.0, m.id(\"red\"))",
+        "let m = default_materials(); Cone(0.5, 10.0, m.id(\"red\"))"
+    ),
+    f!(
+        "Torus",
+        Geometry,
+        [
+            "Torus()",
+            "Torus(r1: float, r2: float)",
+            "Torus(r1: float, r2: float, material: int)"
+        ],
+        "A ring about the z axis: major radius r1, tube radius r2.",
+        "Torus(10.0, 2.0, m.id(\"red\"))",
+        "let m = default_materials(); Torus(10.0, 2.0, m.id(\"red\"))"
+    ),
+    f!(
+        "PolygonRevolve",
+        Geometry,
+        [
+            "PolygonRevolve(profile: [Vec3], axis_start: Vec3, axis_end: Vec3, sweep_degrees: float)",
+            "PolygonRevolve(profile: [Vec3], axis_start: Vec3, axis_end: Vec3, sweep_degrees: float, material: int)",
+            "PolygonRevolve()"
+        ],
+        "A profile (x = radius, z = height) revolved about an axis by a sweep angle.",
+        "PolygonRevolve([Vec3(2, 0, 0), Vec3(5, 0, 0), Vec3(5, 0, 4), Vec3(2, 0, 4)], Vec3(0, 0, 0), Vec3(0, 0, 1), 360.0, m.id(\"red\"))",
+        "let m = default_materials(); PolygonRevolve([Vec3(2, 0, 0), Vec3(5, 0, 0), Vec3(5, 0, 4), Vec3(2, 0, 4)], Vec3(0, 0, 0), Vec3(0, 0, 1), 360.0, m.id(\"red\"))"
+    ),
+    f!(
+        "Mirror",
+        Transform,
+        [
+            "Mirror(axis: string, offset: float, child: Node)",
+            "Mirror(point: Vec3, normal: Vec3, child: Node)",
+            "Mirror(p0: Vec3, p1: Vec3, p2: Vec3, child: Node)",
+            "Mirror()"
+        ],
+        "Its child reflected in a plane (the original is not kept).",
+        "Mirror(\"x\", 0.0, child)",
+        "let m = default_materials(); Mirror(\"x\", 0.0, Sphere(Vec3(5, 0, 0), 2.0, m.id(\"red\")))"
+    ),
+    f!(
+        "Identity",
+        Transform,
+        ["Identity(child: Node)", "Identity()"],
+        "Its child unchanged: a local frame of its own for the expressions below it.",
+        "Identity(child)",
+        "let m = default_materials(); Identity(Sphere(Vec3(0, 0, 0), 2.0, m.id(\"red\")))"
+    ),
+    f!(
+        "Sum",
+        Boolean,
+        [
+            "Sum(iso: float, children: [Node])",
+            "Sum(iso: float)",
+            "Sum()"
+        ],
+        "pyvcad's Sum: the children's distances added plus `iso` (a blobby merge, not a distance).",
+        "Sum(0.0, [a, b])",
+        "let m = default_materials(); Sum(2.0, [Sphere(Vec3(0, 0, 0), 3.0, m.id(\"red\")), Sphere(Vec3(4, 0, 0), 3.0, m.id(\"red\"))])"
     ),
     f!(
         "PolygonExtrude",
