@@ -199,6 +199,9 @@ pub fn register(engine: &mut Engine) {
     four(engine, "%", Op::Mod);
     four(engine, "**", Op::Pow);
     four(engine, "floor_div", Op::FloorDiv);
+    // Python's one-argument `range(n)` (Rhai has the two- and three-argument
+    // forms).
+    engine.register_fn("range", |n: INT| 0..n.max(0));
     // `x /= y` and friends: Rhai looks for the assignment form first and
     // would find its built-in integer one; these take any value, act on
     // two numbers, and otherwise call the type's own operator (a Vec3

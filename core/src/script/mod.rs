@@ -620,3 +620,7 @@ fn register_lattice_types(engine: &mut Engine) {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_forms;
+#[cfg(test)]
+mod tests_python;

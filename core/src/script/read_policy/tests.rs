@@ -73,7 +73,7 @@ fn without_a_marker_only_the_script_folder_and_the_allowed_ones() {
 fn absolute_paths_are_refused_even_inside_the_project() {
     let (_t, r) = tree(&["p/.git"], &["p/x.csv"]);
     let abs = r.join("p/x.csv").display().to_string();
-    let e = resolve(&abs, &r.join("p"), &[r.clone()], None).unwrap_err();
+    let e = resolve(&abs, &r.join("p"), std::slice::from_ref(&r), None).unwrap_err();
     assert!(e.contains("relative to the script's folder"), "{e}");
 }
 
@@ -125,7 +125,7 @@ fn the_home_folder_is_never_a_project() {
     // A script saved in home itself reads nothing but allowed folders.
     let e = resolve("top.csv", &home, &[], Some(&home)).unwrap_err();
     assert!(e.contains("never a project"), "{e}");
-    ok("top.csv", &home, &[home.clone()], Some(&home));
+    ok("top.csv", &home, std::slice::from_ref(&home), Some(&home));
     // Nor anything above home.
     assert_eq!(project_of(&r, Some(&home)).root, None);
 }
