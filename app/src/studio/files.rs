@@ -105,6 +105,8 @@ pub enum DialogPurpose {
     SaveAs,
     /// An export panel's output folder (panel index).
     ExportFolder(usize),
+    /// A folder scripts may read besides their project.
+    ReadFolder,
 }
 
 /// A dialog's answer.
@@ -173,7 +175,7 @@ impl Dialogs {
                             }
                         })
                     }
-                    DialogPurpose::ExportFolder(_) => d.pick_folder(),
+                    DialogPurpose::ExportFolder(_) | DialogPurpose::ReadFolder => d.pick_folder(),
                 };
                 let _ = tx.send(DialogAnswer { purpose: p, path });
                 ctx.request_repaint();
