@@ -76,6 +76,10 @@ fn what_functions_cannot_do_with_top_level_values_is_explained() {
     // Read before any assignment at the top level: named, not a bare "()".
     let e = run("Sphere(Vec3(0,0,0), R, 1);\nR = 1;").unwrap_err();
     assert!(e.message.contains("`R`, which has no value yet"), "{e}");
+    assert_eq!(
+        log("print(R);\nR = 1;\nSphere(Vec3(0,0,0), R, 1)"),
+        ["<R: no value yet>"]
+    );
     let e = run("x = R + 1;\nR = 1;").unwrap_err();
     assert!(e.message.contains("no value yet"), "{e}");
 }

@@ -229,6 +229,12 @@ pub fn seed(scope: &mut Scope, names: &[String]) -> Cells {
 /// takes nor declares resolves to the top-level cell's current value (read
 /// only, as the engine makes every resolved value).
 pub fn resolve_in_functions(engine: &mut Engine, cells: Cells) {
+    // `print(W)` before `W = ...` shows that, not a Rust type name.
+    for name in ["to_string", "to_debug"] {
+        engine.register_fn(name, |u: &mut Unassigned| {
+            format!("<{}: no value yet>", u.0)
+        });
+    }
     #[allow(deprecated)] // `on_var` is marked volatile, not deprecated.
     engine.on_var(move |name, index, ctx| {
         // At the top level the scope holds the cells; an index is a local
