@@ -199,6 +199,26 @@ pub fn register(engine: &mut Engine) {
     four(engine, "%", Op::Mod);
     four(engine, "**", Op::Pow);
     four(engine, "floor_div", Op::FloorDiv);
+    // Python's math functions take integers too (`sqrt(2)`); Rhai's take
+    // floats only.
+    let unary: [(&str, fn(f64) -> f64); 13] = [
+        ("sqrt", f64::sqrt),
+        ("sin", f64::sin),
+        ("cos", f64::cos),
+        ("tan", f64::tan),
+        ("asin", f64::asin),
+        ("acos", f64::acos),
+        ("atan", f64::atan),
+        ("sinh", f64::sinh),
+        ("cosh", f64::cosh),
+        ("tanh", f64::tanh),
+        ("exp", f64::exp),
+        ("ln", f64::ln),
+        ("log", f64::log10),
+    ];
+    for (name, f) in unary {
+        engine.register_fn(name, move |x: INT| f(x as f64));
+    }
     // Python's one-argument `range(n)` (Rhai has the two- and three-argument
     // forms).
     engine.register_fn("range", |n: INT| 0..n.max(0));

@@ -87,6 +87,10 @@ fn every_operator_on_every_pair_is_python_s() {
         ("to_int(7 / 2)", Int(3)),
         ("to_int(-7 / 2)", Int(-3)),
         ("10 - 4 / 2", Float(8.0)),
+        // math.sqrt(4), math.sin(0), max(2, 2.5) in Python.
+        ("sqrt(4)", Float(2.0)),
+        ("sin(0)", Float(0.0)),
+        ("max(2, 2.5)", Float(2.5)),
     ];
     for (expr, want) in cases {
         check(expr, want);
