@@ -201,7 +201,8 @@ pub fn register(engine: &mut Engine) {
     four(engine, "floor_div", Op::FloorDiv);
     // Python's math functions take integers too (`sqrt(2)`); Rhai's take
     // floats only.
-    let unary: [(&str, fn(f64) -> f64); 13] = [
+    type Unary = fn(f64) -> f64;
+    let unary: [(&str, Unary); 13] = [
         ("sqrt", f64::sqrt),
         ("sin", f64::sin),
         ("cos", f64::cos),
