@@ -56,6 +56,13 @@ root = plate(2);
     assert_eq!(d.log, ["10", "20"]);
     let m = Model::prepare(&d.root, d.materials).unwrap();
     assert_eq!(m.bbox().max.x - m.bbox().min.x, 20.0);
+    // Through a function calling a function, and in closures.
+    assert_eq!(
+        log(
+            "W = 2;\nfn inner() { W * 10 }\nfn outer() { inner() + W }\nprint(outer());\nprint([1, 2].map(|v| v * W));\nSphere(Vec3(0,0,0), 1, 1)"
+        ),
+        ["22", "[2, 4]"]
+    );
     // A parameter or a local of the same name wins over the top level.
     assert_eq!(
         log(
