@@ -326,6 +326,14 @@ fn to_script_error(e: &EvalAltResult, file: &str, engine: &Engine, max_heap: u64
                 "an integer is needed here (an array index, a count), got a number; {INTEGER_HINT}"
             )
         }
+        EvalAltResult::ErrorVariableNotFound(var, _) => match var.strip_prefix("global::") {
+            Some(plain) => format!(
+                "`{var}`: top-level values are seen inside functions by their plain name; write `{plain}`"
+            ),
+            None => format!(
+                "unknown name `{var}`: assign it first (`{var} = ...`), or pass it to the function as an argument"
+            ),
+        },
         EvalAltResult::ErrorAssignmentToConstant(var, _) => format!(
             "cannot assign `{var}`: it is a constant, or a top-level value seen from inside a \
              function (functions read top-level values but do not change them: declare a local \

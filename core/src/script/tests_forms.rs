@@ -80,6 +80,10 @@ fn what_functions_cannot_do_with_top_level_values_is_explained() {
     let e = run("W = 1;\nfn f() { W = 3; }\nf();").unwrap_err();
     assert!(e.message.contains("`let W = ...`"), "{e}");
     assert!(e.message.contains("return the new value"), "{e}");
+    let e = run("K = 1;\nfn f() { global::K }\nf()").unwrap_err();
+    assert!(e.message.contains("write `K`"), "{e}");
+    let e = run("fn f() { Q }\nf()").unwrap_err();
+    assert!(e.message.contains("unknown name `Q`"), "{e}");
     // Read before any assignment at the top level: named, not a bare "()".
     let e = run("Sphere(Vec3(0,0,0), R, 1);\nR = 1;").unwrap_err();
     assert!(e.message.contains("`R`, which has no value yet"), "{e}");
