@@ -110,7 +110,7 @@ pub fn resolve(
     };
     Err(format!(
         "cannot read \"{name}\" ({}): it is {place}; to allow it, run with `--allow-read {}` \
-         (in the studio: Settings, folders scripts may read)",
+         (in the studio: File → Folders Scripts May Read)",
         full.display(),
         folder.display()
     ))
