@@ -536,3 +536,47 @@ fn signals_cancel_exports_and_leave_nothing() {
         assert!(!staging(), "SIG{signal}: staging left");
     }
 }
+
+#[test]
+fn scripts_read_inside_their_project_and_allow_read_adds_folders() {
+    let t = tmp("allow-read");
+    let root = t.path();
+    // The home folder elsewhere: a folder above home is never a project.
+    let home = tmp("allow-read-home");
+    for d in ["p/designs", "data"] {
+        std::fs::create_dir_all(root.join(d)).unwrap();
+    }
+    std::fs::write(root.join("data/r.csv"), "r\n2\n").unwrap();
+    let design = root.join("p/designs/d.rhai");
+    std::fs::write(
+        &design,
+        "r = read_csv(\"../../data/r.csv\")[0].r;\nroot = Sphere(Vec3(0, 0, 0), r, 1);\n",
+    )
+    .unwrap();
+    let run = |extra: &[&str]| {
+        let mut args = vec!["info", design.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        Command::new(env!("CARGO_BIN_EXE_volcad"))
+            .args(&args)
+            .env("XDG_RUNTIME_DIR", runtime_dir())
+            .env("HOME", home.path())
+            .output()
+            .expect("run volcad")
+    };
+    // No .git or volcad.toml above the script: its own folder only.
+    let err = fails(&run(&[]));
+    assert!(err.contains("d.rhai:1:"), "{err}");
+    assert!(err.contains("outside the project folder"), "{err}");
+    assert!(err.contains("--allow-read"), "{err}");
+    let data = root.join("data");
+    let out = ok(&run(&["--allow-read", data.to_str().unwrap()]));
+    assert!(out.contains("[-2.0000, -2.0000, -2.0000]"), "{out}");
+    let err = fails(&run(&["--allow-read", "/no/such/folder"]));
+    assert!(
+        err.contains("--allow-read /no/such/folder: no such folder"),
+        "{err}"
+    );
+    // A volcad.toml at the top makes the whole tree one project.
+    std::fs::write(root.join("volcad.toml"), "").unwrap();
+    ok(&run(&[]));
+}

@@ -74,12 +74,27 @@ fn check_params(given: &HashMap<String, f64>, declared: &[Param]) -> anyhow::Res
     Ok(())
 }
 
+/// Each `--allow-read DIR` must be a folder that exists: a typo would
+/// otherwise surface only as a refused file later.
+fn allowed_folders(dirs: &[std::path::PathBuf]) -> anyhow::Result<Vec<std::path::PathBuf>> {
+    dirs.iter()
+        .map(|d| {
+            if d.is_dir() {
+                Ok(d.clone())
+            } else {
+                bail!("--allow-read {}: no such folder", d.display())
+            }
+        })
+        .collect()
+}
+
 /// Run and prepare the design named by `args`; warnings go to stderr.
 pub fn load_design(args: &DesignArgs) -> anyhow::Result<Loaded> {
     let source = std::fs::read_to_string(&args.design)
         .with_context(|| format!("cannot read {}", args.design.display()))?;
     let mut opts = ScriptOptions::for_file(&args.design);
     opts.params = parse_params(&args.params)?;
+    opts.allow_read = allowed_folders(&args.allow_read)?;
     let name = args.design.display().to_string();
     let start = Instant::now();
     let design = run_script(&source, &name, &opts)?;

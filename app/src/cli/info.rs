@@ -76,6 +76,10 @@ pub struct BenchArgs {
     /// Measure evaluation only (no slice-stack and mesh exports).
     #[arg(long)]
     pub no_exports: bool,
+    /// A folder the designs may also read, besides their projects
+    /// (repeatable).
+    #[arg(long = "allow-read", value_name = "DIR")]
+    pub allow_read: Vec<PathBuf>,
 }
 
 /// `volcad bench`: points per second near the surface for each design
@@ -127,6 +131,7 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
         let d = super::DesignArgs {
             design: path.clone(),
             params: vec![],
+            allow_read: args.allow_read.clone(),
         };
         let l = match load_design(&d) {
             Ok(l) => l,

@@ -31,6 +31,11 @@ pub struct DesignArgs {
     /// Override a `param(...)` of the script: `--param name=value` (repeatable).
     #[arg(long = "param", value_name = "NAME=VALUE")]
     pub params: Vec<String>,
+    /// A folder the script may also read, besides its project (the
+    /// nearest folder above it holding .git or volcad.toml, else its own
+    /// folder): `--allow-read DIR` (repeatable).
+    #[arg(long = "allow-read", value_name = "DIR")]
+    pub allow_read: Vec<PathBuf>,
 }
 
 /// The subcommands.

@@ -205,6 +205,12 @@ impl StudioApp {
                 }
             }
             DialogPurpose::ExportFolder(_) => self.exports.set_dir(path),
+            DialogPurpose::ReadFolder => {
+                if !self.settings.read_folders.contains(&path) {
+                    self.settings.read_folders.push(path);
+                }
+                self.run_now();
+            }
         }
     }
 
@@ -293,6 +299,18 @@ impl StudioApp {
                 if ui.add(egui::Button::new("Save As…").shortcut_text(sc(&SAVE_AS))).clicked() {
                     self.save_as_dialog(&ctx);
                 }
+                ui.menu_button("Folders Scripts May Read", |ui| {
+                    ui.weak("Besides the script's project (the folder above it with .git or volcad.toml)");
+                    for p in self.settings.read_folders.clone() {
+                        if ui.button(format!("✕ {}", p.display())).on_hover_text("Remove").clicked() {
+                            self.settings.read_folders.retain(|q| q != &p);
+                            self.run_now();
+                        }
+                    }
+                    if ui.button("Add Folder…").clicked() {
+                        self.dialogs.show(&ctx, DialogPurpose::ReadFolder, None, None);
+                    }
+                });
                 ui.separator();
                 if ui.button("Quit").clicked() {
                     self.request(&ctx, Pending::Quit);

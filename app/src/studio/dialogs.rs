@@ -29,6 +29,8 @@ pub enum DialogPurpose {
     SaveAs,
     /// An export panel's output folder (panel index).
     ExportFolder(usize),
+    /// A folder scripts may read besides their project.
+    ReadFolder,
 }
 
 /// A dialog's answer.
@@ -165,6 +167,7 @@ impl Dialogs {
             DialogPurpose::Open => (BrowserKind::OpenFile, "Open design"),
             DialogPurpose::SaveAs => (BrowserKind::SaveFile, "Save design as"),
             DialogPurpose::ExportFolder(_) => (BrowserKind::Folder, "Output folder"),
+            DialogPurpose::ReadFolder => (BrowserKind::Folder, "A folder scripts may read"),
         };
         let dir = dir
             .or_else(|| std::env::current_dir().ok())
@@ -233,6 +236,6 @@ fn native_dialog(
             d.save_file()
                 .map(|p| with_rhai_extension(&DialogPurpose::SaveAs, p))
         }
-        DialogPurpose::ExportFolder(_) => d.pick_folder(),
+        DialogPurpose::ExportFolder(_) | DialogPurpose::ReadFolder => d.pick_folder(),
     }
 }

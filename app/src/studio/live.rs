@@ -30,6 +30,8 @@ pub struct RunRequest {
     pub base_dir: Option<PathBuf>,
     /// Parameter overrides (sliders).
     pub params: HashMap<String, f64>,
+    /// Folders the script may read besides its project (settings).
+    pub allow_read: Vec<PathBuf>,
 }
 
 /// A successful run: the design's side data and its prepared model.
@@ -191,6 +193,7 @@ impl Drop for LiveRunner {
 pub fn run(req: RunRequest, cancel: Arc<AtomicBool>) -> LiveResult {
     let opts = ScriptOptions {
         base_dir: req.base_dir,
+        allow_read: req.allow_read,
         params: req.params,
         cancel: Some(cancel),
         ..ScriptOptions::default()
@@ -258,6 +261,7 @@ RectPrism(Vec3(0, 0, 0), Vec3(15, 10, 5), m.id("gray"))"#;
             name: "<editor>".into(),
             base_dir: None,
             params: HashMap::new(),
+            allow_read: Vec::new(),
         }
     }
 

@@ -287,6 +287,7 @@ impl StudioApp {
             name: self.doc.name(),
             base_dir: self.doc.base_dir.clone(),
             params: self.params.overrides().clone(),
+            allow_read: self.settings.read_folders.clone(),
         }
     }
 

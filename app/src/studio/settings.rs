@@ -44,6 +44,9 @@ pub struct Settings {
     pub show_bottom: bool,
     /// Output folder last used by an export panel.
     pub last_export_dir: Option<PathBuf>,
+    /// Folders scripts may read besides their project (the command line's
+    /// `--allow-read DIR`).
+    pub read_folders: Vec<PathBuf>,
 }
 
 impl Default for Settings {
@@ -57,6 +60,7 @@ impl Default for Settings {
             show_side: true,
             show_bottom: true,
             last_export_dir: None,
+            read_folders: Vec::new(),
         }
     }
 }

@@ -9,13 +9,17 @@
 //! binary counts the heap, `crate::heap`), or when its cancel flag is set.
 //! The design is the script's final value, or else a variable named `root`.
 
+mod arith;
 mod bulk;
 mod file_cache;
 mod files_api;
 mod leaves_api;
 mod nodes_api;
+mod query_api;
+pub mod read_policy;
 pub mod reference;
 mod shapes_api;
+mod toplevel;
 mod values;
 
 use std::collections::HashMap;
@@ -48,9 +52,15 @@ pub struct Param {
 /// How to run a script.
 #[derive(Clone, Debug)]
 pub struct ScriptOptions {
-    /// Folder that relative file names (CSV, meshes, tables) resolve in; the
-    /// script may read files only under it. `None`: no file access.
+    /// Folder that relative file names (CSV, meshes, tables) resolve in
+    /// (the script's folder); the script may read files inside its project
+    /// (see [`read_policy`]). `None`: no file access.
     pub base_dir: Option<PathBuf>,
+    /// More folders the script may read (`--allow-read DIR`, the studio's
+    /// read folders).
+    pub allow_read: Vec<PathBuf>,
+    /// The user's home folder: never part of a project (default: `$HOME`).
+    pub home: Option<PathBuf>,
     /// Values for `param(...)` by name, overriding defaults (clamped to range).
     pub params: HashMap<String, f64>,
     /// Set to stop the script at its next operation.
@@ -67,6 +77,8 @@ impl Default for ScriptOptions {
     fn default() -> Self {
         Self {
             base_dir: None,
+            allow_read: Vec::new(),
+            home: read_policy::home_dir(),
             params: HashMap::new(),
             cancel: None,
             max_operations: 500_000_000,
@@ -141,12 +153,15 @@ pub(crate) struct RunState {
 #[derive(Clone)]
 pub(crate) struct RunContext {
     pub base_dir: Option<PathBuf>,
+    pub allow_read: Arc<Vec<PathBuf>>,
+    pub home: Option<PathBuf>,
     pub overrides: Arc<HashMap<String, f64>>,
     pub state: Arc<Mutex<RunState>>,
 }
 
 impl RunContext {
-    /// Resolve `name` inside the script's folder, refusing anything outside.
+    /// Resolve `name` relative to the script's folder, refusing anything
+    /// outside its project and the allowed folders.
     pub fn resolve(&self, name: &str, pos: Position) -> RResult<PathBuf> {
         let Some(base) = &self.base_dir else {
             return fail(
@@ -156,23 +171,8 @@ impl RunContext {
                 ),
             );
         };
-        let joined = base.join(name);
-        let canon = joined
-            .canonicalize()
-            .or_else(|e| fail(pos, format!("cannot read \"{}\": {e}", joined.display())))?;
-        let base_canon = base
-            .canonicalize()
-            .or_else(|e| fail(pos, format!("script folder {}: {e}", base.display())))?;
-        if !canon.starts_with(&base_canon) {
-            return fail(
-                pos,
-                format!(
-                    "\"{name}\" is outside the script's folder {}; scripts may only read files beside them",
-                    base.display()
-                ),
-            );
-        }
-        Ok(canon)
+        read_policy::resolve(name, base, &self.allow_read, self.home.as_deref())
+            .or_else(|m| fail(pos, m))
     }
 
     fn lock(&self) -> std::sync::MutexGuard<'_, RunState> {
@@ -205,6 +205,8 @@ pub fn model_of_file(path: &Path) -> Result<crate::Model, String> {
 pub fn run_script(source: &str, name: &str, opts: &ScriptOptions) -> Result<Design, ScriptError> {
     let ctx = RunContext {
         base_dir: opts.base_dir.clone(),
+        allow_read: Arc::new(opts.allow_read.clone()),
+        home: opts.home.clone(),
         overrides: Arc::new(opts.params.clone()),
         state: Arc::new(Mutex::new(RunState::default())),
     };
@@ -216,9 +218,13 @@ pub fn run_script(source: &str, name: &str, opts: &ScriptOptions) -> Result<Desi
             message,
         });
     }
-    let engine = build_engine(&ctx, opts);
+    let top = toplevel::scan(source);
+    let mut scope = Scope::new();
+    let cells = toplevel::seed(&mut scope, &top.names);
+    let mut engine = build_engine(&ctx, opts);
+    toplevel::resolve_in_functions(&mut engine, cells);
     let err = |e: &EvalAltResult| to_script_error(e, name, &engine, opts.max_heap);
-    let ast = engine.compile(source).map_err(|e| {
+    let ast = engine.compile(&top.source).map_err(|e| {
         let pos = e.position();
         ScriptError {
             file: name.to_owned(),
@@ -227,7 +233,6 @@ pub fn run_script(source: &str, name: &str, opts: &ScriptOptions) -> Result<Desi
             message: e.err_type().to_string(),
         }
     })?;
-    let mut scope = Scope::new();
     let value: Dynamic = engine
         .eval_ast_with_scope(&mut scope, &ast)
         .map_err(|e| err(&e))?;
@@ -263,12 +268,15 @@ pub fn run_script(source: &str, name: &str, opts: &ScriptOptions) -> Result<Desi
 /// The names of every function the script engine registers (sorted,
 /// once each): the language reference is checked against them.
 pub fn registered_functions() -> Vec<String> {
+    let opts = ScriptOptions::default();
     let ctx = RunContext {
         base_dir: None,
+        allow_read: Arc::new(opts.allow_read.clone()),
+        home: opts.home.clone(),
         overrides: Arc::new(HashMap::new()),
         state: Arc::new(Mutex::new(RunState::default())),
     };
-    let engine = build_engine(&ctx, &ScriptOptions::default());
+    let engine = build_engine(&ctx, &opts);
     let mut names: Vec<String> = engine
         .gen_fn_signatures(false)
         .iter()
@@ -337,6 +345,24 @@ fn to_script_error(e: &EvalAltResult, file: &str, engine: &Engine, max_heap: u64
             "stopped: the script ran too many operations (an endless loop?)".into()
         }
         EvalAltResult::ErrorFunctionNotFound(sig, _) => not_found(sig, engine),
+        EvalAltResult::ErrorMismatchDataType(want, got, _) if got == "f64" && want == "i64" => {
+            format!(
+                "an integer is needed here (an array index, a count), got a number; {INTEGER_HINT}"
+            )
+        }
+        EvalAltResult::ErrorVariableNotFound(var, _) => match var.strip_prefix("global::") {
+            Some(plain) => format!(
+                "`{var}`: top-level values are seen inside functions by their plain name; write `{plain}`"
+            ),
+            None => format!(
+                "unknown name `{var}`: assign it first (`{var} = ...`), or pass it to the function as an argument"
+            ),
+        },
+        EvalAltResult::ErrorAssignmentToConstant(var, _) => format!(
+            "cannot assign `{var}`: it is a constant, or a top-level value seen from inside a \
+             function (functions read top-level values but do not change them: declare a local \
+             with `let {var} = ...`, or return the new value)"
+        ),
         other => {
             let mut s = other.to_string();
             if let Some(i) = s.rfind(" (line ") {
@@ -353,6 +379,11 @@ fn to_script_error(e: &EvalAltResult, file: &str, engine: &Engine, max_heap: u64
     }
 }
 
+/// What to write where Python's true division gave a float and Rhai needs
+/// an integer.
+const INTEGER_HINT: &str = "`/` divides as in Python and gives a number: write `floor_div(a, b)` \
+     (Python's `a // b`) or `to_int(x)` where an integer is needed";
+
 /// rhai's "Function not found: Tile (volcad_core::node::Node, Vec3)" in the
 /// script's terms: argument types by the names a script knows them by; for
 /// a known name, that no form of it takes those arguments; for an unknown
@@ -362,23 +393,40 @@ fn not_found(sig: &str, engine: &Engine) -> String {
         Some((n, a)) => (n.trim(), a.strip_suffix(')').unwrap_or(a)),
         None => (sig.trim(), ""),
     };
-    let args: Vec<&str> = args
-        .split(", ")
-        .filter(|a| !a.is_empty())
-        .map(script_type)
-        .collect();
+    let raw: Vec<&str> = args.split(", ").filter(|a| !a.is_empty()).collect();
+    let float_arg = raw.iter().any(|a| matches!(a.trim(), "f64" | "f32"));
+    let args: Vec<&str> = raw.iter().map(|a| script_type(a)).collect();
+    if raw.iter().any(|a| a.ends_with("Unassigned")) {
+        return format!(
+            "`{name}` is given a name that has no value yet ({}): assign it above this line",
+            args.join(", ")
+        );
+    }
+    if matches!(name, ".." | "..=") {
+        return format!(
+            "a range's bounds must be integers, got ({}); {INTEGER_HINT}",
+            args.join(", ")
+        );
+    }
+    // Rhai's standard functions (`range`, `sub_string`) count as known.
     let mut known: Vec<String> = engine
-        .gen_fn_signatures(false)
+        .gen_fn_signatures(true)
         .iter()
         .filter_map(|s| s.split('(').next())
         .map(|n| n.trim().to_owned())
+        .filter(|n| !n.contains('$'))
         .collect();
     known.sort();
     known.dedup();
     if known.iter().any(|k| k == name) {
+        let hint = if float_arg {
+            format!("; {INTEGER_HINT}")
+        } else {
+            String::new()
+        };
         return format!(
             "no form of `{name}` takes ({}): check the number, order and types of its \
-             arguments (the README's script table lists each form)",
+             arguments (the README's script table lists each form){hint}",
             args.join(", ")
         );
     }
@@ -390,12 +438,17 @@ fn not_found(sig: &str, engine: &Engine) -> String {
 
 /// A Rust type name as rhai prints it, in a script's words.
 fn script_type(t: &str) -> &str {
-    match t.trim() {
+    let t = t.trim();
+    if t.contains("ImmutableString") {
+        return "string";
+    }
+    match t.rsplit("::").next().unwrap_or(t) {
         "f64" | "f32" => "number",
         "i64" | "i32" | "usize" => "integer",
         "ImmutableString" | "&str" | "String" | "string" => "string",
         "()" => "nothing",
-        other => other.rsplit("::").next().unwrap_or(other),
+        "Unassigned" => "a name with no value yet",
+        other => other,
     }
 }
 
@@ -424,6 +477,7 @@ fn build_engine(ctx: &RunContext, opts: &ScriptOptions) -> Engine {
     let dbg = ctx.clone();
     engine.on_debug(move |s, _, pos| dbg.lock().log.push(format!("[{pos}] {s}")));
 
+    arith::register(&mut engine);
     register_vec3(&mut engine);
     register_materials(&mut engine, ctx);
     register_lattice_types(&mut engine);
@@ -432,6 +486,7 @@ fn build_engine(ctx: &RunContext, opts: &ScriptOptions) -> Engine {
     shapes_api::register_shapes(&mut engine);
     nodes_api::register_methods(&mut engine);
     files_api::register(&mut engine, ctx);
+    query_api::register(&mut engine, ctx);
     bulk::register(&mut engine, opts.max_heap);
 
     let params = ctx.clone();
@@ -498,6 +553,8 @@ fn register_vec3(engine: &mut Engine) {
     engine.register_fn("*", |s: f64, a: Vec3| Vec3(a.0 * s));
     engine.register_fn("*", |a: Vec3, s: i64| Vec3(a.0 * s as f64));
     engine.register_fn("/", |a: Vec3, s: f64| Vec3(a.0 / s));
+    engine.register_fn("/", |a: Vec3, s: i64| Vec3(a.0 / s as f64));
+    engine.register_fn("*", |s: i64, a: Vec3| Vec3(a.0 * s as f64));
     engine.register_fn("length", |a: &mut Vec3| a.0.length());
     engine.register_fn("distance", |a: Vec3, b: Vec3| a.0.distance(b.0));
     engine.register_fn("to_string", |a: &mut Vec3| {
@@ -595,3 +652,7 @@ fn register_lattice_types(engine: &mut Engine) {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_forms;
+#[cfg(test)]
+mod tests_python;

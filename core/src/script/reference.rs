@@ -292,6 +292,22 @@ pub static FUNCTIONS: &[FnDoc] = &[
         "let m = default_materials(); Union(false, [Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\")), Sphere(Vec3(6, 0, 0), 5.0, m.id(\"blue\"))])"
     ),
     f!(
+        "BBoxUnion",
+        Boolean,
+        ["BBoxUnion(children: [Node])", "BBoxUnion()"],
+        "pyvcad's name for `Union(false, children)` (an exact distance everywhere).",
+        "BBoxUnion([a, b])",
+        "let m = default_materials(); BBoxUnion([Sphere(Vec3(0, 0, 0), 2.0, m.id(\"red\")), Sphere(Vec3(5, 0, 0), 2.0, m.id(\"blue\"))])"
+    ),
+    f!(
+        "BBoxIntersection",
+        Boolean,
+        ["BBoxIntersection(children: [Node])", "BBoxIntersection()"],
+        "`Intersection(false, children)` under pyvcad's bounding-box name.",
+        "BBoxIntersection([a, b])",
+        "let m = default_materials(); BBoxIntersection([Sphere(Vec3(0, 0, 0), 3.0, m.id(\"red\")), RectPrism(Vec3(0, 0, 0), Vec3(4, 4, 4), m.id(\"red\"))])"
+    ),
+    f!(
         "Intersection",
         Boolean,
         [
@@ -491,6 +507,38 @@ pub static FUNCTIONS: &[FnDoc] = &[
         "let m = default_materials(); let d = Difference(); d.set_left(Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\"))); d.set_right(Sphere(Vec3(3, 0, 0), 3.0, m.id(\"red\"))); d"
     ),
     f!(
+        "evaluate",
+        Method,
+        ["node.evaluate(x: float, y: float, z: float) -> float"],
+        "The signed distance at a point (negative inside), of the tree as it is at that line.",
+        "n.evaluate(0.0, 0.0, 0.0)",
+        "let m = default_materials(); let s = Sphere(Vec3(0, 0, 0), 2.0, m.id(\"red\")); let d = s.evaluate(0.0, 0.0, 0.0); s"
+    ),
+    f!(
+        "distribution",
+        Method,
+        ["node.distribution(x: float, y: float, z: float) -> [float]"],
+        "The fractions at a point, indexed by material id (`f[m.id(\"red\")]`); all 0 outside.",
+        "n.distribution(0.0, 0.0, 0.0)",
+        "let m = default_materials(); let s = Sphere(Vec3(0, 0, 0), 2.0, m.id(\"red\")); let f = s.distribution(0.0, 0.0, 0.0); s"
+    ),
+    f!(
+        "bounding_box",
+        Method,
+        ["node.bounding_box() -> [Vec3, Vec3]"],
+        "The node's box as [min, max].",
+        "n.bounding_box()",
+        "let m = default_materials(); let s = Sphere(Vec3(0, 0, 0), 2.0, m.id(\"red\")); let b = s.bounding_box(); s"
+    ),
+    f!(
+        "prepare",
+        Method,
+        ["node.prepare(voxel: Vec3, interior: float, exterior: float)"],
+        "Accepted for pyvcad scripts; does nothing (designs are prepared when used).",
+        "n.prepare(Vec3(0.1, 0.1, 0.1), 1.0, 1.0)",
+        "let m = default_materials(); let s = Sphere(Vec3(0, 0, 0), 2.0, m.id(\"red\")); s.prepare(Vec3(0.1, 0.1, 0.1), 1.0, 1.0); s"
+    ),
+    f!(
         "num_children",
         Method,
         ["node.num_children() -> int"],
@@ -529,6 +577,17 @@ pub static FUNCTIONS: &[FnDoc] = &[
         "The distance between two points.",
         "distance(a, b)",
         "let m = default_materials(); let r = distance(Vec3(0, 0, 0), Vec3(3, 4, 0)); Sphere(Vec3(0, 0, 0), r, m.id(\"red\"))"
+    ),
+    f!(
+        "floor_div",
+        Value,
+        [
+            "floor_div(a: int, b: int) -> int",
+            "floor_div(a: float, b: float) -> float"
+        ],
+        "Python's `a // b` (`//` starts a comment in scripts); `/` is true division as in Python.",
+        "floor_div(a, b)",
+        "let m = default_materials(); let n = floor_div(7, 2); Sphere(Vec3(0, 0, 0), n * 1.0, m.id(\"red\"))"
     ),
     f!(
         "param",
@@ -647,7 +706,11 @@ mod tests {
     fn ours(name: &str) -> bool {
         !matches!(
             name,
-            "to_string" | "to_debug" | "+" | "-" | "*" | "/" | "==" | "!=" | "x" | "y" | "z"
+            "to_string" | "to_debug" | "+" | "-" | "*" | "/" | "%" | "**" | "/=" | "%=" | "**="
+                | "==" | "!=" | "x" | "y" | "z"
+                // Rhai's own math and `range`, given Python's integer forms.
+                | "sqrt" | "exp" | "ln" | "log" | "sin" | "cos" | "tan" | "asin" | "acos"
+                | "atan" | "sinh" | "cosh" | "tanh" | "range"
         ) && !name.starts_with("get$")
             && !name.starts_with("set$")
     }

@@ -217,7 +217,7 @@ fn files_need_a_folder_and_stay_inside_it() {
     assert!((m.distance(DVec3::ZERO) + 4.5).abs() < 1e-12);
     std::fs::write(dir.join("secret.csv"), "a\n1\n").unwrap();
     let e = run_script("read_csv(\"../secret.csv\")", "t", &opts).unwrap_err();
-    assert!(e.message.contains("outside the script's folder"), "{e}");
+    assert!(e.message.contains("outside the project folder"), "{e}");
 }
 
 #[test]

@@ -21,6 +21,12 @@ pub fn described(v: &Dynamic) -> String {
     if v.is::<Node>() {
         return "a node".into();
     }
+    if let Some(u) = v.read_lock::<super::toplevel::Unassigned>() {
+        return format!(
+            "`{}`, which has no value yet (assign it above this line)",
+            u.0
+        );
+    }
     match v.type_name() {
         "i64" => "an integer".into(),
         "f64" => "a number".into(),
