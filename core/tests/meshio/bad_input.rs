@@ -71,6 +71,21 @@ fn obj_coordinates_are_blamed_at_their_line_and_column() {
         "v 0 0 0\nv 1 0 0 # x\nv 0 1 0\nf 1 2 4\n",
     );
     assert!(e.to_string().ends_with("f.obj:4:7: face vertex 4 does not exist: the file has 3 vertices (write 1..=3, or -1 for the last one read before the face)"), "{e}");
+    // A 10 MB line is quoted by its start only.
+    let long = format!(
+        "v 0 0 0\nv 1 0 0\nv {} 0\nf 1 2 3\n",
+        "7".repeat(10_000_000)
+    );
+    let e = load_err(dir.path(), "long.obj", long).to_string();
+    assert!(
+        e.contains(&format!(
+            "long.obj:3:1: expected `v x y z` with 3 numbers, found `v {}…`",
+            "7".repeat(58)
+        )),
+        "{}",
+        &e[..200]
+    );
+    assert!(e.len() < 300, "{}", e.len());
     let e = load_err(dir.path(), "g.obj", "v 0 0 0\nf 1 2\n");
     assert!(matches!(e, MeshError::Parse { line: 2, .. }), "{e}");
 }
@@ -190,6 +205,14 @@ fn special_empty_and_oversized_files_are_refused_before_reading() {
     assert!(
         e.to_string()
             .contains("PLY: the file ends inside element `vertex` 3 of 4000000000: truncated?"),
+        "{e}"
+    );
+    // An element without properties takes no bytes, whatever its count.
+    let ply = "ply\nformat ascii 1.0\nelement junk 4000000000\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n";
+    let e = load_err(dir.path(), "junk.ply", ply);
+    assert!(
+        e.to_string()
+            .contains("PLY: the file ends inside element `face` 1 of 1: truncated?"),
         "{e}"
     );
 }

@@ -159,8 +159,9 @@ pub(crate) fn text<'a>(path: &Path, bytes: &'a [u8]) -> Result<&'a str, MeshErro
 
 /// Parses one coordinate of a text format, with the reason a value is
 /// refused (the caller adds file, line and column).
-pub(crate) fn coord(tok: &str) -> Result<f64, String> {
-    let v: f64 = tok
+pub(crate) fn coord(word: &str) -> Result<f64, String> {
+    let tok = excerpt(word);
+    let v: f64 = word
         .parse()
         .map_err(|_| format!("`{tok}` is not a number"))?;
     if v.is_nan() {
@@ -179,6 +180,18 @@ pub(crate) fn coord(tok: &str) -> Result<f64, String> {
     range_check(v)
         .map(|()| v)
         .map_err(|m| format!("`{tok}` {m}"))
+}
+
+/// Most characters of the file's text that a message quotes.
+const QUOTE_CHARS: usize = 60;
+
+/// `s`, or its first [`QUOTE_CHARS`] characters and `…`: a 10 MB line is
+/// not echoed whole.
+pub(crate) fn excerpt(s: &str) -> String {
+    match s.char_indices().nth(QUOTE_CHARS) {
+        Some((cut, _)) => format!("{}…", &s[..cut]),
+        None => s.to_string(),
+    }
 }
 
 /// Refuses magnitudes beyond [`MAX_COORD`].

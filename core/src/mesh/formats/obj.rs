@@ -13,7 +13,7 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use super::{MeshError, Soup, fan, parse_error, point, words};
+use super::{MeshError, Soup, excerpt, fan, parse_error, point, words};
 
 /// Column, resolved 0-based index, index as written.
 type FaceRef = (usize, i64, i64);
@@ -48,7 +48,10 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<Soup, MeshError> {
                     return Err(err(
                         ln,
                         col,
-                        format!("expected `v x y z` with 3 numbers, found `{}`", raw.trim()),
+                        format!(
+                            "expected `v x y z` with 3 numbers, found `{}`",
+                            excerpt(raw.trim())
+                        ),
                     ));
                 }
                 vertices.push(point(&nums, ln, &err)?);
@@ -60,7 +63,10 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<Soup, MeshError> {
                     return Err(err(
                         ln,
                         col,
-                        format!("a face needs at least 3 vertices, found `{}`", raw.trim()),
+                        format!(
+                            "a face needs at least 3 vertices, found `{}`",
+                            excerpt(raw.trim())
+                        ),
                     ));
                 }
                 faces.push(Face { line: ln, refs });
@@ -114,7 +120,8 @@ fn face_refs<'a>(
                 _ => Err((
                     c,
                     format!(
-                        "face vertex `{w}` is not a vertex number (1-based, or negative counting back from the last vertex)"
+                        "face vertex `{}` is not a vertex number (1-based, or negative counting back from the last vertex)",
+                        excerpt(w)
                     ),
                 )),
             }

@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use super::{MeshError, Soup, capacity, fan, parse_error, point, words};
+use super::{MeshError, Soup, capacity, excerpt, fan, parse_error, point, words};
 
 pub(super) fn parse(path: &Path, text: &str) -> Result<Soup, MeshError> {
     let err = parse_error(path);
@@ -37,7 +37,10 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<Soup, MeshError> {
             err(
                 count_line,
                 c,
-                format!("expected the counts `vertices faces edges`, found `{w}` (a whole number)"),
+                format!(
+                    "expected the counts `vertices faces edges`, found `{}` (a whole number)",
+                    excerpt(w)
+                ),
             )
         })
     };
@@ -86,7 +89,7 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<Soup, MeshError> {
                 w[0].0,
                 format!(
                     "expected a face `n i0 … i(n-1)` with n ≥ 3 vertex numbers, found `{}`",
-                    w.iter().map(|x| x.1).collect::<Vec<_>>().join(" ")
+                    excerpt(&w.iter().map(|x| x.1).collect::<Vec<_>>().join(" "))
                 ),
             ));
         };
@@ -99,7 +102,8 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<Soup, MeshError> {
                         ln,
                         c,
                         format!(
-                            "face vertex `{s}` is not one of the {nv} vertices (0-based: 0..{nv})"
+                            "face vertex `{}` is not one of the {nv} vertices (0-based: 0..{nv})",
+                            excerpt(s)
                         ),
                     ));
                 }

@@ -13,7 +13,7 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use super::{MeshError, Soup, capacity, coord, fan, parse_error, range_check, words};
+use super::{MeshError, Soup, capacity, coord, excerpt, fan, parse_error, range_check, words};
 
 #[derive(Clone, Copy, PartialEq)]
 enum Encoding {
@@ -70,7 +70,7 @@ impl Property {
     /// `property TYPE NAME` or `property list COUNT_TYPE ITEM_TYPE NAME`.
     fn parse(w: &[(usize, &str)]) -> Result<Property, String> {
         let word = |k: usize| w.get(k).map(|x| x.1);
-        let found = w.iter().map(|x| x.1).collect::<Vec<_>>().join(" ");
+        let found = excerpt(&w.iter().map(|x| x.1).collect::<Vec<_>>().join(" "));
         if word(1) == Some("list") {
             let ct = word(2).and_then(Scalar::parse);
             match (ct, word(3).and_then(Scalar::parse), word(4)) {
@@ -148,7 +148,10 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Soup, MeshError> {
                 .sum();
             vertices.reserve(capacity(el.count, body.len(), min_bytes));
         }
-        for i in 0..el.count {
+        // An element without properties takes no bytes: nothing to read,
+        // however large its count.
+        let count = if el.props.is_empty() { 0 } else { el.count };
+        for i in 0..count {
             let at = |e: ReadError| e.into_mesh_error(path, &el.name, i, el.count);
             let mut p = [0.0; 3];
             for (k, prop) in el.props.iter().enumerate() {
@@ -235,7 +238,7 @@ fn header(bytes: &[u8]) -> Result<Header<'_>, HeaderError> {
                             col,
                             format!(
                                 "expected `format ascii|binary_little_endian|binary_big_endian 1.0`, found `{}`",
-                                line.trim()
+                                excerpt(line.trim())
                             ),
                         );
                     }
@@ -246,7 +249,10 @@ fn header(bytes: &[u8]) -> Result<Header<'_>, HeaderError> {
                 let (Some(name), Some(count)) = (w.get(1), count) else {
                     return bad(
                         col,
-                        format!("expected `element NAME COUNT`, found `{}`", line.trim()),
+                        format!(
+                            "expected `element NAME COUNT`, found `{}`",
+                            excerpt(line.trim())
+                        ),
                     );
                 };
                 elements.push(Element {
@@ -263,7 +269,12 @@ fn header(bytes: &[u8]) -> Result<Header<'_>, HeaderError> {
                 el.props.push(prop);
             }
             "end_header" => break,
-            _ => return bad(col, format!("unknown PLY header line `{}`", line.trim())),
+            _ => {
+                return bad(
+                    col,
+                    format!("unknown PLY header line `{}`", excerpt(line.trim())),
+                );
+            }
         }
     }
     let Some(encoding) = encoding else {
@@ -372,8 +383,9 @@ impl Body<'_> {
                 if coordinate {
                     coord(w).map_err(|m| ReadError::Text(l, c, m))
                 } else {
-                    w.parse::<f64>()
-                        .map_err(|_| ReadError::Text(l, c, format!("`{w}` is not a number")))
+                    w.parse::<f64>().map_err(|_| {
+                        ReadError::Text(l, c, format!("`{}` is not a number", excerpt(w)))
+                    })
                 }
             }
             Body::Binary {

@@ -10,7 +10,7 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use super::{MeshError, Soup, parse_error, point, range_check, words};
+use super::{MeshError, Soup, excerpt, parse_error, point, range_check, words};
 
 /// Parses STL bytes (ASCII or binary, see the module docs).
 pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Soup, MeshError> {
@@ -149,7 +149,10 @@ fn parse_ascii(path: &Path, text: &str) -> Result<Soup, MeshError> {
                     return Err(err(
                         ln,
                         col,
-                        format!("expected `facet normal nx ny nz`, found `{}`", raw.trim()),
+                        format!(
+                            "expected `facet normal nx ny nz`, found `{}`",
+                            excerpt(raw.trim())
+                        ),
                     ));
                 }
             }
@@ -161,7 +164,7 @@ fn parse_ascii(path: &Path, text: &str) -> Result<Soup, MeshError> {
                     return Err(err(
                         ln,
                         col,
-                        format!("expected `outer loop`, found `{}`", raw.trim()),
+                        format!("expected `outer loop`, found `{}`", excerpt(raw.trim())),
                     ));
                 }
                 state = State::InLoop;
@@ -175,7 +178,7 @@ fn parse_ascii(path: &Path, text: &str) -> Result<Soup, MeshError> {
                         col,
                         format!(
                             "expected `vertex x y z` with 3 numbers, found `{}`",
-                            raw.trim()
+                            excerpt(raw.trim())
                         ),
                     ));
                 }
@@ -206,7 +209,7 @@ fn parse_ascii(path: &Path, text: &str) -> Result<Soup, MeshError> {
                 return Err(err(
                     ln,
                     col,
-                    format!("expected {expected}, found `{}`", raw.trim()),
+                    format!("expected {expected}, found `{}`", excerpt(raw.trim())),
                 ));
             }
         }

@@ -22,7 +22,7 @@ use std::path::Path;
 use glam::{DAffine3, DMat3, DVec3};
 use quick_xml::events::{BytesStart, Event};
 
-use super::{MeshError, Soup, coord};
+use super::{MeshError, Soup, coord, excerpt};
 
 /// Largest model part read (uncompressed): refuses zip bombs.
 const MAX_PART_BYTES: u64 = 1 << 30;
@@ -132,8 +132,9 @@ fn index(e: &BytesStart, name: &str) -> Result<u64, String> {
     let s = required(e, name)?;
     s.trim().parse::<u64>().map_err(|_| {
         format!(
-            "<{}> attribute `{name}` = `{s}` is not a whole number from 0",
-            e.local_name().as_ref()
+            "<{}> attribute `{name}` = `{}` is not a whole number from 0",
+            e.local_name().as_ref(),
+            excerpt(&s)
         )
     })
 }
