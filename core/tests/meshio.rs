@@ -159,6 +159,16 @@ fn threemf_objects_components_transforms_and_unit() {
     // Inside the third item, 10 mm from its faces.
     assert!((m.signed_distance(DVec3::new(-10.0, 90.0, 10.0)) + 10.0).abs() < 1e-12);
     assert!((m.signed_distance(DVec3::new(-10.0, 90.0, 25.0)) - 5.0).abs() < 1e-12);
+
+    // pyvcad 2.3.4 (Assimp) on the unit cube in millimetres gives
+    // -0.5000001192092896 at its centre (an f32 grid value) and reads the
+    // same file in centimetres, or moved by a build item, unchanged: it
+    // ignores `unit` and build transforms, which the 3MF spec requires.
+    let model = writers::model("millimeter", &objects, "<item objectid=\"1\"/>");
+    let path = write(dir.path(), "cube.3mf", writers::threemf(&model));
+    let m = TriangleMesh::load(&path).unwrap();
+    let pyvcad = -0.5000001192092896;
+    assert!((m.signed_distance(DVec3::splat(0.5)) - pyvcad).abs() < 1e-6);
 }
 
 /// The cube `[-1, 1]³` without its top (+z) face, as OBJ.
