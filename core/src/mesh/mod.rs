@@ -25,7 +25,8 @@ mod candidates;
 mod certificate;
 mod coarse;
 mod distance;
-mod load;
+mod formats;
+mod gaps;
 mod topology;
 mod triangle;
 pub(crate) mod wide;
@@ -55,23 +56,71 @@ pub enum MeshError {
         /// The operating system's message.
         msg: String,
     },
-    /// The extension is neither `.obj` nor `.stl`.
-    #[error("{}: unsupported mesh format `.{extension}` (expected .obj or .stl)", .path.display())]
-    UnsupportedFormat {
+    /// The path is a folder, FIFO, socket or device (refused before opening:
+    /// reading a FIFO would block).
+    #[error("{}: is {kind}, not a regular file; give the path of a mesh file (STL, OBJ, PLY, OFF or 3MF)", .path.display())]
+    NotRegular {
         /// The file.
         path: PathBuf,
-        /// The extension found (lower case, may be empty).
-        extension: String,
+        /// What it is instead.
+        kind: &'static str,
     },
-    /// A text file (ASCII STL or OBJ) has a malformed line.
-    #[error("{}:{line}: {msg}", .path.display())]
+    /// The file has no bytes at all.
+    #[error("{}: the file is empty (0 bytes); expected a mesh (STL, OBJ, PLY, OFF or 3MF)", .path.display())]
+    EmptyFile {
+        /// The file.
+        path: PathBuf,
+    },
+    /// The content matches no format read here.
+    #[error("{}: not a mesh format read here (STL, OBJ, PLY, OFF or 3MF, told by content): {detail}", .path.display())]
+    UnknownFormat {
+        /// The file.
+        path: PathBuf,
+        /// What the content looked like.
+        detail: String,
+    },
+    /// A text format has a malformed line.
+    #[error("{}:{line}{}: {msg}", .path.display(), column_suffix(*.column))]
     Parse {
         /// The file.
         path: PathBuf,
         /// 1-based line number.
         line: usize,
+        /// 1-based column (0 when the whole line is meant).
+        column: usize,
         /// What was expected and what was found.
         msg: String,
+    },
+    /// A 3MF model part has a malformed element.
+    #[error("{} (in `{part}` line {line}, column {column}): {msg}", .path.display())]
+    ThreeMf {
+        /// The file.
+        path: PathBuf,
+        /// The model part inside the zip.
+        part: String,
+        /// 1-based line in the part.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// What is wrong.
+        msg: String,
+    },
+    /// The mesh has holes and validation was asked for.
+    #[error(
+        "{}: mesh is not closed: {open_edges} open edges (used by one triangle only); the largest gap, {gap_edges} edges around ({:.3}, {:.3}, {:.3}), spans {gap_size:.3} mm. Repair the mesh, or load it with disable_validation = true (`Mesh(\"{}\", m, true)`) to decide inside/outside by the generalized winding number",
+        .path.display(), .gap_center.x, .gap_center.y, .gap_center.z, .path.display()
+    )]
+    NotClosed {
+        /// The file.
+        path: PathBuf,
+        /// Edges used by exactly one triangle.
+        open_edges: usize,
+        /// Open edges around the largest gap.
+        gap_edges: usize,
+        /// Centre of the largest gap's bounding box.
+        gap_center: DVec3,
+        /// Diagonal of the largest gap's bounding box (mm).
+        gap_size: f64,
     },
     /// A binary STL is truncated, has trailing bytes or a non-finite value.
     #[error("{}: invalid binary STL: {msg}", .path.display())]
@@ -81,19 +130,14 @@ pub enum MeshError {
         /// What is wrong (sizes, triangle number).
         msg: String,
     },
-    /// The OBJ reader failed where no single line could be blamed.
-    #[error("{}: invalid OBJ: {msg}", .path.display())]
-    Obj {
-        /// The file.
-        path: PathBuf,
-        /// The reader's message.
-        msg: String,
-    },
-    /// The file parsed but holds no triangle.
-    #[error("{}: the file contains no triangles", .path.display())]
+    /// The file parsed but holds no triangle (none at all, or only
+    /// degenerate ones).
+    #[error("{}: {}", .path.display(), empty_reason(*.read))]
     Empty {
         /// The file.
         path: PathBuf,
+        /// Triangles read before degenerate ones were dropped.
+        read: usize,
     },
     /// The file parsed but its contents were rejected by
     /// [`TriangleMesh::from_triangles`].
@@ -127,6 +171,23 @@ pub enum MeshError {
         /// Its coordinates.
         position: DVec3,
     },
+}
+
+fn empty_reason(read: usize) -> String {
+    if read == 0 {
+        "the file contains no triangles".into()
+    } else {
+        format!("all {read} triangles of the file have a repeated corner: there is no surface")
+    }
+}
+
+/// `":column"` for a known column, nothing for 0.
+fn column_suffix(column: usize) -> String {
+    if column > 0 {
+        format!(":{column}")
+    } else {
+        String::new()
+    }
 }
 
 /// A triangle mesh prepared for exact signed-distance queries. Immutable and
@@ -168,20 +229,47 @@ struct PseudoNormals {
 }
 
 impl TriangleMesh {
-    /// Loads an `.obj` (via `tobj`, polygons triangulated) or `.stl` (binary
-    /// or ASCII) file. Identical vertex positions are welded, so an STL's
-    /// shared edges are recognised. Problems that still allow a distance
-    /// field (holes, …) become [`TriangleMesh::warnings`], not errors.
+    /// Loads a mesh file: STL (ASCII or binary), OBJ, PLY (ASCII or
+    /// binary), OFF or 3MF, told by content (`formats`). Identical vertex
+    /// positions are welded, so an STL's shared edges are recognised;
+    /// triangles with a repeated corner and repeated copies of a triangle are
+    /// dropped. Problems that still allow a distance field (holes, …) become
+    /// [`TriangleMesh::warnings`], not errors: call
+    /// [`TriangleMesh::check_closed`] to refuse open meshes.
     pub fn load(path: &Path) -> Result<TriangleMesh, MeshError> {
-        let (vertices, triangles) = load::load(path)?;
-        if triangles.is_empty() {
+        let loaded = formats::load(path)?;
+        if loaded.triangles.is_empty() {
             return Err(MeshError::Empty {
                 path: path.to_path_buf(),
+                read: loaded.read_triangles,
             });
         }
-        Self::from_triangles(vertices, triangles).map_err(|e| MeshError::Invalid {
+        let mut mesh = Self::from_triangles(loaded.vertices, loaded.triangles).map_err(|e| {
+            MeshError::Invalid {
+                path: path.to_path_buf(),
+                msg: e.to_string(),
+            }
+        })?;
+        let mut warnings = loaded.warnings;
+        warnings.append(&mut mesh.warnings);
+        mesh.warnings = warnings;
+        Ok(mesh)
+    }
+
+    /// Refuses a mesh with open edges (pyvcad's validation: "Mesh is not
+    /// closed"), naming how many and where the largest gap is; `path` is the
+    /// file to name.
+    pub fn check_closed(&self, path: &Path) -> Result<(), MeshError> {
+        if self.topology.boundary_edges == 0 {
+            return Ok(());
+        }
+        let gap = gaps::largest(&self.vertices, &self.triangles);
+        Err(MeshError::NotClosed {
             path: path.to_path_buf(),
-            msg: e.to_string(),
+            open_edges: self.topology.boundary_edges,
+            gap_edges: gap.edges,
+            gap_center: gap.center,
+            gap_size: gap.size,
         })
     }
 

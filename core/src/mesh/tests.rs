@@ -6,6 +6,11 @@ use std::path::PathBuf;
 use glam::DVec3;
 
 use super::{MeshError, TriangleMesh};
+
+/// The format writers of the integration tests (`core/tests/meshio`).
+#[allow(dead_code)]
+#[path = "../../tests/meshio/writers.rs"]
+mod writers;
 use crate::bounds::Aabb;
 
 const BUNNY: &str = concat!(
@@ -533,43 +538,13 @@ pub(crate) fn temp_path(name: &str) -> PathBuf {
     ))
 }
 
-fn ascii_stl(v: &[DVec3], t: &[[u32; 3]]) -> String {
-    let mut s = String::from("solid cube\n");
-    for tri in t {
-        s += "  facet normal 0 0 0\n    outer loop\n";
-        for &i in tri {
-            let p = v[i as usize];
-            s += &format!("      vertex {} {} {}\n", p.x, p.y, p.z);
-        }
-        s += "    endloop\n  endfacet\n";
-    }
-    s + "endsolid cube\n"
-}
-
-fn binary_stl(v: &[DVec3], t: &[[u32; 3]]) -> Vec<u8> {
-    let mut b = b"solid but actually binary".to_vec();
-    b.resize(80, b' ');
-    b.extend_from_slice(&(t.len() as u32).to_le_bytes());
-    for tri in t {
-        b.extend_from_slice(&[0u8; 12]);
-        for &i in tri {
-            let p = v[i as usize];
-            for x in [p.x, p.y, p.z] {
-                b.extend_from_slice(&(x as f32).to_le_bytes());
-            }
-        }
-        b.extend_from_slice(&[0u8; 2]);
-    }
-    b
-}
-
 #[test]
 fn stl_ascii_and_binary_load_and_weld() {
     let (v, t) = cube(None);
     let a = temp_path("cube_ascii.stl");
     let b = temp_path("cube_binary.STL");
-    std::fs::write(&a, ascii_stl(&v, &t)).unwrap();
-    std::fs::write(&b, binary_stl(&v, &t)).unwrap();
+    std::fs::write(&a, writers::stl_ascii(&v, &t)).unwrap();
+    std::fs::write(&b, writers::stl_binary(&v, &t)).unwrap();
     for path in [&a, &b] {
         let m = TriangleMesh::load(path).unwrap();
         assert_eq!(m.triangle_count(), 12);
@@ -581,7 +556,7 @@ fn stl_ascii_and_binary_load_and_weld() {
     }
     // Open cube as STL: boundary edges are counted after welding.
     let (v, t) = cube(Some(0));
-    std::fs::write(&a, ascii_stl(&v, &t)).unwrap();
+    std::fs::write(&a, writers::stl_ascii(&v, &t)).unwrap();
     let m = TriangleMesh::load(&a).unwrap();
     assert_eq!(m.boundary_edge_count(), 4);
     assert!(m.is_inside(DVec3::ZERO));
@@ -594,14 +569,20 @@ fn stl_ascii_and_binary_load_and_weld() {
 fn broken_files_report_line_or_size() {
     let (v, t) = cube(None);
     let path = temp_path("broken.stl");
-    let text = ascii_stl(&v, &t).replacen("vertex -1 -1 -1", "vertex -1 abc -1", 1);
+    let text = writers::stl_ascii(&v, &t).replacen("vertex -1 -1 -1", "vertex -1 abc -1", 1);
     let line = text.lines().position(|l| l.contains("abc")).unwrap() + 1;
+    let col = text.lines().nth(line - 1).unwrap().find("abc").unwrap() + 1;
     std::fs::write(&path, &text).unwrap();
     let e = TriangleMesh::load(&path).unwrap_err();
     match &e {
-        MeshError::Parse { line: l, msg, .. } => {
-            assert_eq!(*l, line);
-            assert!(msg.contains("vertex x y z"), "{msg}");
+        MeshError::Parse {
+            line: l,
+            column,
+            msg,
+            ..
+        } => {
+            assert_eq!((*l, *column), (line, col));
+            assert_eq!(msg, "`abc` is not a number");
         }
         other => panic!("{other}"),
     }
@@ -610,7 +591,7 @@ fn broken_files_report_line_or_size() {
         "{e}"
     );
 
-    let mut bin = binary_stl(&v, &t);
+    let mut bin = writers::stl_binary(&v, &t);
     bin.truncate(bin.len() - 7);
     std::fs::write(&path, &bin).unwrap();
     let e = TriangleMesh::load(&path).unwrap_err();
@@ -635,8 +616,12 @@ fn broken_files_report_line_or_size() {
 
     let e = TriangleMesh::load(&temp_path("missing.obj")).unwrap_err();
     assert!(matches!(e, MeshError::Io { .. }), "{e}");
-    let e = TriangleMesh::load(&temp_path("mesh.ply")).unwrap_err();
-    assert!(matches!(e, MeshError::UnsupportedFormat { .. }), "{e}");
+    // Binary bytes of no format, whatever the name says.
+    let junk = temp_path("mesh.ply");
+    std::fs::write(&junk, [0u8, 1, 2, 3, 0xff, 0xfe, 7, 0]).unwrap();
+    let e = TriangleMesh::load(&junk).unwrap_err();
+    assert!(matches!(e, MeshError::UnknownFormat { .. }), "{e}");
+    let _ = std::fs::remove_file(&junk);
 }
 
 /// Throughput of `signed_distance` on the bunny for points within 2 mm of

@@ -25,29 +25,7 @@ pub(super) fn register(engine: &mut Engine, ctx: &RunContext) {
         },
     );
 
-    let c = ctx.clone();
-    let mesh = move |cc: &Ctx, path: &str, m: Option<&Dynamic>| -> RResult<Node> {
-        let p = cc.call_position();
-        let full = c.resolve(path, p)?;
-        let mesh = file_cache::cached(&[&full], || crate::mesh::TriangleMesh::load(&full))
-            .or_else(|e| fail(p, e.to_string()))?;
-        {
-            let mut st = c.lock();
-            for w in mesh.warnings() {
-                st.warnings.push(format!("Mesh(\"{path}\"): {w}"));
-            }
-        }
-        let material = m.map_or(Ok(1), |m| material(m, p))?;
-        Ok(Node::with_origin(
-            NodeKind::Mesh { mesh, material },
-            origin(p),
-        ))
-    };
-    let m1 = mesh.clone();
-    engine.register_fn("Mesh", move |cc: Ctx, path: &str| m1(&cc, path, None));
-    engine.register_fn("Mesh", move |cc: Ctx, path: &str, m: Dynamic| {
-        mesh(&cc, path, Some(&m))
-    });
+    register_mesh(engine, ctx);
 
     let c = ctx.clone();
     engine.register_fn(
@@ -96,6 +74,122 @@ pub(super) fn register(engine: &mut Engine, ctx: &RunContext) {
             Ok(Node::with_origin(NodeKind::SimulationField { field, exprs, materials: mats }, origin(p)))
         },
     );
+}
+
+/// `Mesh(path)`, `Mesh(path, m)`, `Mesh(path, m, disable_validation)`,
+/// `Mesh(path, sample_size)`, `Mesh(path, sample_size, m)` and
+/// `Mesh(path, sample_size, m, disable_validation)`: pyvcad 2.3.4's two
+/// constructors (OPENVCAD.md §2). `sample_size` is checked and otherwise
+/// not needed: distances come from the triangles exactly, not from a grid.
+fn register_mesh(engine: &mut Engine, ctx: &RunContext) {
+    let c = ctx.clone();
+    let mesh = move |cc: &Ctx, path: &str, args: &[&Dynamic]| -> RResult<Node> {
+        let p = cc.call_position();
+        let form = MeshArgs::parse(args, p)?;
+        let full = c.resolve(path, p)?;
+        let mesh = file_cache::cached(&[&full], || crate::mesh::TriangleMesh::load(&full))
+            .or_else(|e| fail(p, e.to_string()))?;
+        if form.validate {
+            // Named as the script wrote it, so the suggested call is one to paste.
+            mesh.check_closed(std::path::Path::new(path))
+                .or_else(|e| fail(p, e.to_string()))?;
+        }
+        {
+            let mut st = c.lock();
+            for w in mesh.warnings() {
+                st.warnings.push(format!("Mesh(\"{path}\"): {w}"));
+            }
+        }
+        Ok(Node::with_origin(
+            NodeKind::Mesh {
+                mesh,
+                material: form.material,
+            },
+            origin(p),
+        ))
+    };
+    let (m1, m2, m3) = (mesh.clone(), mesh.clone(), mesh.clone());
+    engine.register_fn("Mesh", move |cc: Ctx, path: &str| m1(&cc, path, &[]));
+    engine.register_fn("Mesh", move |cc: Ctx, path: &str, a: Dynamic| {
+        m2(&cc, path, &[&a])
+    });
+    engine.register_fn(
+        "Mesh",
+        move |cc: Ctx, path: &str, a: Dynamic, b: Dynamic| m3(&cc, path, &[&a, &b]),
+    );
+    engine.register_fn(
+        "Mesh",
+        move |cc: Ctx, path: &str, a: Dynamic, b: Dynamic, d: Dynamic| {
+            mesh(&cc, path, &[&a, &b, &d])
+        },
+    );
+}
+
+/// The arguments after a `Mesh` path.
+struct MeshArgs {
+    material: u8,
+    validate: bool,
+}
+
+impl MeshArgs {
+    const FORMS: &str = "Mesh(path), Mesh(path, m), Mesh(path, m, disable_validation) or Mesh(path, Vec3 sample_size, m, disable_validation)";
+
+    fn parse(args: &[&Dynamic], p: rhai::Position) -> RResult<MeshArgs> {
+        // The second form starts with a Vec3 sample size.
+        let rest = match args.first() {
+            Some(a) if a.is::<Vec3>() => {
+                let s = vec3(a, "Mesh: sample_size (argument 2)", p)?;
+                if !(s.is_finite() && s.min_element() > 0.0) {
+                    return fail(
+                        p,
+                        format!(
+                            "Mesh: sample_size (argument 2) must be positive in x, y and z, got Vec3({}, {}, {})",
+                            s.x, s.y, s.z
+                        ),
+                    );
+                }
+                &args[1..]
+            }
+            _ if args.len() == 3 => {
+                return fail(
+                    p,
+                    format!(
+                        "Mesh: with 4 arguments the second is the sample size, a Vec3; got {}. Write {}",
+                        described(args[0]),
+                        Self::FORMS
+                    ),
+                );
+            }
+            _ => args,
+        };
+        let first = args.len() - rest.len() + 2; // 1-based position of rest[0]
+        let material = match rest.first() {
+            None => 1,
+            Some(m) => material(m, p).map_err(|e| match *e {
+                rhai::EvalAltResult::ErrorRuntime(msg, pos) => {
+                    Box::new(rhai::EvalAltResult::ErrorRuntime(
+                        format!("Mesh: argument {first} (the material): {msg}").into(),
+                        pos,
+                    ))
+                }
+                other => Box::new(other),
+            })?,
+        };
+        let validate = match rest.get(1) {
+            None => true,
+            Some(d) => !d.as_bool().or_else(|_| {
+                fail(
+                    p,
+                    format!(
+                        "Mesh: argument {} is disable_validation and must be true or false, got {}",
+                        first + 1,
+                        described(d)
+                    ),
+                )
+            })?,
+        };
+        Ok(MeshArgs { material, validate })
+    }
 }
 
 /// A CSV with a header row into an array of maps (column name -> value);

@@ -211,8 +211,13 @@ pub static FUNCTIONS: &[FnDoc] = &[
     f!(
         "Mesh",
         Data,
-        ["Mesh(path: string)", "Mesh(path: string, material: int)"],
-        "A closed triangle mesh (OBJ, STL) as exact signed distance.",
+        [
+            "Mesh(path: string)",
+            "Mesh(path: string, material: int)",
+            "Mesh(path: string, material: int, disable_validation: bool)",
+            "Mesh(path: string, sample_size: Vec3, material: int, disable_validation: bool)"
+        ],
+        "A triangle mesh (STL, OBJ, PLY, OFF, 3MF, told by content) as exact signed distance; an open one is refused unless validation is disabled (then the winding number decides inside).",
         "Mesh(\"part.obj\", m.id(\"red\"))",
         ""
     ),
