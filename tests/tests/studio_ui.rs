@@ -770,3 +770,45 @@ fn save_as_falls_back_to_the_built_in_file_browser() {
     let log = h.state().log_lines().join("\n");
     assert!(log.contains("built-in file browser"), "{log}");
 }
+
+/// Slider values saved as a named set beside the design come back when the
+/// design is opened again, and the command line can use the same file.
+#[test]
+fn parameter_sets_are_saved_beside_the_design_and_restored() {
+    let script = r#"let m = default_materials();
+let w = param("width", 15.0, 5.0, 30.0);
+RectPrism(Vec3(0, 0, 0), Vec3(w, 10, 5), m.id("gray"))"#;
+    let (scratch, mut h) = studio(BAR, "param-sets");
+    let file = scratch.path().join("plate.rhai");
+    std::fs::write(&file, script).expect("write plate.rhai");
+    let ctx = h.ctx.clone();
+    h.state_mut().open_path(&ctx, file.clone());
+    wait_for(&mut h, "the plate", |a| {
+        a.is_idle() && bbox_x(a) == Some(15.0)
+    });
+    h.get_by_role_and_label(Role::Slider, "width")
+        .set_value_accesskit(22.0);
+    wait_for(&mut h, "the new width", |a| {
+        bbox_x(a).is_some_and(|x| (x - 22.0).abs() < 1e-9)
+    });
+    h.get_by_label("Set name").focus();
+    h.step();
+    h.get_by_label("Set name").type_text("wide");
+    h.step();
+    h.get_by_label("Save set").click();
+    h.run_steps(2);
+    let sets = scratch.path().join("plate.params.json");
+    let text = std::fs::read_to_string(&sets).expect("plate.params.json written");
+    assert!(
+        text.contains("\"wide\"") && text.contains("\"22\""),
+        "{text}"
+    );
+    drop(h);
+    // Opened again in a new studio: the sliders come back as saved.
+    let mut h2 = harness(StudioOptions::for_tests(scratch.path().join("data2"), BAR));
+    let ctx = h2.ctx.clone();
+    h2.state_mut().open_path(&ctx, file);
+    wait_for(&mut h2, "the saved width", |a| {
+        a.is_idle() && bbox_x(a).is_some_and(|x| (x - 22.0).abs() < 1e-9)
+    });
+}

@@ -143,7 +143,9 @@ impl StudioApp {
         ));
         self.doc = doc;
         self.editor.set_text(ctx, text);
-        self.params.clear();
+        if let Err(e) = self.params.open_sets(self.doc.path.as_deref()) {
+            self.bottom.log(format!("parameter sets not read: {e}"));
+        }
         self.recovery.clear();
         self.error = None;
         self.viewport.fit_next();
@@ -178,6 +180,7 @@ impl StudioApp {
         match self.doc.save_as(&path, &text) {
             Ok(()) => {
                 self.settings.add_recent(&path);
+                self.params.moved_to(&path);
                 self.recovery.clear();
                 self.bottom.log(format!("saved {}", path.display()));
                 true
@@ -471,7 +474,9 @@ impl StudioApp {
             .log("restored unsaved work from the recovery file");
         self.doc = doc;
         self.editor.set_text(ctx, r.text);
-        self.params.clear();
+        if let Err(e) = self.params.open_sets(self.doc.path.as_deref()) {
+            self.bottom.log(format!("parameter sets not read: {e}"));
+        }
         self.viewport.fit_next();
         self.run_now();
     }

@@ -536,7 +536,11 @@ impl StudioApp {
                     .as_ref()
                     .map(|g| g.params.clone())
                     .unwrap_or_default();
-                if self.params.ui(ui, &params) {
+                let (log, changed) = self.params.ui(ui, &params);
+                if let Some(line) = log {
+                    self.bottom.log(line);
+                }
+                if changed {
                     self.run_now();
                 }
             });

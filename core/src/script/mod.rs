@@ -15,6 +15,7 @@ mod file_cache;
 mod files_api;
 mod leaves_api;
 mod nodes_api;
+pub mod param_sets;
 mod query_api;
 pub mod read_policy;
 pub mod reference;
