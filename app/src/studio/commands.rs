@@ -354,7 +354,10 @@ impl StudioApp {
             });
             ui.menu_button("Examples", |ui| {
                 for e in examples::all() {
-                    if ui.button(&e.title).on_hover_text(e.file).clicked() {
+                    if ui
+                        .add(egui::Button::new(&e.title).shortcut_text(e.file))
+                        .clicked()
+                    {
                         self.request(&ctx, Pending::Example(e.file));
                     }
                 }
@@ -385,6 +388,10 @@ impl StudioApp {
             return;
         };
         let mut close = false;
+        // Enter takes the highlighted (first, safe) choice; Escape cancels,
+        // keeping everything as it was.
+        let enter = ctx.input_mut(|i| i.consume_key(Modifiers::NONE, Key::Enter));
+        let esc = ctx.input_mut(|i| i.consume_key(Modifiers::NONE, Key::Escape));
         egui::Modal::new(egui::Id::unique("studio-modal")).show(ctx, |ui| {
             ui.set_max_width(440.0);
             match &modal {
@@ -392,7 +399,7 @@ impl StudioApp {
                     ui.heading("Unsaved changes");
                     ui.label(format!("Save the changes to {} first?", self.doc.name()));
                     ui.horizontal(|ui| {
-                        if ui.button("Save").clicked() {
+                        if ui.button("Save").clicked() || enter {
                             close = true;
                             if self.doc.path.is_some() {
                                 if self.save(ctx) {
@@ -409,7 +416,7 @@ impl StudioApp {
                             self.doc.saved_text = self.editor.text.clone();
                             self.perform(ctx, p.clone());
                         }
-                        if ui.button("Cancel").clicked() {
+                        if ui.button("Cancel").clicked() || esc {
                             close = true;
                         }
                     });
@@ -425,13 +432,18 @@ impl StudioApp {
                         r.text.lines().count()
                     ));
                     ui.horizontal(|ui| {
-                        if ui.button("Restore").clicked() {
+                        if ui.button("Restore").clicked() || enter {
                             close = true;
                             self.restore(ctx, r.clone());
                         }
                         if ui.button("Discard").clicked() {
                             close = true;
                             self.recovery.clear();
+                        }
+                        // Escape decides nothing: the file is offered again
+                        // next time.
+                        if ui.button("Later").clicked() || esc {
+                            close = true;
                         }
                     });
                 }
@@ -444,14 +456,14 @@ impl StudioApp {
                             self.jobs.cancel_all();
                             self.quit(ctx);
                         }
-                        if ui.button("Keep working").clicked() {
+                        if ui.button("Keep working").clicked() || enter || esc {
                             close = true;
                         }
                     });
                 }
                 Modal::Message(m) => {
                     ui.label(m);
-                    if ui.button("OK").clicked() {
+                    if ui.button("OK").clicked() || enter || esc {
                         close = true;
                     }
                 }

@@ -67,10 +67,24 @@ fn title(file: &str, source: &str) -> String {
     let first = source.lines().next().unwrap_or_default().trim();
     if let Some(c) = first.strip_prefix("//") {
         let c = c.trim_start_matches('/').trim();
-        // "Graded bar: red to blue" → "Graded bar"
-        let c = c.split([':', '.', '—']).next().unwrap_or(c).trim();
-        if !c.is_empty() && c.len() <= 48 {
-            return c.to_owned();
+        // "Graded bar: red to blue" → "Graded bar"; but a heading that only
+        // says where it comes from ("Paper listing 3: a colour sheet",
+        // "Lattice grading (b): per unit cell") gives way to what follows.
+        let mut parts = c.splitn(2, ':');
+        let head = parts.next().unwrap_or(c).trim();
+        let says_what =
+            |h: &str| !(h.starts_with("Paper listing") || h.starts_with("Lattice grading"));
+        let c = match parts.next() {
+            Some(rest) if !says_what(head) => rest,
+            _ => head,
+        };
+        let c = c.split(['.', '—', ':']).next().unwrap_or(c).trim();
+        if !c.is_empty() && c.len() <= 60 {
+            let mut chars = c.chars();
+            return chars
+                .next()
+                .map(|f| f.to_uppercase().chain(chars).collect())
+                .unwrap_or_default();
         }
     }
     let stem = file.trim_end_matches(".rhai").replace(['_', '-'], " ");
@@ -116,5 +130,15 @@ mod tests {
             title("bcc_lattice_sphere.rhai", "let m = 1;"),
             "Bcc lattice sphere"
         );
+        assert_eq!(
+            title(
+                "s.rhai",
+                "// Paper listing 3: a 12 x 12 colour calibration sheet (cyan).\n"
+            ),
+            "A 12 x 12 colour calibration sheet (cyan)"
+        );
+        for e in all() {
+            assert!(!e.title.starts_with("Paper listing"), "{}", e.title);
+        }
     }
 }

@@ -32,6 +32,8 @@ pub struct Job {
     /// Its state.
     pub state: JobState,
     handle: Option<JobHandle>,
+    /// "Open folder" found no file manager: why, shown at the button.
+    open_failed: Option<String>,
 }
 
 impl Job {
@@ -56,6 +58,7 @@ impl Jobs {
             dest,
             state: JobState::Running(None),
             handle: Some(handle),
+            open_failed: None,
         });
     }
 
@@ -101,9 +104,9 @@ impl Jobs {
                 };
                 finished.push(match &j.state {
                     JobState::Done(s) => format!(
-                        "{} done: {} files in {:.1} s, {}",
+                        "{} done: {} in {:.1} s, {}",
                         j.title,
-                        s.files.len(),
+                        count(s.files.len(), "file"),
                         s.seconds,
                         j.dest.display()
                     ),
@@ -129,7 +132,7 @@ impl Jobs {
     pub fn ui(&mut self, ui: &mut egui::Ui) -> Vec<String> {
         let mut notes = Vec::new();
         let mut remove = None;
-        for (i, j) in self.list.iter().enumerate().rev() {
+        for (i, j) in self.list.iter_mut().enumerate().rev() {
             ui.push_id(("job", i), |ui| {
                 ui.group(|ui| {
                     ui.horizontal(|ui| {
@@ -161,12 +164,23 @@ impl Jobs {
                                 if ui.button("Open folder").clicked()
                                     && let Err(e) = files::open_folder(&j.dest)
                                 {
+                                    j.open_failed = Some(e.clone());
                                     notes.push(e);
                                 }
                                 if ui.small_button("Dismiss").clicked() {
                                     remove = Some(i);
                                 }
                             });
+                            if let Some(e) = &j.open_failed {
+                                ui.colored_label(ui.visuals().warn_fg_color, e);
+                                ui.horizontal(|ui| {
+                                    let path = j.dest.display().to_string();
+                                    ui.monospace(&path);
+                                    if ui.small_button("Copy path").clicked() {
+                                        ui.ctx().copy_text(path);
+                                    }
+                                });
+                            }
                         }
                         JobState::Cancelled => {
                             ui.weak("Cancelled; nothing was written.");
@@ -218,11 +232,20 @@ pub fn duration_text(d: Duration) -> String {
     }
 }
 
+/// "1 file", "2 files".
+pub fn count(n: usize, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
+}
+
 fn summary_text(s: &Summary) -> String {
     let mut t = format!(
-        "Done in {}: {} files",
+        "Done in {}: {}",
         duration_text(Duration::from_secs_f64(s.seconds)),
-        s.files.len()
+        count(s.files.len(), "file")
     );
     if s.units > 0 {
         t += &format!(", {} {}", s.units, s.unit);
