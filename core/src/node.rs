@@ -180,6 +180,14 @@ pub enum NodeKind {
         exprs: Vec<Arc<Expr>>,
         materials: Vec<MaterialId>,
     },
+    /// Text outlines (laid out and flattened by `crate::text`) extruded by
+    /// `depth` centred on z = 0.
+    Text {
+        text: String,
+        shape: Arc<crate::model::polygon2d::Polygon2d>,
+        depth: f64,
+        material: MaterialId,
+    },
 }
 
 impl NodeKind {
@@ -207,6 +215,7 @@ impl NodeKind {
             NodeKind::Blend { .. } => "Blend",
             NodeKind::Mesh { .. } => "Mesh",
             NodeKind::SimulationField { .. } => "SimulationField",
+            NodeKind::Text { .. } => "Text",
         }
     }
 
@@ -222,7 +231,8 @@ impl NodeKind {
             | NodeKind::Function { material, .. }
             | NodeKind::Tpms { material, .. }
             | NodeKind::GraphLattice { material, .. }
-            | NodeKind::Mesh { material, .. } => std::slice::from_ref(material),
+            | NodeKind::Mesh { material, .. }
+            | NodeKind::Text { material, .. } => std::slice::from_ref(material),
             NodeKind::FGrade { materials, .. } | NodeKind::SimulationField { materials, .. } => {
                 materials
             }

@@ -123,6 +123,7 @@ impl PNode {
             | PNode::Prism { .. }
             | PNode::Lattice { .. }
             | PNode::Mesh { .. }
+            | PNode::Text { .. }
             | PNode::SimField(_) => true,
             PNode::Function { .. } | PNode::Tpms { .. } | PNode::Tile { .. } => false,
             PNode::Translate { child, .. }
@@ -145,7 +146,10 @@ impl PNode {
             PNode::Sphere { .. } | PNode::Box { .. } | PNode::Cylinder { .. } => {
                 primitive(self, b).unwrap_or_else(|| lipschitz(self, b))
             }
-            PNode::Strut { .. } | PNode::Prism { .. } | PNode::Lattice { .. } => lipschitz(self, b),
+            PNode::Strut { .. }
+            | PNode::Prism { .. }
+            | PNode::Lattice { .. }
+            | PNode::Text { .. } => lipschitz(self, b),
             PNode::Mesh { mesh, .. } => mesh_interval(mesh, b),
             PNode::SimField(g) => mesh_interval(g.field.boundary_mesh(), b),
             PNode::Function {

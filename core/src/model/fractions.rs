@@ -99,7 +99,8 @@ impl PNode {
             | PNode::Function { m, .. }
             | PNode::Tpms { m, .. }
             | PNode::Lattice { m, .. }
-            | PNode::Mesh { m, .. } => Some(*m),
+            | PNode::Mesh { m, .. }
+            | PNode::Text { m, .. } => Some(*m),
             _ => None,
         }
     }

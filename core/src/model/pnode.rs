@@ -194,6 +194,12 @@ pub enum PNode {
         m: Slot,
     },
     SimField(Box<SimGrade>),
+    /// Text outlines extruded between z = ±hz.
+    Text {
+        shape: Arc<super::polygon2d::Polygon2d>,
+        hz: f64,
+        m: Slot,
+    },
 }
 
 /// Union or intersection over many children.
@@ -346,6 +352,10 @@ impl PNode {
             PNode::Blend { child, .. } => child.dist(p),
             PNode::Mesh { mesh, .. } => mesh.signed_distance(p),
             PNode::SimField(s) => s.field.signed_distance(p),
+            PNode::Text { shape, hz, .. } => sdf::extrude(
+                shape.signed_distance(DVec2::new(p.x, p.y)),
+                p.z.abs() - *hz,
+            ),
         }
     }
 }

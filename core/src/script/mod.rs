@@ -14,6 +14,7 @@ mod file_cache;
 mod files_api;
 mod leaves_api;
 mod nodes_api;
+mod text_api;
 mod values;
 
 use std::collections::HashMap;
@@ -410,6 +411,7 @@ fn build_engine(ctx: &RunContext, opts: &ScriptOptions) -> Engine {
     nodes_api::register_composites(&mut engine);
     nodes_api::register_methods(&mut engine);
     files_api::register(&mut engine, ctx);
+    text_api::register(&mut engine, ctx);
     bulk::register(&mut engine, opts.max_heap);
 
     let params = ctx.clone();
