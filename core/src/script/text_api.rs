@@ -86,7 +86,7 @@ fn enum_arg<T: Clone + 'static>(
                 fail(
                     pos,
                     format!(
-                        "Text: {what} must be a {enum_name} (for example {enum_name}.{}), got {}",
+                        "Text: {what} must be a {enum_name} (for example {enum_name}::{}), got {}",
                         example(enum_name),
                         described(v)
                     ),
