@@ -157,7 +157,10 @@ fn bicycle_seat() {
 fn text_label() {
     let m = example("text_label.rhai");
     let b = m.bbox();
-    assert!((b.max.z - 0.8).abs() < 1e-12 && (b.min.z + 2.0).abs() < 1e-12, "{b:?}");
+    assert!(
+        (b.max.z - 0.8).abs() < 1e-12 && (b.min.z + 2.0).abs() < 1e-12,
+        "{b:?}"
+    );
     // Above the plate's top face: red letters along the first line, air
     // between the two lines; the plate itself is gray.
     let red = (0..400)

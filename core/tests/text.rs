@@ -59,7 +59,8 @@ fn brute(contours: &[Vec<DVec2>], p: DVec2) -> f64 {
 }
 
 fn model(src: &str) -> (Model, Vec<String>) {
-    let d = run_script(src, "text.rhai", &ScriptOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let d =
+        run_script(src, "text.rhai", &ScriptOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     let m = Model::prepare(&d.root, d.materials.clone()).unwrap_or_else(|e| panic!("{e}"));
     (m, d.warnings)
 }
@@ -86,14 +87,16 @@ fn glyph_distances_match_brute_force() {
 
 #[test]
 fn the_node_is_the_extruded_polygon() {
-    let (m, warnings) = model(r#"Text("Volcad\nlabel", 8.0, 1.5, 1, FontAspect::Regular, "DejaVu Sans")"#);
+    let (m, warnings) =
+        model(r#"Text("Volcad\nlabel", 8.0, 1.5, 1, FontAspect::Regular, "DejaVu Sans")"#);
     assert!(warnings.is_empty(), "{warnings:?}");
     let o = centred_at("Volcad\nlabel", 8.0);
     let b = m.bbox();
     assert_eq!((b.min.z, b.max.z), (-0.75, 0.75));
     let mut rng = XorShift::new(5);
     for _ in 0..2000 {
-        let p = b.min - 1.0 + (b.size() + 2.0) * DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64());
+        let p = b.min - 1.0
+            + (b.size() + 2.0) * DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64());
         let d2 = brute(&o.contours, DVec2::new(p.x, p.y));
         let dz = p.z.abs() - 0.75;
         let want = d2.max(dz).min(0.0) + DVec2::new(d2, dz).max(DVec2::ZERO).length();
@@ -120,7 +123,12 @@ fn interval_bounds_contain_samples() {
         for _ in 0..20 {
             let p = b.min + b.size() * DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64());
             let d = m.distance(p);
-            assert!(i.lo <= d && d <= i.hi, "{d} outside [{}, {}] over {b:?}", i.lo, i.hi);
+            assert!(
+                i.lo <= d && d <= i.hi,
+                "{d} outside [{}, {}] over {b:?}",
+                i.lo,
+                i.hi
+            );
         }
     }
 }
@@ -139,12 +147,42 @@ fn layout_matches_pyvcad() {
         ("H\nH", H::Center, V::Center, [-2.778, -9.282, 2.778, 9.648]),
         ("H\nH", H::Center, V::Bottom, [-2.778, 0.0, 2.778, 18.931]),
         ("H\nH", H::Center, V::Top, [-2.778, -20.923, 2.778, -1.992]),
-        ("H\nH", H::Center, V::Top_First_Line, [-2.778, -11.641, 2.778, 7.29]),
-        ("HH\nH", H::Center, V::Center, [-6.538, -9.282, 6.538, 9.648]),
-        ("Hello", H::Center, V::Center, [-11.692, -3.604, 12.126, 4.136]),
-        ("AV", H::Left, V::Top_First_Line, [0.0781, 0.0, 12.959, 7.29]),
-        ("To", H::Left, V::Top_First_Line, [-0.0293, -0.1416, 9.9805, 7.29]),
-        ("Hello", H::Left, V::Top_First_Line, [0.9814, -0.1416, 24.7998, 7.5977]),
+        (
+            "H\nH",
+            H::Center,
+            V::Top_First_Line,
+            [-2.778, -11.641, 2.778, 7.29],
+        ),
+        (
+            "HH\nH",
+            H::Center,
+            V::Center,
+            [-6.538, -9.282, 6.538, 9.648],
+        ),
+        (
+            "Hello",
+            H::Center,
+            V::Center,
+            [-11.692, -3.604, 12.126, 4.136],
+        ),
+        (
+            "AV",
+            H::Left,
+            V::Top_First_Line,
+            [0.0781, 0.0, 12.959, 7.29],
+        ),
+        (
+            "To",
+            H::Left,
+            V::Top_First_Line,
+            [-0.0293, -0.1416, 9.9805, 7.29],
+        ),
+        (
+            "Hello",
+            H::Left,
+            V::Top_First_Line,
+            [0.9814, -0.1416, 24.7998, 7.5977],
+        ),
     ];
     for (text, h, v, want) in cases {
         let o = outline(text, &style(*h, *v)).unwrap();
@@ -153,7 +191,10 @@ fn layout_matches_pyvcad() {
         for k in 0..4 {
             // pyvcad's figures are rounded to 1e-3 or 1e-4; curves are
             // flattened to within 5 µm.
-            assert!((got[k] - want[k]).abs() < 2e-3, "{text:?} {h:?} {v:?}: {got:?} vs {want:?}");
+            assert!(
+                (got[k] - want[k]).abs() < 2e-3,
+                "{text:?} {h:?} {v:?}: {got:?} vs {want:?}"
+            );
         }
     }
 }
@@ -195,18 +236,41 @@ fn lines_are_aligned_one_by_one() {
 fn inside_agrees_with_pyvcad() {
     let (m, _) = model(r#"Text("Ag\nB", 10.0, 2.0, 1, FontAspect::Regular, "DejaVu Sans")"#);
     let probes = [
-        (-2.62, 0.885, false), (-1.3, 2.078, false), (1.257, -8.689, true),
-        (-4.868, 6.749, false), (-2.406, -5.313, true), (4.956, -0.595, false),
-        (3.365, -0.473, false), (1.391, -6.988, false), (1.349, 7.361, false),
-        (0.232, 4.825, false), (1.714, -8.719, true), (2.582, 1.822, false),
-        (-1.987, -9.38, false), (3.655, -0.545, false), (2.188, 7.576, true),
-        (2.141, 8.422, false), (-1.05, 6.018, false), (-0.554, 8.712, false),
-        (3.789, -8.051, false), (-3.64, -5.66, false), (4.655, -1.277, false),
-        (1.266, -3.979, false), (0.072, -2.283, true), (-1.491, 1.701, false),
+        (-2.62, 0.885, false),
+        (-1.3, 2.078, false),
+        (1.257, -8.689, true),
+        (-4.868, 6.749, false),
+        (-2.406, -5.313, true),
+        (4.956, -0.595, false),
+        (3.365, -0.473, false),
+        (1.391, -6.988, false),
+        (1.349, 7.361, false),
+        (0.232, 4.825, false),
+        (1.714, -8.719, true),
+        (2.582, 1.822, false),
+        (-1.987, -9.38, false),
+        (3.655, -0.545, false),
+        (2.188, 7.576, true),
+        (2.141, 8.422, false),
+        (-1.05, 6.018, false),
+        (-0.554, 8.712, false),
+        (3.789, -8.051, false),
+        (-3.64, -5.66, false),
+        (4.655, -1.277, false),
+        (1.266, -3.979, false),
+        (0.072, -2.283, true),
+        (-1.491, 1.701, false),
     ];
+    // docs/PYVCAD.md's way to pyvcad's orientation: probe as pyvcad was.
+    let (turned, _) = model(
+        r#"Rotate(0, 0, 180, Vec3(0, 0, 0),
+                  Text("Ag\nB", 10.0, 2.0, 1, FontAspect::Regular, "DejaVu Sans"))"#,
+    );
     for (x, y, inside) in probes {
         let d = m.distance(DVec3::new(x, y, 0.0));
         assert_eq!(d <= 0.0, inside, "({x}, {y}): {d}");
+        let d = turned.distance(DVec3::new(-x, -y, 0.0));
+        assert_eq!(d <= 0.0, inside, "turned ({x}, {y}): {d}");
     }
 }
 
@@ -215,7 +279,10 @@ fn defaults_and_enums_follow_pyvcad() {
     // pyvcad's defaults: material 1, Regular, "Consolas", centred both ways.
     let (m, warnings) = model(r#"Text("H", 10.0, 2.0)"#);
     let b = m.bbox();
-    assert!((b.min.x + 2.778).abs() < 2e-3 && (b.max.y - 3.828).abs() < 2e-3, "{b:?}");
+    assert!(
+        (b.min.x + 2.778).abs() < 2e-3 && (b.max.y - 3.828).abs() < 2e-3,
+        "{b:?}"
+    );
     if warnings.iter().any(|w| w.contains("Consolas")) {
         assert!(warnings[0].contains("line 1:1"), "{warnings:?}");
     }
@@ -237,11 +304,22 @@ fn bad_inputs_say_what_to_write() {
     let e = script_error(r#"Text("   ", 10.0, 2.0, 1, FontAspect::Regular, "DejaVu Sans")"#);
     assert!(e.contains("no visible glyph"), "{e}");
     let e = script_error(r#"Text(42, 10.0, 2.0)"#);
-    assert!(e.contains("must be the text as a string, got an integer"), "{e}");
+    assert!(
+        e.contains("must be the text as a string, got an integer"),
+        "{e}"
+    );
     let e = script_error(r#"Text("A", 10.0, 2.0, 1, "Bold")"#);
-    assert!(e.contains("aspect (5th argument) must be a FontAspect"), "{e}");
-    let e = script_error(r#"Text("A", 10.0, 2.0, 1, FontAspect::Bold, "DejaVu Sans", VerticalAlignment::Top)"#);
-    assert!(e.contains("h_align (7th argument) must be a HorizontalAlignment"), "{e}");
+    assert!(
+        e.contains("aspect (5th argument) must be a FontAspect"),
+        "{e}"
+    );
+    let e = script_error(
+        r#"Text("A", 10.0, 2.0, 1, FontAspect::Bold, "DejaVu Sans", VerticalAlignment::Top)"#,
+    );
+    assert!(
+        e.contains("h_align (7th argument) must be a HorizontalAlignment"),
+        "{e}"
+    );
     let long = "x".repeat(volcad_core::text::MAX_CHARS + 1);
     let e = script_error(&format!("Text(\"{long}\", 1.0, 1.0)"));
     assert!(e.contains("at most 10000"), "{e}");
@@ -256,7 +334,10 @@ fn unknown_family_falls_back_with_a_warning() {
     );
     assert_eq!(warnings.len(), 1, "{warnings:?}");
     let w = &warnings[0];
-    assert!(w.contains("line 2:17") && w.contains("\"No Such Family 7\"") && w.contains("DejaVu Sans"), "{w}");
+    assert!(
+        w.contains("line 2:17") && w.contains("\"No Such Family 7\"") && w.contains("DejaVu Sans"),
+        "{w}"
+    );
     // The fallback is the same outline as asking for DejaVu Sans.
     let (d, _) = model(r#"Text("Hi", 10.0, 2.0, 1, FontAspect::Regular, "DejaVu Sans")"#);
     assert_eq!(format!("{:?}", m.bbox()), format!("{:?}", d.bbox()));
@@ -266,7 +347,10 @@ fn unknown_family_falls_back_with_a_warning() {
 fn missing_glyphs_warn_and_leave_a_gap() {
     let (m, warnings) = model(r#"Text("A中B", 10.0, 2.0, 1, FontAspect::Regular, "DejaVu Sans")"#);
     assert_eq!(warnings.len(), 1, "{warnings:?}");
-    assert!(warnings[0].contains("U+4E2D") && warnings[0].contains("DejaVu Sans"), "{warnings:?}");
+    assert!(
+        warnings[0].contains("U+4E2D") && warnings[0].contains("DejaVu Sans"),
+        "{warnings:?}"
+    );
     let (ab, _) = model(r#"Text("AB", 10.0, 2.0, 1, FontAspect::Regular, "DejaVu Sans")"#);
     assert!(m.bbox().size().x > ab.bbox().size().x + 2.0);
 }

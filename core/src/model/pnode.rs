@@ -352,10 +352,9 @@ impl PNode {
             PNode::Blend { child, .. } => child.dist(p),
             PNode::Mesh { mesh, .. } => mesh.signed_distance(p),
             PNode::SimField(s) => s.field.signed_distance(p),
-            PNode::Text { shape, hz, .. } => sdf::extrude(
-                shape.signed_distance(DVec2::new(p.x, p.y)),
-                p.z.abs() - *hz,
-            ),
+            PNode::Text { shape, hz, .. } => {
+                sdf::extrude(shape.signed_distance(DVec2::new(p.x, p.y)), p.z.abs() - *hz)
+            }
         }
     }
 }

@@ -147,7 +147,9 @@ impl Polygon2d {
     /// About `2·√n` bands: a band then holds a few edges of each contour it
     /// passes through.
     fn build_bands(&mut self) {
-        let bands = ((self.edges.len() as f64).sqrt() * 2.0).ceil().clamp(1.0, 4096.0) as usize;
+        let bands = ((self.edges.len() as f64).sqrt() * 2.0)
+            .ceil()
+            .clamp(1.0, 4096.0) as usize;
         let height = (self.hi.y - self.lo.y).max(f64::MIN_POSITIVE);
         self.band_h = height / bands as f64;
         self.bands = bands;

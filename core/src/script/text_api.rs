@@ -21,54 +21,19 @@ pub(super) fn register(engine: &mut Engine, ctx: &RunContext) {
     register_enums(engine);
     let c = ctx.clone();
     let text = move |cc: &Ctx, args: &[Dynamic]| -> RResult<Node> { make(cc, &c, args) };
-    // Every pyvcad arity from (text, height, depth) up to all eight.
-    let t = text.clone();
-    engine.register_fn("Text", move |c: Ctx, a: Dynamic, b: Dynamic, d: Dynamic| {
-        t(&c, &[a, b, d])
-    });
-    let t = text.clone();
-    engine.register_fn(
-        "Text",
-        move |c: Ctx, a: Dynamic, b: Dynamic, d: Dynamic, m: Dynamic| t(&c, &[a, b, d, m]),
-    );
-    let t = text.clone();
-    engine.register_fn(
-        "Text",
-        move |c: Ctx, a: Dynamic, b: Dynamic, d: Dynamic, m: Dynamic, f: Dynamic| {
-            t(&c, &[a, b, d, m, f])
-        },
-    );
-    let t = text.clone();
-    engine.register_fn(
-        "Text",
-        move |c: Ctx, a: Dynamic, b: Dynamic, d: Dynamic, m: Dynamic, f: Dynamic, n: Dynamic| {
-            t(&c, &[a, b, d, m, f, n])
-        },
-    );
-    let t = text.clone();
-    engine.register_fn(
-        "Text",
-        move |c: Ctx,
-              a: Dynamic,
-              b: Dynamic,
-              d: Dynamic,
-              m: Dynamic,
-              f: Dynamic,
-              n: Dynamic,
-              h: Dynamic| t(&c, &[a, b, d, m, f, n, h]),
-    );
-    engine.register_fn(
-        "Text",
-        move |c: Ctx,
-              a: Dynamic,
-              b: Dynamic,
-              d: Dynamic,
-              m: Dynamic,
-              f: Dynamic,
-              n: Dynamic,
-              h: Dynamic,
-              v: Dynamic| text(&c, &[a, b, d, m, f, n, h, v]),
-    );
+    // Every pyvcad arity, from (text, height, depth) up to all eight.
+    macro_rules! arity {
+        ($($arg:ident),+) => {{
+            let t = text.clone();
+            engine.register_fn("Text", move |c: Ctx, $($arg: Dynamic),+| t(&c, &[$($arg),+]));
+        }};
+    }
+    arity!(a, b, d);
+    arity!(a, b, d, m);
+    arity!(a, b, d, m, f);
+    arity!(a, b, d, m, f, n);
+    arity!(a, b, d, m, f, n, h);
+    arity!(a, b, d, m, f, n, h, v);
 }
 
 /// An enum argument, or pyvcad's default when absent.

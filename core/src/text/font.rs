@@ -9,7 +9,7 @@ use super::FontAspect;
 
 /// DejaVu Sans 2.37 (Bitstream Vera licence, `assets/fonts/`), the family
 /// pyvcad falls back to on Linux.
-static BUNDLED: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans.ttf");
+pub(super) static BUNDLED: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans.ttf");
 
 /// The bundled font's family name.
 pub const BUNDLED_FAMILY: &str = "DejaVu Sans";
@@ -62,9 +62,9 @@ fn system_face(family: &str, aspect: FontAspect) -> Option<(fontdb::ID, bool)> {
 /// Run `f` on the font for `family` and `aspect`, with the family name it
 /// used. Order: the bundled font for its own family in the regular
 /// aspect (the same outlines on every machine); else the machine's face;
-/// else DejaVu Sans (the machine's in the asked aspect if it has one, else
-/// the bundled regular face), with a warning that names the family asked
-/// for. `Err` only when the font data cannot be parsed.
+/// else, with a warning that names the family asked for, DejaVu Sans: the
+/// built-in face for `Regular`, the machine's face for another aspect if
+/// it has one. `Err` only when the font data cannot be parsed.
 pub fn with_font<T>(
     family: &str,
     aspect: FontAspect,
@@ -93,13 +93,16 @@ pub fn with_font<T>(
                      {BUNDLED_FAMILY} (give an installed family, or install the font)"
                 ));
             }
-            match system_face(BUNDLED_FAMILY, aspect).filter(|(_, exact)| *exact) {
+            let styled = (aspect != FontAspect::Regular)
+                .then(|| system_face(BUNDLED_FAMILY, aspect))
+                .flatten();
+            match styled.filter(|(_, exact)| *exact) {
                 Some((id, _)) => (Some(id), BUNDLED_FAMILY.to_owned()),
                 None => {
                     if aspect != FontAspect::Regular {
                         warnings.push(format!(
                             "the built-in {BUNDLED_FAMILY} has only its regular face; \
-                             FontAspect.{} is drawn regular",
+                             FontAspect::{} is drawn regular",
                             aspect.name()
                         ));
                     }

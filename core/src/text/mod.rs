@@ -293,7 +293,10 @@ impl ttf_parser::OutlineBuilder for Flattener<'_> {
             let t = k as f64 / n as f64;
             let u = 1.0 - t;
             self.push(
-                p0 * (u * u * u) + p1 * (3.0 * u * u * t) + p2 * (3.0 * u * t * t) + p3 * (t * t * t),
+                p0 * (u * u * u)
+                    + p1 * (3.0 * u * u * t)
+                    + p2 * (3.0 * u * t * t)
+                    + p3 * (t * t * t),
             );
         }
     }
