@@ -6,11 +6,14 @@
 //!   [`LEAF`] edges, children visited nearer first, pruned by the squared
 //!   box distance).
 //! * Sign: the non-zero winding rule (TrueType's and CFF's fill rule), from
-//!   the crossings of a horizontal ray, half-open in y so a ray through a
-//!   vertex counts it once. Edges are bucketed by horizontal bands and
-//!   sorted by x, so a point only tests the edges of its band on the side
-//!   of its shorter ray (the crossings on the two sides sum to zero for
-//!   closed contours).
+//!   the crossings of one axis-parallel ray, half-open across it so a ray
+//!   through a vertex counts it once. Edges are bucketed by bands of rows
+//!   and of columns, each sorted along its rays, and a point scans the
+//!   shortest of its four rays: the edges of its row band right or left of
+//!   it, or of its column band above or below it (the crossings on the two
+//!   sides of a line sum to zero for closed contours). A line of text is
+//!   wide and short, so a vertical ray meets a few edges where a
+//!   horizontal one would meet the whole line's.
 //!
 //! Outside the region the value is the exact distance to it. Inside, where
 //! contours overlap, an edge of one contour may lie inside another and the
@@ -47,18 +50,136 @@ impl Edge {
         self.a.max(self.b)
     }
 
-    /// +1 or −1 when the horizontal line through `y` crosses the edge
-    /// upward or downward (half-open: `[min y, max y)`), with the crossing's
-    /// x clamped to the edge's x range so every scan agrees on its side.
+    /// Where the line `p[axis] = c` crosses the edge (half-open: `[min,
+    /// max)` along `axis`), along the other axis and clamped to the edge's
+    /// range there so every scan agrees on its side, with the crossing's
+    /// winding sign for a ray toward + along the other axis: +1 for an
+    /// edge passing the ray counter-clockwise.
     #[inline]
-    fn crossing(&self, y: f64) -> Option<(f64, i32)> {
+    fn crossing(&self, axis: usize, c: f64) -> Option<(f64, i32)> {
         let (a, b) = (self.a, self.b);
-        if (a.y <= y) == (b.y <= y) {
+        let j = 1 - axis;
+        if (a[axis] <= c) == (b[axis] <= c) {
             return None;
         }
-        let x = a.x + (y - a.y) * (b.x - a.x) / (b.y - a.y);
-        let x = x.clamp(a.x.min(b.x), a.x.max(b.x));
-        Some((x, if b.y > a.y { 1 } else { -1 }))
+        let t = a[j] + (c - a[axis]) * (b[j] - a[j]) / (b[axis] - a[axis]);
+        let t = t.clamp(a[j].min(b[j]), a[j].max(b[j]));
+        let up = b[axis] > a[axis];
+        // Rows: upward edges pass a rightward ray counter-clockwise;
+        // columns: leftward edges pass an upward ray so.
+        Some((t, if up == (axis == 1) { 1 } else { -1 }))
+    }
+}
+
+/// Edges bucketed by bands across one axis, for rays along the other.
+#[derive(Clone, Debug)]
+struct Bands {
+    /// The axis the bands divide (1: rows, rays along x; 0: columns).
+    axis: usize,
+    lo: f64,
+    h: f64,
+    n: usize,
+    /// `start[i]..start[i + 1]` indexes band `i`'s entries.
+    start: Vec<u32>,
+    /// Per band, edges by decreasing maximum along the rays (the forward
+    /// ray's candidates are a prefix), with that maximum.
+    by_high: Vec<(f64, u32)>,
+    /// Per band, edges by increasing minimum along the rays, with it.
+    by_low: Vec<(f64, u32)>,
+}
+
+impl Bands {
+    /// About `2·√n` bands: a band then holds a few edges of each contour
+    /// it passes through.
+    fn new(edges: &[Edge], lo: DVec2, hi: DVec2, axis: usize) -> Self {
+        let n = ((edges.len() as f64).sqrt() * 2.0)
+            .ceil()
+            .clamp(1.0, 4096.0) as usize;
+        let span = (hi[axis] - lo[axis]).max(f64::MIN_POSITIVE);
+        let mut bands = Bands {
+            axis,
+            lo: lo[axis],
+            h: span / n as f64,
+            n,
+            start: vec![0],
+            by_high: Vec::new(),
+            by_low: Vec::new(),
+        };
+        let mut lists: Vec<Vec<u32>> = vec![Vec::new(); n];
+        for (i, e) in edges.iter().enumerate() {
+            let (b0, b1) = (bands.band(e.lo()[axis]), bands.band(e.hi()[axis]));
+            for list in &mut lists[b0..=b1] {
+                list.push(i as u32);
+            }
+        }
+        let j = 1 - axis;
+        for list in &lists {
+            let mut high: Vec<(f64, u32)> = list
+                .iter()
+                .map(|&i| (edges[i as usize].hi()[j], i))
+                .collect();
+            high.sort_by(|a, b| b.0.total_cmp(&a.0));
+            let mut low: Vec<(f64, u32)> = list
+                .iter()
+                .map(|&i| (edges[i as usize].lo()[j], i))
+                .collect();
+            low.sort_by(|a, b| a.0.total_cmp(&b.0));
+            bands.by_high.extend(high);
+            bands.by_low.extend(low);
+            bands.start.push(bands.by_high.len() as u32);
+        }
+        bands
+    }
+
+    #[inline]
+    fn band(&self, c: f64) -> usize {
+        let i = ((c - self.lo) / self.h).floor();
+        if i > 0.0 {
+            (i as usize).min(self.n - 1)
+        } else {
+            0
+        }
+    }
+
+    /// `p`'s band and the lengths of its forward and backward candidate
+    /// lists.
+    #[inline]
+    fn counts(&self, p: DVec2) -> (usize, usize, usize) {
+        let b = self.band(p[self.axis]);
+        let (s, e) = (self.start[b] as usize, self.start[b + 1] as usize);
+        let c = p[1 - self.axis];
+        (
+            b,
+            self.by_high[s..e].partition_point(|&(x, _)| x > c),
+            self.by_low[s..e].partition_point(|&(x, _)| x < c),
+        )
+    }
+
+    /// The winding number from the first `n` candidates of band `b` on one
+    /// side of `p`.
+    fn scan(&self, edges: &[Edge], p: DVec2, b: usize, forward: bool, n: usize) -> i32 {
+        let s = self.start[b] as usize;
+        let (k, c) = (self.axis, p[1 - self.axis]);
+        let mut w = 0;
+        if forward {
+            for &(_, i) in &self.by_high[s..s + n] {
+                if let Some((t, sign)) = edges[i as usize].crossing(k, p[k])
+                    && t > c
+                {
+                    w += sign;
+                }
+            }
+        } else {
+            // Crossings before p and at or after it sum to zero.
+            for &(_, i) in &self.by_low[s..s + n] {
+                if let Some((t, sign)) = edges[i as usize].crossing(k, p[k])
+                    && t <= c
+                {
+                    w -= sign;
+                }
+            }
+        }
+        w
     }
 }
 
@@ -81,16 +202,8 @@ pub struct Polygon2d {
     nodes: Vec<BvhNode>,
     lo: DVec2,
     hi: DVec2,
-    /// Bands of equal height over `lo.y..hi.y`.
-    band_h: f64,
-    bands: usize,
-    /// `band_start[i]..band_start[i + 1]` indexes band `i`'s entries.
-    band_start: Vec<u32>,
-    /// Per band, edges by decreasing max x (the rightward ray's candidates
-    /// are a prefix), with that max x.
-    by_right: Vec<(f64, u32)>,
-    /// Per band, edges by increasing min x (the leftward ray's), with it.
-    by_left: Vec<(f64, u32)>,
+    rows: Bands,
+    cols: Bands,
 }
 
 impl Polygon2d {
@@ -119,19 +232,14 @@ impl Polygon2d {
         let n = edges.len();
         build(&mut edges, &mut nodes, 0, 0, n);
         let (lo, hi) = (nodes[0].lo, nodes[0].hi);
-        let mut poly = Polygon2d {
+        Some(Polygon2d {
+            rows: Bands::new(&edges, lo, hi, 1),
+            cols: Bands::new(&edges, lo, hi, 0),
             edges,
             nodes,
             lo,
             hi,
-            band_h: 1.0,
-            bands: 1,
-            band_start: Vec::new(),
-            by_right: Vec::new(),
-            by_left: Vec::new(),
-        };
-        poly.build_bands();
-        Some(poly)
+        })
     }
 
     /// Lower-left and upper-right corners of the edges' box.
@@ -144,81 +252,24 @@ impl Polygon2d {
         self.edges.len()
     }
 
-    /// About `2·√n` bands: a band then holds a few edges of each contour it
-    /// passes through.
-    fn build_bands(&mut self) {
-        let bands = ((self.edges.len() as f64).sqrt() * 2.0)
-            .ceil()
-            .clamp(1.0, 4096.0) as usize;
-        let height = (self.hi.y - self.lo.y).max(f64::MIN_POSITIVE);
-        self.band_h = height / bands as f64;
-        self.bands = bands;
-        let mut lists: Vec<Vec<u32>> = vec![Vec::new(); bands];
-        for (i, e) in self.edges.iter().enumerate() {
-            let (b0, b1) = (self.band_of(e.lo().y), self.band_of(e.hi().y));
-            for list in &mut lists[b0..=b1] {
-                list.push(i as u32);
-            }
-        }
-        self.band_start.push(0);
-        for list in &lists {
-            let mut right: Vec<(f64, u32)> = list
-                .iter()
-                .map(|&i| (self.edges[i as usize].hi().x, i))
-                .collect();
-            right.sort_by(|a, b| b.0.total_cmp(&a.0));
-            let mut left: Vec<(f64, u32)> = list
-                .iter()
-                .map(|&i| (self.edges[i as usize].lo().x, i))
-                .collect();
-            left.sort_by(|a, b| a.0.total_cmp(&b.0));
-            self.by_right.extend(right);
-            self.by_left.extend(left);
-            self.band_start.push(self.by_right.len() as u32);
-        }
-    }
-
-    #[inline]
-    fn band_of(&self, y: f64) -> usize {
-        let i = ((y - self.lo.y) / self.band_h).floor();
-        if i > 0.0 {
-            (i as usize).min(self.bands - 1)
-        } else {
-            0
-        }
-    }
-
-    /// The non-zero winding number of the contours around `p`.
+    /// The non-zero winding number of the contours around `p`, from the
+    /// shortest of its four rays.
     pub fn winding(&self, p: DVec2) -> i32 {
-        if !(p.y >= self.lo.y && p.y < self.hi.y && p.x >= self.lo.x && p.x <= self.hi.x) {
+        if !(p.y >= self.lo.y && p.y < self.hi.y && p.x >= self.lo.x && p.x < self.hi.x) {
             return 0;
         }
-        let b = self.band_of(p.y);
-        let (s, e) = (self.band_start[b] as usize, self.band_start[b + 1] as usize);
-        let right = &self.by_right[s..e];
-        let left = &self.by_left[s..e];
-        let n_right = right.partition_point(|&(x, _)| x > p.x);
-        let n_left = left.partition_point(|&(x, _)| x < p.x);
-        let mut w = 0;
-        if n_right <= n_left {
-            for &(_, i) in &right[..n_right] {
-                if let Some((x, s)) = self.edges[i as usize].crossing(p.y)
-                    && x > p.x
-                {
-                    w += s;
-                }
-            }
+        let (rb, right, left) = self.rows.counts(p);
+        let (cb, up, down) = self.cols.counts(p);
+        let least = right.min(left).min(up).min(down);
+        if least == right {
+            self.rows.scan(&self.edges, p, rb, true, right)
+        } else if least == left {
+            self.rows.scan(&self.edges, p, rb, false, left)
+        } else if least == up {
+            self.cols.scan(&self.edges, p, cb, true, up)
         } else {
-            // Crossings left of p and at or right of it sum to zero.
-            for &(_, i) in &left[..n_left] {
-                if let Some((x, s)) = self.edges[i as usize].crossing(p.y)
-                    && x <= p.x
-                {
-                    w -= s;
-                }
-            }
+            self.cols.scan(&self.edges, p, cb, false, down)
         }
-        w
     }
 
     /// Squared distance from `p` to the nearest edge.
@@ -357,6 +408,48 @@ mod tests {
             let p = DVec2::new(-3.0 + 13.0 * rng.next_f64(), -3.0 + 7.0 * rng.next_f64());
             let (got, want) = (poly.signed_distance(p), brute(&contours, p));
             assert!((got - want).abs() < 1e-12, "{p}: {got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn all_four_rays_agree() {
+        // Vertices on a 0.25 lattice, queried on the same lattice: rays
+        // through vertices and along edges at every turn.
+        let q = |x: f64, y: f64| DVec2::new(x, y);
+        let contours = vec![
+            vec![
+                q(0.0, 0.0),
+                q(2.0, 0.0),
+                q(2.0, 1.0),
+                q(1.0, 0.5),
+                q(0.0, 1.0),
+            ],
+            vec![q(0.25, 0.25), q(0.25, 0.5), q(0.5, 0.25)],
+            vec![q(3.0, 0.0), q(4.0, 1.0), q(3.0, 2.0), q(2.5, 1.0)],
+        ];
+        let poly = Polygon2d::new(&contours).unwrap();
+        for i in -2..=18 {
+            for j in -2..=10 {
+                let p = q(0.25 * f64::from(i), 0.25 * f64::from(j));
+                if poly.dist2(p) == 0.0 {
+                    continue; // on an edge: either answer is right
+                }
+                let want = i32::from(brute(&contours, p) < 0.0);
+                let inside = p.cmpge(poly.lo).all() && p.cmplt(poly.hi).all();
+                for bands in [&poly.rows, &poly.cols] {
+                    let (b, fwd, back) = bands.counts(p);
+                    let w = |f, n| {
+                        if inside {
+                            bands.scan(&poly.edges, p, b, f, n).abs()
+                        } else {
+                            0
+                        }
+                    };
+                    assert_eq!(w(true, fwd), want, "{p} forward, axis {}", bands.axis);
+                    assert_eq!(w(false, back), want, "{p} backward, axis {}", bands.axis);
+                }
+                assert_eq!(poly.winding(p).abs(), want, "{p}");
+            }
         }
     }
 
