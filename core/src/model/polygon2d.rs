@@ -200,6 +200,7 @@ pub struct Polygon2d {
     /// Edges in BVH leaf order.
     edges: Vec<Edge>,
     nodes: Vec<BvhNode>,
+    hints: Hints,
     lo: DVec2,
     hi: DVec2,
     rows: Bands,
@@ -232,14 +233,17 @@ impl Polygon2d {
         let n = edges.len();
         build(&mut edges, &mut nodes, 0, 0, n);
         let (lo, hi) = (nodes[0].lo, nodes[0].hi);
-        Some(Polygon2d {
+        let mut poly = Polygon2d {
+            hints: Hints::default(),
             rows: Bands::new(&edges, lo, hi, 1),
             cols: Bands::new(&edges, lo, hi, 0),
             edges,
             nodes,
             lo,
             hi,
-        })
+        };
+        poly.hints = Hints::new(&poly);
+        Some(poly)
     }
 
     /// Lower-left and upper-right corners of the edges' box.
@@ -274,19 +278,40 @@ impl Polygon2d {
 
     /// Squared distance from `p` to the nearest edge.
     pub fn dist2(&self, p: DVec2) -> f64 {
-        let mut best = f64::INFINITY;
-        let mut stack = [0u32; 64];
+        self.nearest(p, self.hints.first_guess(p, &self.edges)).0
+    }
+
+    /// The edge nearest `p` (index into `edges`; `u32::MAX` when none is
+    /// nearer than the bound).
+    fn nearest_edge(&self, p: DVec2) -> u32 {
+        self.nearest(p, f64::INFINITY).1
+    }
+
+    /// The squared distance to the nearest edge and its index, below a
+    /// known upper bound `best` (∞ for none).
+    fn nearest(&self, p: DVec2, mut best: f64) -> (f64, u32) {
+        let mut arg = u32::MAX;
+        // Entries carry their box distance, computed once by the parent.
+        let mut stack = [(0u32, 0.0f64); 64];
         let mut top = 1;
         while top > 0 {
             top -= 1;
-            let n = &self.nodes[stack[top] as usize];
-            if box_dist2(n, p) >= best {
+            let (i, d) = stack[top];
+            if d >= best {
                 continue;
             }
+            let n = &self.nodes[i as usize];
             if n.count > 0 {
                 let first = n.first as usize;
-                for e in &self.edges[first..first + n.count as usize] {
-                    best = crate::fastmath::min_plain(best, e.dist2(p));
+                for (k, e) in self.edges[first..first + n.count as usize]
+                    .iter()
+                    .enumerate()
+                {
+                    let d = e.dist2(p);
+                    if d < best {
+                        best = d;
+                        arg = (first + k) as u32;
+                    }
                 }
                 continue;
             }
@@ -296,14 +321,18 @@ impl Polygon2d {
                 box_dist2(&self.nodes[r as usize], p),
             );
             // The nearer child is popped first.
-            let (far, near) = if dl <= dr { (r, l) } else { (l, r) };
+            let (far, near) = if dl <= dr {
+                ((r, dr), (l, dl))
+            } else {
+                ((l, dl), (r, dr))
+            };
             if top + 2 <= stack.len() {
                 stack[top] = far;
                 stack[top + 1] = near;
                 top += 2;
             }
         }
-        best
+        (best, arg)
     }
 
     /// Signed distance: negative where the winding number is non-zero.
@@ -311,6 +340,60 @@ impl Polygon2d {
     pub fn signed_distance(&self, p: DVec2) -> f64 {
         let d = self.dist2(p).sqrt();
         if self.winding(p) != 0 { -d } else { d }
+    }
+}
+
+/// Per cell of a grid over the region's box, the edge nearest the cell's
+/// centre: its distance to a query point bounds the nearest distance from
+/// above by at most the cell's diagonal more than the answer, so the BVH
+/// walk prunes nearly every box at once.
+#[derive(Clone, Debug, Default)]
+struct Hints {
+    lo: DVec2,
+    inv: f64,
+    nx: usize,
+    ny: usize,
+    edge: Vec<u32>,
+}
+
+impl Hints {
+    /// About two cells per edge, at most 2²⁰.
+    fn new(poly: &Polygon2d) -> Self {
+        let size = (poly.hi - poly.lo).max(DVec2::splat(f64::MIN_POSITIVE));
+        let cells = (2 * poly.edges.len()).clamp(1, 1 << 20) as f64;
+        let side = (size.x * size.y / cells)
+            .sqrt()
+            .max(size.max_element() / 4096.0);
+        let nx = ((size.x / side).ceil() as usize).max(1);
+        let ny = ((size.y / side).ceil() as usize).max(1);
+        let mut edge = Vec::with_capacity(nx * ny);
+        for j in 0..ny {
+            for i in 0..nx {
+                let c = poly.lo + DVec2::new(i as f64 + 0.5, j as f64 + 0.5) * side;
+                edge.push(poly.nearest_edge(c));
+            }
+        }
+        Hints {
+            lo: poly.lo,
+            inv: 1.0 / side,
+            nx,
+            ny,
+            edge,
+        }
+    }
+
+    /// The squared distance from `p` to its cell's edge; ∞ outside the grid.
+    #[inline]
+    fn first_guess(&self, p: DVec2, edges: &[Edge]) -> f64 {
+        let q = (p - self.lo) * self.inv;
+        if !(q.x >= 0.0 && q.y >= 0.0 && q.x < self.nx as f64 && q.y < self.ny as f64) {
+            return f64::INFINITY;
+        }
+        let k = q.y as usize * self.nx + q.x as usize;
+        self.edge
+            .get(k)
+            .and_then(|&e| edges.get(e as usize))
+            .map_or(f64::INFINITY, |e| e.dist2(p))
     }
 }
 
