@@ -1,10 +1,12 @@
 //! Signed distance to a 2D region bounded by several closed contours (glyph
 //! outlines: outer contours and holes, letters that may touch or overlap).
 //!
-//! * Distance: the exact Euclidean distance to the nearest edge, found with
-//!   a bounding-volume hierarchy over the edges (boxes of at most
-//!   [`LEAF`] edges, children visited nearer first, pruned by the squared
-//!   box distance).
+//! * Distance: the exact Euclidean distance to the nearest edge. A grid of
+//!   about two cells per edge lists, per cell, every edge that can be
+//!   nearest to a point of it, sorted for an early stop ([`Cells`]); cells
+//!   far from every edge, and points outside the grid, walk a
+//!   bounding-volume hierarchy over the edges (boxes of at most [`LEAF`]
+//!   edges, nearer child first, pruned by the squared box distance).
 //! * Sign: the non-zero winding rule (TrueType's and CFF's fill rule), from
 //!   the crossings of one axis-parallel ray, half-open across it so a ray
 //!   through a vertex counts it once. Edges are bucketed by bands of rows
@@ -200,7 +202,7 @@ pub struct Polygon2d {
     /// Edges in BVH leaf order.
     edges: Vec<Edge>,
     nodes: Vec<BvhNode>,
-    hints: Hints,
+    cells: Cells,
     lo: DVec2,
     hi: DVec2,
     rows: Bands,
@@ -234,7 +236,7 @@ impl Polygon2d {
         build(&mut edges, &mut nodes, 0, 0, n);
         let (lo, hi) = (nodes[0].lo, nodes[0].hi);
         let mut poly = Polygon2d {
-            hints: Hints::default(),
+            cells: Cells::default(),
             rows: Bands::new(&edges, lo, hi, 1),
             cols: Bands::new(&edges, lo, hi, 0),
             edges,
@@ -242,7 +244,7 @@ impl Polygon2d {
             lo,
             hi,
         };
-        poly.hints = Hints::new(&poly);
+        poly.cells = Cells::new(&poly);
         Some(poly)
     }
 
@@ -278,13 +280,35 @@ impl Polygon2d {
 
     /// Squared distance from `p` to the nearest edge.
     pub fn dist2(&self, p: DVec2) -> f64 {
-        self.nearest(p, self.hints.first_guess(p, &self.edges)).0
+        match self.cells.nearest2(p, &self.edges) {
+            Ok(d2) => d2,
+            Err(bound) => self.nearest(p, bound).0,
+        }
     }
 
-    /// The edge nearest `p` (index into `edges`; `u32::MAX` when none is
-    /// nearer than the bound).
-    fn nearest_edge(&self, p: DVec2) -> u32 {
-        self.nearest(p, f64::INFINITY).1
+    /// The edges within squared distance `r2` of `c`, with their distances.
+    fn within(&self, c: DVec2, r2: f64, out: &mut Vec<(f64, u32)>) {
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let n = &self.nodes[stack[top] as usize];
+            if box_dist2(n, c) > r2 {
+                continue;
+            }
+            if n.count > 0 {
+                for k in n.first..n.first + n.count {
+                    let d2 = self.edges[k as usize].dist2(c);
+                    if d2 <= r2 {
+                        out.push((d2.sqrt(), k));
+                    }
+                }
+            } else if top + 2 <= stack.len() {
+                stack[top] = n.first;
+                stack[top + 1] = n.first + 1;
+                top += 2;
+            }
+        }
     }
 
     /// The squared distance to the nearest edge and its index, below a
@@ -343,20 +367,33 @@ impl Polygon2d {
     }
 }
 
-/// Per cell of a grid over the region's box, the edge nearest the cell's
-/// centre: its distance to a query point bounds the nearest distance from
-/// above by at most the cell's diagonal more than the answer, so the BVH
-/// walk prunes nearly every box at once.
+/// Most candidates a cell lists; a cell that would need more (far from
+/// every edge, where the query's ball is wide) keeps its centre's nearest
+/// edge as a first bound for the BVH walk instead.
+const CELL_CAP: usize = 48;
+
+/// A grid over the region's box whose cells list every edge that can be
+/// nearest to a point of the cell, by distance from the cell's centre c.
+/// Exact: for q in the cell (|q − c| ≤ r, the half diagonal) the nearest
+/// edge e* has d(q, e*) ≤ d(c) + r, so d(c, e*) ≤ d(c) + 2r, the list's
+/// reach; and d(q, e) ≥ d(c, e) − |q − c|, so the scan stops at the first
+/// entry whose bound reaches the best distance found.
 #[derive(Clone, Debug, Default)]
-struct Hints {
+struct Cells {
     lo: DVec2,
+    side: f64,
     inv: f64,
     nx: usize,
     ny: usize,
+    /// Per cell, `(start, len)` into the lists; `len == u32::MAX` marks a
+    /// full cell, whose `start` is its centre's nearest edge.
+    span: Vec<(u32, u32)>,
+    /// Distance from the cell's centre, and the edge.
+    dist: Vec<f64>,
     edge: Vec<u32>,
 }
 
-impl Hints {
+impl Cells {
     /// About two cells per edge, at most 2²⁰.
     fn new(poly: &Polygon2d) -> Self {
         let size = (poly.hi - poly.lo).max(DVec2::splat(f64::MIN_POSITIVE));
@@ -366,34 +403,66 @@ impl Hints {
             .max(size.max_element() / 4096.0);
         let nx = ((size.x / side).ceil() as usize).max(1);
         let ny = ((size.y / side).ceil() as usize).max(1);
-        let mut edge = Vec::with_capacity(nx * ny);
-        for j in 0..ny {
-            for i in 0..nx {
-                let c = poly.lo + DVec2::new(i as f64 + 0.5, j as f64 + 0.5) * side;
-                edge.push(poly.nearest_edge(c));
-            }
-        }
-        Hints {
+        let mut g = Cells {
             lo: poly.lo,
+            side,
             inv: 1.0 / side,
             nx,
             ny,
-            edge,
+            ..Cells::default()
+        };
+        let r = side * std::f64::consts::FRAC_1_SQRT_2;
+        let mut near = Vec::new();
+        for j in 0..ny {
+            for i in 0..nx {
+                let c = poly.lo + DVec2::new(i as f64 + 0.5, j as f64 + 0.5) * side;
+                let (d2, e) = poly.nearest(c, f64::INFINITY);
+                let reach = d2.sqrt() + 2.0 * r;
+                near.clear();
+                poly.within(c, reach * reach, &mut near);
+                if near.len() > CELL_CAP {
+                    g.span.push((e, u32::MAX));
+                    continue;
+                }
+                near.sort_by(|a, b| a.0.total_cmp(&b.0));
+                g.span.push((g.edge.len() as u32, near.len() as u32));
+                g.dist.extend(near.iter().map(|n| n.0));
+                g.edge.extend(near.iter().map(|n| n.1));
+            }
         }
+        g
     }
 
-    /// The squared distance from `p` to its cell's edge; ∞ outside the grid.
+    /// The squared distance from `p` to the nearest edge when `p`'s cell
+    /// lists its candidates (`Ok`), else an upper bound to start a walk
+    /// from (`Err`: ∞ outside the grid).
     #[inline]
-    fn first_guess(&self, p: DVec2, edges: &[Edge]) -> f64 {
+    fn nearest2(&self, p: DVec2, edges: &[Edge]) -> Result<f64, f64> {
         let q = (p - self.lo) * self.inv;
         if !(q.x >= 0.0 && q.y >= 0.0 && q.x < self.nx as f64 && q.y < self.ny as f64) {
-            return f64::INFINITY;
+            return Err(f64::INFINITY);
         }
-        let k = q.y as usize * self.nx + q.x as usize;
-        self.edge
-            .get(k)
-            .and_then(|&e| edges.get(e as usize))
-            .map_or(f64::INFINITY, |e| e.dist2(p))
+        let (i, j) = (q.x as usize, q.y as usize);
+        let Some(&(start, len)) = self.span.get(j * self.nx + i) else {
+            return Err(f64::INFINITY);
+        };
+        if len == u32::MAX {
+            return Err(edges
+                .get(start as usize)
+                .map_or(f64::INFINITY, |e| e.dist2(p)));
+        }
+        let c = self.lo + DVec2::new(i as f64 + 0.5, j as f64 + 0.5) * self.side;
+        let pc = (p - c).length();
+        let mut best = f64::INFINITY;
+        let (s, n) = (start as usize, len as usize);
+        for (&dc, &e) in self.dist[s..s + n].iter().zip(&self.edge[s..s + n]) {
+            let lower = dc - pc;
+            if lower > 0.0 && lower * lower >= best {
+                break;
+            }
+            best = best.min(edges[e as usize].dist2(p));
+        }
+        Ok(best)
     }
 }
 
@@ -491,6 +560,28 @@ mod tests {
             let p = DVec2::new(-3.0 + 13.0 * rng.next_f64(), -3.0 + 7.0 * rng.next_f64());
             let (got, want) = (poly.signed_distance(p), brute(&contours, p));
             assert!((got - want).abs() < 1e-12, "{p}: {got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn listed_and_full_cells_are_exact() {
+        let style = crate::text::TextStyle {
+            height: 4.0,
+            aspect: crate::text::FontAspect::Regular,
+            font: "DejaVu Sans".into(),
+            h_align: crate::text::HorizontalAlignment::Left,
+            v_align: crate::text::VerticalAlignment::Top,
+        };
+        let o = crate::text::outline("Wide gaps\n\n\n  between  lines", &style).unwrap();
+        let poly = Polygon2d::new(&o.contours).unwrap();
+        let full = poly.cells.span.iter().filter(|s| s.1 == u32::MAX).count();
+        assert!(full > 0 && full < poly.cells.span.len(), "{full}");
+        let mut rng = XorShift::new(21);
+        let (lo, hi) = poly.bounds();
+        for _ in 0..3000 {
+            let p = lo + (hi - lo) * DVec2::new(rng.next_f64(), rng.next_f64());
+            let want = brute(&o.contours, p);
+            assert!((poly.signed_distance(p) - want).abs() < 1e-12, "{p}");
         }
     }
 
