@@ -24,6 +24,7 @@
 //! minimum is 0), so `d(centre) ± half diagonal` bounds it over a box.
 
 use glam::DVec2;
+use rayon::prelude::*;
 
 /// Most edges in a BVH leaf.
 const LEAF: usize = 4;
@@ -412,22 +413,36 @@ impl Cells {
             ..Cells::default()
         };
         let r = side * std::f64::consts::FRAC_1_SQRT_2;
-        let mut near = Vec::new();
-        for j in 0..ny {
-            for i in 0..nx {
-                let c = poly.lo + DVec2::new(i as f64 + 0.5, j as f64 + 0.5) * side;
-                let (d2, e) = poly.nearest(c, f64::INFINITY);
-                let reach = d2.sqrt() + 2.0 * r;
-                near.clear();
-                poly.within(c, reach * reach, &mut near);
-                if near.len() > CELL_CAP {
-                    g.span.push((e, u32::MAX));
-                    continue;
+        // Rows in parallel (a paragraph has tens of thousands of cells),
+        // merged in order, so the lists do not depend on the thread count.
+        let rows: Vec<Vec<Result<Vec<(f64, u32)>, u32>>> = (0..ny)
+            .into_par_iter()
+            .map(|j| {
+                let mut near = Vec::new();
+                (0..nx)
+                    .map(|i| {
+                        let c = poly.lo + DVec2::new(i as f64 + 0.5, j as f64 + 0.5) * side;
+                        let (d2, e) = poly.nearest(c, f64::INFINITY);
+                        let reach = d2.sqrt() + 2.0 * r;
+                        near.clear();
+                        poly.within(c, reach * reach, &mut near);
+                        if near.len() > CELL_CAP {
+                            return Err(e);
+                        }
+                        near.sort_by(|a, b| a.0.total_cmp(&b.0));
+                        Ok(near.clone())
+                    })
+                    .collect()
+            })
+            .collect();
+        for cell in rows.into_iter().flatten() {
+            match cell {
+                Err(e) => g.span.push((e, u32::MAX)),
+                Ok(list) => {
+                    g.span.push((g.edge.len() as u32, list.len() as u32));
+                    g.dist.extend(list.iter().map(|n| n.0));
+                    g.edge.extend(list.iter().map(|n| n.1));
                 }
-                near.sort_by(|a, b| a.0.total_cmp(&b.0));
-                g.span.push((g.edge.len() as u32, near.len() as u32));
-                g.dist.extend(near.iter().map(|n| n.0));
-                g.edge.extend(near.iter().map(|n| n.1));
             }
         }
         g
