@@ -373,6 +373,10 @@ impl Polygon2d {
 /// edge as a first bound for the BVH walk instead.
 const CELL_CAP: usize = 48;
 
+/// One cell's candidates (distance from its centre, edge), or, for a full
+/// cell, its centre's nearest edge.
+type CellList = Result<Vec<(f64, u32)>, u32>;
+
 /// A grid over the region's box whose cells list every edge that can be
 /// nearest to a point of the cell, by distance from the cell's centre c.
 /// Exact: for q in the cell (|q − c| ≤ r, the half diagonal) the nearest
@@ -415,7 +419,7 @@ impl Cells {
         let r = side * std::f64::consts::FRAC_1_SQRT_2;
         // Rows in parallel (a paragraph has tens of thousands of cells),
         // merged in order, so the lists do not depend on the thread count.
-        let rows: Vec<Vec<Result<Vec<(f64, u32)>, u32>>> = (0..ny)
+        let rows: Vec<Vec<CellList>> = (0..ny)
             .into_par_iter()
             .map(|j| {
                 let mut near = Vec::new();
