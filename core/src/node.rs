@@ -237,6 +237,14 @@ pub enum NodeKind {
     Identity { child: Option<Node> },
     /// `Σ dᵢ + iso`; fractions of the first child containing the point.
     Sum { iso: f64, children: Vec<Node> },
+    /// Text outlines (laid out and flattened by `crate::text`) extruded by
+    /// `depth` centred on z = 0.
+    Text {
+        text: String,
+        shape: Arc<crate::model::polygon2d::Polygon2d>,
+        depth: f64,
+        material: MaterialId,
+    },
 }
 
 impl NodeKind {
@@ -271,6 +279,7 @@ impl NodeKind {
             NodeKind::Mirror { .. } => "Mirror",
             NodeKind::Identity { .. } => "Identity",
             NodeKind::Sum { .. } => "Sum",
+            NodeKind::Text { .. } => "Text",
         }
     }
 
@@ -290,7 +299,8 @@ impl NodeKind {
             | NodeKind::Cone { material, .. }
             | NodeKind::Torus { material, .. }
             | NodeKind::PolygonRevolve { material, .. }
-            | NodeKind::TaperedStrut { material, .. } => std::slice::from_ref(material),
+            | NodeKind::TaperedStrut { material, .. }
+            | NodeKind::Text { material, .. } => std::slice::from_ref(material),
             NodeKind::FGrade { materials, .. } | NodeKind::SimulationField { materials, .. } => {
                 materials
             }

@@ -152,3 +152,23 @@ fn bicycle_seat() {
     let nose = frac(&m, DVec3::new(240.0, 0.0, 5.0), "VeroCyan");
     assert!(wing > 0.6 && nose < 0.1, "wing {wing}, nose {nose}");
 }
+
+#[test]
+fn text_label() {
+    let m = example("text_label.rhai");
+    let b = m.bbox();
+    assert!(
+        (b.max.z - 0.8).abs() < 1e-12 && (b.min.z + 2.0).abs() < 1e-12,
+        "{b:?}"
+    );
+    // Above the plate's top face: red letters along the first line, air
+    // between the two lines; the plate itself is gray.
+    let red = (0..400)
+        .map(|i| DVec3::new(-20.0 + 0.1 * f64::from(i), 4.0, 0.5))
+        .filter(|p| m.distance(*p) < 0.0)
+        .inspect(|p| assert_eq!(frac(&m, *p, "red"), 1.0))
+        .count();
+    assert!(red > 40, "{red}");
+    assert!(m.distance(DVec3::new(0.0, 0.0, 0.5)) > 0.0);
+    assert_eq!(frac(&m, DVec3::new(-28.0, -10.0, -1.0), "gray"), 1.0);
+}

@@ -129,6 +129,7 @@ impl PNode {
             | PNode::Lattice { .. }
             | PNode::Mesh { .. }
             | PNode::SimField(_)
+            | PNode::Text { .. }
             | PNode::Shape { .. } => true,
             // A sum of n distances changes up to n times as fast.
             PNode::Sum { children, .. } => children.len() == 1 && children[0].is_lipschitz(),
@@ -157,7 +158,8 @@ impl PNode {
             PNode::Strut { .. }
             | PNode::Prism { .. }
             | PNode::Lattice { .. }
-            | PNode::Shape { .. } => lipschitz(self, b),
+            | PNode::Shape { .. }
+            | PNode::Text { .. } => lipschitz(self, b),
             PNode::Mirror {
                 point,
                 normal,

@@ -112,7 +112,8 @@ impl PNode {
             | PNode::Tpms { m, .. }
             | PNode::Lattice { m, .. }
             | PNode::Mesh { m, .. }
-            | PNode::Shape { m, .. } => Some(*m),
+            | PNode::Shape { m, .. }
+            | PNode::Text { m, .. } => Some(*m),
             _ => None,
         }
     }

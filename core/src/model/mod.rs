@@ -11,6 +11,7 @@ mod bound;
 mod frac_bound;
 mod fractions;
 mod pnode;
+pub mod polygon2d;
 mod prepare;
 pub mod sdf;
 mod shapes;

@@ -210,6 +210,12 @@ pub enum PNode {
         iso: f64,
         children: Vec<Arc<PNode>>,
     },
+    /// Text outlines extruded between z = ±hz.
+    Text {
+        shape: Arc<super::polygon2d::Polygon2d>,
+        hz: f64,
+        m: Slot,
+    },
 }
 
 /// Union or intersection over many children.
@@ -369,6 +375,9 @@ impl PNode {
                 child,
             } => child.dist(reflect(p, *point, *normal)),
             PNode::Sum { iso, children } => children.iter().map(|c| c.dist(p)).sum::<f64>() + *iso,
+            PNode::Text { shape, hz, .. } => {
+                sdf::extrude(shape.signed_distance(DVec2::new(p.x, p.y)), p.z.abs() - *hz)
+            }
         }
     }
 }

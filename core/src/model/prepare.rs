@@ -398,6 +398,23 @@ impl Preparer {
                     bbox,
                 )
             }
+            NodeKind::Text {
+                shape,
+                depth,
+                material,
+                ..
+            } => {
+                let (lo, hi) = shape.bounds();
+                let hz = depth * 0.5;
+                (
+                    PNode::Text {
+                        shape: shape.clone(),
+                        hz,
+                        m: self.slot(*material),
+                    },
+                    Aabb::new(DVec3::new(lo.x, lo.y, -hz), DVec3::new(hi.x, hi.y, hz)),
+                )
+            }
             kind => self.build_shape(n, kind)?,
         })
     }

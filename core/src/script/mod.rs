@@ -20,6 +20,7 @@ mod query_api;
 pub mod read_policy;
 pub mod reference;
 mod shapes_api;
+mod text_api;
 mod toplevel;
 mod values;
 
@@ -488,6 +489,7 @@ fn build_engine(ctx: &RunContext, opts: &ScriptOptions) -> Engine {
     nodes_api::register_methods(&mut engine);
     files_api::register(&mut engine, ctx);
     query_api::register(&mut engine, ctx);
+    text_api::register(&mut engine, ctx);
     bulk::register(&mut engine, opts.max_heap);
 
     let params = ctx.clone();

@@ -189,6 +189,17 @@ pub static FUNCTIONS: &[FnDoc] = &[
         "let m = default_materials(); Sum(2.0, [Sphere(Vec3(0, 0, 0), 3.0, m.id(\"red\")), Sphere(Vec3(4, 0, 0), 3.0, m.id(\"red\"))])"
     ),
     f!(
+        "Text",
+        Geometry,
+        [
+            "Text(text: string, height: float, depth: float)",
+            "Text(text: string, height: float, depth: float, material: int, aspect: FontAspect, font: string, h_align: HorizontalAlignment, v_align: VerticalAlignment)"
+        ],
+        "Text in a real font (family name; DejaVu Sans built in), extruded by `depth` centred on z = 0; `height` is the font size, `\\n` starts a line. FontAspect::Regular/Bold/Italic/BoldItalic, HorizontalAlignment::Left/Center/Right, VerticalAlignment::Bottom/Center/Top/Top_First_Line.",
+        "Text(\"Label\", 10.0, 2.0, m.id(\"red\"))",
+        "let m = default_materials(); Text(\"Volcad\", 10.0, 2.0, m.id(\"red\"))"
+    ),
+    f!(
         "PolygonExtrude",
         Geometry,
         ["PolygonExtrude(points: [Vec3], height: float, symmetric: bool, material: int)"],
