@@ -41,6 +41,7 @@ pub mod order;
 pub mod sampler;
 pub mod script;
 pub mod simfield;
+pub mod vcad;
 pub mod xorshift;
 
 pub use bounds::Aabb;

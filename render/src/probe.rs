@@ -19,8 +19,9 @@ pub struct ProbeHit {
 }
 
 /// Sphere-trace `model` along the camera ray through `ndc` (−1..1, y up)
-/// with the exact (lower-bound) distance, clipped by `cut` if given.
-/// `None` when the ray misses.
+/// with the exact (lower-bound) distance, clipped by `cut` if given; a model
+/// whose value is not a distance bound is marched by its sign instead
+/// ([`sign_march`]). `None` when the ray misses.
 pub fn probe(
     model: &Model,
     camera: &Camera,
@@ -53,6 +54,9 @@ pub fn probe(
             None => m,
         }
     };
+    if !model.distance_is_bound() {
+        return sign_march(model, &sdf, o, d, (tmin, tmax), scale);
+    }
     let mut t = tmin;
     for _ in 0..4096 {
         if t > tmax {
@@ -66,13 +70,7 @@ pub fn probe(
             for _ in 0..64 {
                 let p = o + d * tt;
                 if sdf(p) <= 0.0 {
-                    let (_, fr) = model.eval_point(p);
-                    let fractions = fr.into_iter().filter(|(_, f)| *f > 0.0).collect();
-                    return Some(ProbeHit {
-                        point: p,
-                        distance: tt,
-                        fractions,
-                    });
+                    return Some(hit_at(model, p, tt));
                 }
                 tt += eps;
             }
@@ -80,6 +78,56 @@ pub fn probe(
             continue;
         }
         t += dist.max(eps);
+    }
+    None
+}
+
+fn hit_at(model: &Model, point: DVec3, distance: f64) -> ProbeHit {
+    let (_, fr) = model.eval_point(point);
+    ProbeHit {
+        point,
+        distance,
+        fractions: fr.into_iter().filter(|(_, f)| *f > 0.0).collect(),
+    }
+}
+
+/// Steps per bounding-box size of the sign march: four per voxel of the
+/// viewport's finest bake (256 along the longest side), so the probe finds
+/// every feature the viewport draws.
+const SIGN_STEPS: f64 = 1024.0;
+
+/// The first sign change of `sdf` along `o + t·d`, t in `span`: fixed steps
+/// of 1/[`SIGN_STEPS`] of the box size, then bisection to the inside end of
+/// the crossing (what the viewport draws from the redistanced bake).
+fn sign_march(
+    model: &Model,
+    sdf: &dyn Fn(DVec3) -> f64,
+    o: DVec3,
+    d: DVec3,
+    span: (f64, f64),
+    scale: f64,
+) -> Option<ProbeHit> {
+    let (tmin, tmax) = span;
+    let step = scale / SIGN_STEPS;
+    if sdf(o + d * tmin) <= 0.0 {
+        return Some(hit_at(model, o + d * tmin, tmin));
+    }
+    let mut prev = tmin;
+    while prev < tmax {
+        let t = (prev + step).min(tmax);
+        if sdf(o + d * t) <= 0.0 {
+            let (mut a, mut b) = (prev, t);
+            for _ in 0..48 {
+                let m = 0.5 * (a + b);
+                if sdf(o + d * m) <= 0.0 {
+                    b = m;
+                } else {
+                    a = m;
+                }
+            }
+            return Some(hit_at(model, o + d * b, b));
+        }
+        prev = t;
     }
     None
 }

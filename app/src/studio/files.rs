@@ -156,9 +156,9 @@ impl Dialogs {
                     d = d.set_directory(dir);
                 }
                 let path = match &p {
-                    DialogPurpose::Open => {
-                        d.add_filter("Rhai design script", &["rhai"]).pick_file()
-                    }
+                    DialogPurpose::Open => d
+                        .add_filter("Design (Rhai script or legacy .vcad)", &["rhai", "vcad"])
+                        .pick_file(),
                     DialogPurpose::SaveAs => {
                         let d = d.add_filter("Rhai design script", &["rhai"]);
                         let d = match file_name {
