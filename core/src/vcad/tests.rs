@@ -408,8 +408,22 @@ fn the_example_file_runs() {
         "/../assets/examples/legacy.vcad"
     );
     let m = crate::script::model_of_file(std::path::Path::new(path)).expect("legacy.vcad");
-    assert!(m.distance(DVec3::ZERO) < 0.0);
-    assert!(m.materials().len() >= 2);
+    // The plate, graded red (x/40 + 0.5) to blue (0.5 − x/40), at x = −5.
+    let used = |p: DVec3| -> Vec<(u8, f64)> {
+        m.eval_point(p)
+            .1
+            .into_iter()
+            .filter(|(_, f)| *f > 0.0)
+            .collect()
+    };
+    assert!(m.distance(DVec3::new(-5.0, 0.0, 0.0)) < 0.0);
+    assert_eq!(
+        used(DVec3::new(-5.0, 0.0, 0.0)),
+        vec![(1, 0.375), (3, 0.625)]
+    );
+    // The hole through it at x = 3, the magenta ball above it at z = 12.
+    assert!(m.distance(DVec3::new(3.0, 0.0, 0.0)) > 0.0);
+    assert_eq!(used(DVec3::new(12.0, 0.0, 12.0)), vec![(7, 1.0)]);
 }
 
 #[test]
