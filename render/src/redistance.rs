@@ -94,18 +94,27 @@ pub fn redistance(
     let layer = nx * ny;
     let n = field.len();
     if n > NO_SEED as usize {
-        // Seed indices are u32; bakes are far below 2³² voxels.
+        // Seed slots are u32; bakes are far below 2³² voxels.
         return Ok(());
     }
     let f = &*field;
-    // Squared distance (voxels²) to the nearest seed centre, and that seed.
-    let (mut sq, mut feat): (Vec<f32>, Vec<u32>) = (0..n)
+    let centre = |v: usize| Vec3::new((v % nx) as f32, ((v / nx) % ny) as f32, (v / layer) as f32);
+    // Each seed's voxel and its estimate of the surface point (voxels).
+    let seeds: Vec<(u32, Vec3)> = (0..n)
         .into_par_iter()
-        .map(|v| match surface_offset(f, dims, v) {
-            Some(_) => (0.0, v as u32),
-            None => (NONE, NO_SEED),
-        })
-        .unzip();
+        .filter_map(|v| surface_offset(f, dims, v).map(|o| (v as u32, centre(v) + o)))
+        .collect();
+    if cancel.load(Ordering::Relaxed) {
+        return Err(BakeError::Cancelled);
+    }
+    // Squared distance (voxels²) to the nearest seed centre, and that
+    // seed's index in `seeds`.
+    let mut sq = vec![NONE; n];
+    let mut feat = vec![NO_SEED; n];
+    for (slot, (v, _)) in seeds.iter().enumerate() {
+        sq[*v as usize] = 0.0;
+        feat[*v as usize] = slot as u32;
+    }
     for (len, stride) in [(nx, 1), (ny, nx), (nz, layer)] {
         if cancel.load(Ordering::Relaxed) {
             return Err(BakeError::Cancelled);
@@ -113,12 +122,7 @@ pub fn redistance(
         transform_lines(&mut sq, &mut feat, len, stride);
     }
     let far = ((nx * nx + ny * ny + nz * nz) as f32).sqrt() * voxel;
-    let centre = |v: usize| Vec3::new((v % nx) as f32, ((v / nx) % ny) as f32, (v / layer) as f32);
-    let to_surface = |v: usize, s: u32| {
-        let s = s as usize;
-        let point = centre(s) + surface_offset(f, dims, s).unwrap_or(Vec3::ZERO);
-        (centre(v) - point).length()
-    };
+    let to_surface = |v: usize, s: u32| (centre(v) - seeds[s as usize].1).length();
     let (sq, feat) = (&sq, &feat);
     let out: Vec<f32> = (0..n)
         .into_par_iter()
