@@ -34,40 +34,25 @@ use rayon::prelude::*;
 use crate::bake::BakeError;
 
 /// Steepest slope of the value across the surface (mm per mm) that is
-/// still traced as it is: a distance has slope 1 there; a tiled lattice or
-/// a TPMS sheet, not exact distances, stay close to it.
+/// still traced as it is: a distance has slope at most 1; tiled lattices
+/// and TPMS sheets, not exact distances, stay at or below it too.
 const MAX_SLOPE: f64 = 1.5;
-
-/// Flattest typical slope traced as it is: below it the tracer's steps
-/// shrink until it runs out of them before reaching the surface.
-const MIN_SLOPE: f64 = 0.5;
 
 /// Whether a baked field of a model that is not a distance bound must be
 /// redistanced: its slope across the surface (between x-neighbours of
-/// opposite sign) is steeper than [`MAX_SLOPE`] somewhere, or flatter than
-/// [`MIN_SLOPE`] at most crossings. Tiled lattices and TPMS sheets pass as
-/// they are, which keeps their sub-voxel struts (their values stay
-/// distances to within the thin-feature bias the shader applies).
+/// opposite sign, a lower bound of the gradient's size) is steeper than
+/// [`MAX_SLOPE`] somewhere, so a tracer stepping by it would overshoot.
+/// Tiled lattices and TPMS sheets pass as they are, which keeps their
+/// sub-voxel struts and walls and their bake time.
 pub fn needs_redistance(field: &[f32], nx: usize, voxel: f32) -> bool {
     let h = voxel as f64;
-    let (steepest, flat, crossings) = field
-        .par_chunks(nx)
-        .map(|row| {
-            let mut acc = (0.0f64, 0usize, 0usize);
-            for w in row.windows(2) {
-                if (w[0] <= 0.0) != (w[1] <= 0.0) {
-                    let slope = (w[1] as f64 - w[0] as f64).abs() / h;
-                    // A non-finite value is steeper than any limit.
-                    let slope = if slope.is_nan() { f64::INFINITY } else { slope };
-                    acc.0 = acc.0.max(slope);
-                    acc.1 += usize::from(slope < MIN_SLOPE);
-                    acc.2 += 1;
-                }
-            }
-            acc
+    field.par_chunks(nx).any(|row| {
+        row.windows(2).any(|w| {
+            let slope = (w[1] as f64 - w[0] as f64).abs() / h;
+            // A non-finite difference counts as steep.
+            (w[0] <= 0.0) != (w[1] <= 0.0) && (slope > MAX_SLOPE || slope.is_nan())
         })
-        .reduce(|| (0.0, 0, 0), |a, b| (a.0.max(b.0), a.1 + b.1, a.2 + b.2));
-    crossings > 0 && (steepest > MAX_SLOPE || 2 * flat > crossings)
+    })
 }
 
 /// Squared distance (voxels²) standing for "no seed on this line yet".
@@ -379,5 +364,29 @@ mod tests {
         eprintln!("worst error {worst} mm, {worst_near} mm near the surface, for {h} mm voxels");
         assert!(worst_near <= 0.1 * h, "near the surface: {worst_near} mm");
         assert!(worst <= 0.5 * h, "worst error {worst} mm");
+    }
+
+    /// Steep fields are redistanced, distances (and flatter fields) not.
+    #[test]
+    fn only_steep_fields_are_redistanced() {
+        let (n, h) = (16usize, 0.5f32);
+        let grid = |f: &dyn Fn(glam::Vec3) -> f32| -> Vec<f32> {
+            let c = |i: usize| (i as f32 + 0.5) * h - n as f32 * h / 2.0;
+            let mut out = Vec::new();
+            for k in 0..n {
+                for j in 0..n {
+                    for i in 0..n {
+                        out.push(f(glam::Vec3::new(c(i), c(j), c(k))));
+                    }
+                }
+            }
+            out
+        };
+        let distance = grid(&|p| p.length() - 2.0);
+        let quartic = grid(&|p| (p.length_squared() - 4.0).powi(2) * (p.length() - 2.0).signum());
+        let gentle = grid(&|p| 0.3 * (p.length() - 2.0));
+        assert!(!needs_redistance(&distance, n, h));
+        assert!(needs_redistance(&quartic, n, h));
+        assert!(!needs_redistance(&gentle, n, h));
     }
 }
