@@ -83,6 +83,52 @@ fn info_reports_box_materials_and_params() {
     assert!(out.contains("[-15.0000"), "{out}");
 }
 
+/// A legacy OpenVCAD `.vcad` design runs like a script: `info` and an
+/// export, and a bad one names its line and column.
+#[test]
+fn legacy_vcad_designs_info_and_export() {
+    let design = example("legacy.vcad");
+    let out = ok(&volcad(&["info", &design]));
+    assert!(out.contains("root:        Union"), "{out}");
+    assert!(
+        out.contains("[-20.0000, -12.0000, -2.0000] .. [20.0000, 12.0000, 15.0000]"),
+        "{out}"
+    );
+    assert!(
+        out.contains("red (1)") && out.contains("magenta (7)"),
+        "{out}"
+    );
+    let scratch = tmp("vcad");
+    let png = scratch.path().join("png");
+    let out = ok(&volcad(&[
+        "export",
+        "png",
+        &design,
+        "--out",
+        png.to_str().unwrap(),
+        "--voxel",
+        "1",
+    ]));
+    assert!(out.contains("red") && out.contains("yellow"), "{out}");
+    let slices = files_in(&png)
+        .iter()
+        .filter(|f| f.ends_with(".png"))
+        .count();
+    assert_eq!(slices, 17, "17 mm tall at 1 mm layers");
+
+    let bad = scratch.path().join("bad.vcad");
+    std::fs::write(
+        &bad,
+        "union(){\n  sphere(1, \"red\");\n  cube((1,1,1), \"red\");\n}\n",
+    )
+    .unwrap();
+    let err = fails(&volcad(&["info", bad.to_str().unwrap()]));
+    assert!(
+        err.contains("bad.vcad:3:3: construct `cube` is not taken"),
+        "{err}"
+    );
+}
+
 #[test]
 fn eval_prints_distance_and_fractions_by_name() {
     let out = ok(&volcad(&[

@@ -42,6 +42,7 @@ pub mod sampler;
 pub mod script;
 pub mod simfield;
 pub mod text;
+pub mod vcad;
 pub mod xorshift;
 
 pub use bounds::Aabb;

@@ -76,6 +76,27 @@ fn hello_cube() {
     assert_eq!(frac(&m, DVec3::ZERO, "red"), 1.0);
 }
 
+/// The quartic-handle mug: the torus handle is solid red (its value is a
+/// polynomial, not a distance: only its sign counts), its hole is empty,
+/// and the cup is hollow above its 6 mm floor.
+#[test]
+fn mug() {
+    let m = example("mug.rhai");
+    assert!(!m.distance_is_bound());
+    assert_eq!(frac(&m, DVec3::new(64.0, 0.0, 0.0), "red"), 1.0);
+    assert_eq!(frac(&m, DVec3::new(42.0, 0.0, 22.0), "red"), 1.0);
+    assert!(
+        m.distance(DVec3::new(50.0, 0.0, 0.0)) > 0.0,
+        "the handle's hole"
+    );
+    assert!(
+        m.distance(DVec3::new(0.0, 0.0, 10.0)) > 0.0,
+        "inside the cup"
+    );
+    assert_eq!(frac(&m, DVec3::new(38.0, 0.0, 0.0), "gray"), 1.0);
+    assert_eq!(frac(&m, DVec3::new(0.0, 0.0, -42.0), "gray"), 1.0);
+}
+
 #[test]
 fn graded_bar() {
     let m = example("graded_bar.rhai");

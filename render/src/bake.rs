@@ -10,6 +10,10 @@
 //! - fractions of up to [`MAX_CHANNELS`] materials (the first four of
 //!   `Model::materials()`), for visibility and iso surfaces (`Rgba8Unorm`).
 //!
+//! A model whose value is not a distance bound (a math-string `Function`,
+//! see `Model::distance_is_bound`) has its distance volume replaced by
+//! signed distances from its zero crossings (`redistance`) first.
+//!
 //! Finally the colour and fraction volumes are dilated two voxels outwards
 //! (26-neighbour average of inside voxels): trilinear lookups at the
 //! surface, and on the slightly dilated surface the shader draws to keep thin
@@ -85,6 +89,9 @@ pub struct VolumeBake {
     pub resolution: u32,
     /// Wall time of the bake (s).
     pub bake_seconds: f32,
+    /// True when the model's value was not a distance and the distance
+    /// volume holds distances rebuilt from its sign (`redistance`).
+    pub redistanced: bool,
 }
 
 impl VolumeBake {
@@ -139,6 +146,7 @@ impl VolumeBake {
             voxel_size_mm: 1.0,
             resolution: 0,
             bake_seconds: seconds,
+            redistanced: false,
         }
     }
 }
@@ -220,6 +228,8 @@ pub fn bake(model: &Model, resolution: u32, cancel: &AtomicBool) -> Result<Volum
             });
         z0 = z1;
     }
+    let redistanced = !model.distance_is_bound()
+        && redistance_if_needed(&mut distance, grid.dims, voxel as f32, cancel)?;
     dilate(
         &mut color,
         &mut fractions,
@@ -243,7 +253,32 @@ pub fn bake(model: &Model, resolution: u32, cancel: &AtomicBool) -> Result<Volum
         voxel_size_mm: voxel as f32,
         resolution,
         bake_seconds: start.elapsed().as_secs_f32(),
+        redistanced,
     })
+}
+
+/// Redistance the f16 distance volume of a model that is not a distance
+/// bound when its slope says the tracer cannot use it as it is; true when
+/// it did.
+fn redistance_if_needed(
+    distance: &mut [u16],
+    dims: [usize; 3],
+    voxel: f32,
+    cancel: &AtomicBool,
+) -> Result<bool, BakeError> {
+    let mut field: Vec<f32> = distance
+        .par_iter()
+        .map(|b| half::f16::from_bits(*b).to_f32())
+        .collect();
+    if !crate::redistance::needs_redistance(&field, dims[0], voxel) {
+        return Ok(false);
+    }
+    crate::redistance::redistance(&mut field, dims, voxel, cancel)?;
+    distance
+        .par_iter_mut()
+        .zip(field.par_iter())
+        .for_each(|(d, f)| *d = half::f16::from_f32(f.clamp(-60000.0, 60000.0)).to_bits());
+    Ok(true)
 }
 
 /// Mixed colour and channel fractions of one voxel.

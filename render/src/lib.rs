@@ -54,6 +54,7 @@ mod gpu;
 mod offscreen;
 mod probe;
 mod progressive;
+mod redistance;
 mod settings;
 mod upscale;
 pub mod viewport;

@@ -101,8 +101,10 @@ impl Drawn {
 }
 
 /// Sphere-trace `model` along the camera ray through `ndc` (−1..1, y up)
-/// with the exact (lower-bound) distance, clipped by `cut` if given.
-/// Every material counts as drawn. `None` when the ray misses.
+/// with the exact (lower-bound) distance, clipped by `cut` if given; a model
+/// whose value is not a distance bound is marched by its sign instead
+/// ([`sign_march`]). Every material counts as drawn. `None` when the ray
+/// misses.
 pub fn probe(
     model: &Model,
     camera: &Camera,
@@ -166,6 +168,9 @@ fn march(
     let inside_step = (scale * 1e-3).max(eps);
     let cut_d = |p: DVec3| cut.map_or(f64::NEG_INFINITY, |c| c.distance(p.to_array()));
     let sdf = |p: DVec3| model.distance(p).max(cut_d(p));
+    if !model.distance_is_bound() {
+        return sign_march(model, cut, &sdf, o, d, (tmin, tmax), scale);
+    }
     let at = |t: f64| o + d * t;
     // The last point inside the part that was not drawn, if the ray is
     // walking through hidden material.
@@ -241,4 +246,63 @@ fn bisect<T>(mut lo: f64, mut hi: f64, drawn_at: impl Fn(f64) -> Option<T>) -> O
     }
     best.map(|v| (hi, v))
         .or_else(|| drawn_at(hi).map(|v| (hi, v)))
+}
+
+/// The hit at `point` of a sign march (hidden materials are not looked
+/// through there: such fields are rare and the march is coarse already).
+fn hit_at(model: &Model, cut: Option<&CutPlane>, point: DVec3, distance: f64) -> ProbeHit {
+    let (dm, fr) = model.eval_point(point);
+    let on_cut = cut.is_some_and(|c| c.distance(point.to_array()) >= dm);
+    ProbeHit {
+        point,
+        distance,
+        fractions: fr.into_iter().filter(|(_, f)| *f > 0.0).collect(),
+        surface: if on_cut {
+            HitSurface::Cut
+        } else {
+            HitSurface::Part
+        },
+    }
+}
+
+/// Steps per bounding-box size of the sign march: four per voxel of the
+/// viewport's finest bake (256 along the longest side), so the probe finds
+/// every feature the viewport draws.
+const SIGN_STEPS: f64 = 1024.0;
+
+/// The first sign change of `sdf` along `o + t·d`, t in `span`: fixed steps
+/// of 1/[`SIGN_STEPS`] of the box size, then bisection to the inside end of
+/// the crossing (what the viewport draws from the redistanced bake).
+fn sign_march(
+    model: &Model,
+    cut: Option<&CutPlane>,
+    sdf: &dyn Fn(DVec3) -> f64,
+    o: DVec3,
+    d: DVec3,
+    span: (f64, f64),
+    scale: f64,
+) -> Option<ProbeHit> {
+    let (tmin, tmax) = span;
+    let step = scale / SIGN_STEPS;
+    if sdf(o + d * tmin) <= 0.0 {
+        return Some(hit_at(model, cut, o + d * tmin, tmin));
+    }
+    let mut prev = tmin;
+    while prev < tmax {
+        let t = (prev + step).min(tmax);
+        if sdf(o + d * t) <= 0.0 {
+            let (mut a, mut b) = (prev, t);
+            for _ in 0..48 {
+                let m = 0.5 * (a + b);
+                if sdf(o + d * m) <= 0.0 {
+                    b = m;
+                } else {
+                    a = m;
+                }
+            }
+            return Some(hit_at(model, cut, o + d * b, b));
+        }
+        prev = t;
+    }
+    None
 }

@@ -7,7 +7,8 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, bail};
 use volcad_core::Model;
 use volcad_core::material::nearest_name;
-use volcad_core::script::{Design, Param, ScriptOptions, run_script};
+use volcad_core::script::{Design, Param, ScriptOptions};
+use volcad_core::vcad::run_design;
 
 use super::DesignArgs;
 
@@ -97,7 +98,8 @@ pub fn load_design(args: &DesignArgs) -> anyhow::Result<Loaded> {
     opts.allow_read = allowed_folders(&args.allow_read)?;
     let name = args.design.display().to_string();
     let start = Instant::now();
-    let design = run_script(&source, &name, &opts)?;
+    // `.vcad` files are legacy OpenVCAD text designs; anything else is Rhai.
+    let design = run_design(&source, &name, &opts)?;
     let script_time = start.elapsed();
     check_params(&opts.params, &design.params)?;
     for line in &design.log {

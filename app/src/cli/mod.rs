@@ -26,7 +26,7 @@ pub struct Cli {
 /// Options shared by every command that loads a design.
 #[derive(clap::Args, Debug, Clone)]
 pub struct DesignArgs {
-    /// The design script (.rhai).
+    /// The design: a Rhai script (.rhai) or a legacy OpenVCAD text design (.vcad).
     pub design: PathBuf,
     /// Override a `param(...)` of the script: `--param name=value` (repeatable).
     #[arg(long = "param", value_name = "NAME=VALUE")]

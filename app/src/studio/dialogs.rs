@@ -226,7 +226,9 @@ fn native_dialog(
         d = d.set_directory(dir);
     }
     match p {
-        DialogPurpose::Open => d.add_filter("Design", &["rhai", "vcad"]).pick_file(),
+        DialogPurpose::Open => d
+            .add_filter("Design (Rhai script or legacy .vcad)", &["rhai", "vcad"])
+            .pick_file(),
         DialogPurpose::SaveAs => {
             let d = d.add_filter("Rhai design script", &["rhai"]);
             let d = match file_name {

@@ -17,7 +17,8 @@ use std::sync::mpsc::{Receiver, Sender, channel};
 use std::time::{Duration, Instant};
 
 use volcad_core::Model;
-use volcad_core::script::{Design, Param, ScriptError, ScriptOptions, run_script};
+use volcad_core::script::{Design, Param, ScriptError, ScriptOptions};
+use volcad_core::vcad::run_design;
 
 /// One script run to do.
 #[derive(Clone, Debug)]
@@ -199,7 +200,8 @@ pub fn run(req: RunRequest, cancel: Arc<AtomicBool>) -> LiveResult {
         ..ScriptOptions::default()
     };
     let t0 = Instant::now();
-    let design: Design = match run_script(&req.source, &req.name, &opts) {
+    // A `.vcad` name runs the legacy OpenVCAD text reader, anything else Rhai.
+    let design: Design = match run_design(&req.source, &req.name, &opts) {
         Ok(d) => d,
         Err(error) => {
             return LiveResult::Err(LiveError {

@@ -158,6 +158,14 @@ impl Model {
         self.prepare_time
     }
 
+    /// True when [`Model::distance`] is 1-Lipschitz, so a sphere tracer may
+    /// step by it; false when a node's value is not a distance (a math
+    /// string `Function`, a TPMS sheet, a `Tile`), where a renderer must
+    /// find the surface by the sign of the value instead.
+    pub fn distance_is_bound(&self) -> bool {
+        self.root.is_lipschitz()
+    }
+
     /// Signed distance at `p` (negative inside; inside ⇔ ≤ 0).
     #[inline]
     pub fn distance(&self, p: DVec3) -> f64 {

@@ -184,11 +184,25 @@ impl RunContext {
     }
 }
 
+/// The message of an error a registered function raised (without Rhai's
+/// position suffix), for readers of other languages (`crate::vcad`).
+pub(crate) fn runtime_message(e: &EvalAltResult) -> String {
+    match e {
+        EvalAltResult::ErrorRuntime(v, _) => v.to_string(),
+        other => other.to_string(),
+    }
+}
+
+/// A mesh file, loaded once while it is unchanged (the cache scripts use).
+pub(crate) fn load_mesh(full: &Path) -> Result<Arc<crate::mesh::TriangleMesh>, String> {
+    file_cache::cached(&[full], || crate::mesh::TriangleMesh::load(full)).map_err(|e| e.to_string())
+}
+
 /// Run a design script and prepare its model (what tests, benchmarks and
 /// one-shot tools do); the error is the script's or the preparation's
 /// message.
 pub fn model_of(source: &str, name: &str, opts: &ScriptOptions) -> Result<crate::Model, String> {
-    let d = run_script(source, name, opts).map_err(|e| e.to_string())?;
+    let d = crate::vcad::run_design(source, name, opts).map_err(|e| e.to_string())?;
     crate::Model::prepare(&d.root, d.materials.clone()).map_err(|e| e.to_string())
 }
 
