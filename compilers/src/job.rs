@@ -321,6 +321,7 @@ pub fn run_job<F>(
 where
     F: FnOnce(&JobContext) -> Result<Summary, ExportError>,
 {
+    let dest = resolve_destination(dest)?;
     if dest.exists() && !(dest.is_dir() && dest.join("manifest.json").exists()) {
         // Never replace something that is not one of our exports.
         if !(dest.is_dir()
@@ -337,11 +338,8 @@ where
         .unwrap_or(Path::new("."));
     // A file where a folder must be: "File exists" from the OS says neither
     // which path nor what is wrong with it.
-    if let Some(file) = parent
-        .ancestors()
-        .find(|a| a.exists())
-        .filter(|a| !a.is_dir())
-    {
+    let existing = parent.ancestors().find(|a| a.exists());
+    if let Some(file) = existing.filter(|a| !a.is_dir()) {
         return Err(ExportError::Other(format!(
             "{}: is a file, not a folder, so {} cannot be created in it",
             file.display(),
@@ -349,6 +347,71 @@ where
         )));
     }
     std::fs::create_dir_all(parent).map_err(|e| ExportError::io(parent, e))?;
+    // The folders made for this export go again if it fails: a refused
+    // export leaves the tree as it found it.
+    let made: Vec<PathBuf> = parent
+        .ancestors()
+        .take_while(|a| Some(*a) != existing)
+        .map(Path::to_path_buf)
+        .collect();
+    let out = stage_and_run(&dest, parent, cancel, tx, design_hash, work);
+    if out.is_err() {
+        for folder in &made {
+            if std::fs::remove_dir(folder).is_err() {
+                break;
+            }
+        }
+    }
+    out
+}
+
+/// `dest` as the export will write it: a symlink to a folder is followed
+/// (the folder it names is the destination, the link stays); a special
+/// file, or a symlink to one or to nothing, is refused, never renamed over
+/// (a rename would replace `/dev/stdout`'s link with a regular folder).
+fn resolve_destination(dest: PathBuf) -> Result<PathBuf, ExportError> {
+    let Ok(link) = std::fs::symlink_metadata(&dest) else {
+        return Ok(dest);
+    };
+    let meta = if link.file_type().is_symlink() {
+        std::fs::metadata(&dest).map_err(|e| {
+            ExportError::Other(format!(
+                "{}: a symlink whose target cannot be opened ({e}); remove it or choose another folder",
+                dest.display()
+            ))
+        })?
+    } else {
+        link.clone()
+    };
+    if meta.is_dir() {
+        return if link.file_type().is_symlink() {
+            dest.canonicalize().map_err(|e| ExportError::io(&dest, e))
+        } else {
+            Ok(dest)
+        };
+    }
+    if meta.is_file() {
+        return Err(ExportError::DestinationExists(dest));
+    }
+    Err(ExportError::Other(format!(
+        "{}: is a device, pipe or socket; an export writes a folder of files, so give a folder path",
+        dest.display()
+    )))
+}
+
+/// Make the staging folder beside `dest` in `parent`, run `work` in it and
+/// rename it into place (see [`run_job`]).
+fn stage_and_run<F>(
+    dest: &Path,
+    parent: &Path,
+    cancel: Arc<AtomicBool>,
+    tx: SyncSender<Progress>,
+    design_hash: String,
+    work: F,
+) -> Result<Summary, ExportError>
+where
+    F: FnOnce(&JobContext) -> Result<Summary, ExportError>,
+{
     let name = dest
         .file_name()
         .map(|n| n.to_string_lossy().to_string())

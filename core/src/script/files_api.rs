@@ -101,6 +101,8 @@ pub(super) fn register(engine: &mut Engine, ctx: &RunContext) {
 /// A CSV with a header row into an array of maps (column name -> value);
 /// numeric cells become floats, others strings.
 fn parse_csv(text: &str) -> Result<rhai::Array, String> {
+    // A UTF-8 byte-order mark (some spreadsheets write one) is not data.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut lines = text
         .lines()
         .enumerate()
