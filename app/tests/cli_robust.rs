@@ -77,14 +77,7 @@ fn a_closed_pipe_ends_every_command_quietly() {
     let runs: [Vec<&str>; 3] = [
         vec!["info", &bar],
         vec!["eval", &bar, "0", "0", "0"],
-        vec![
-            "sample",
-            &bar,
-            "--points",
-            s(&pts),
-            "--out",
-            "-",
-        ],
+        vec!["sample", &bar, "--points", s(&pts), "--out", "-"],
     ];
     for args in runs {
         let mut child = Command::new(env!("CARGO_BIN_EXE_volcad"))

@@ -456,9 +456,9 @@ where
             .map_err(|e| ExportError::Other(e.to_string()))?;
         std::fs::write(&path, text).map_err(|e| ExportError::io(&path, e))?;
         if dest.exists() {
-            std::fs::remove_dir_all(&dest).map_err(|e| ExportError::io(&dest, e))?;
+            std::fs::remove_dir_all(dest).map_err(|e| ExportError::io(dest, e))?;
         }
-        std::fs::rename(&staging, &dest).map_err(|e| ExportError::io(&dest, e))?;
+        std::fs::rename(&staging, dest).map_err(|e| ExportError::io(dest, e))?;
         Ok(summary)
     };
     let out = result.and_then(finish);
