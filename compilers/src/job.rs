@@ -616,4 +616,59 @@ mod tests {
         assert!(e.contains("plain.txt: is a file, not a folder"), "{e}");
         assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
     }
+
+    #[cfg(unix)]
+    #[test]
+    fn devices_and_pipes_are_refused_and_folder_links_followed() {
+        let scratch = tempfile::tempdir().unwrap();
+        let dir = scratch.path();
+        // A symlink stands in for /dev/stdout: refused, and left a symlink.
+        let null = dir.join("stdout");
+        std::os::unix::fs::symlink("/dev/null", &null).unwrap();
+        let fifo = dir.join("pipe");
+        assert!(
+            std::process::Command::new("mkfifo")
+                .arg(&fifo)
+                .status()
+                .unwrap()
+                .success()
+        );
+        for dest in [&null, &fifo] {
+            let h = spawn(dest.clone(), "abc".into(), |_| Ok(Summary::default()));
+            let e = h.join().unwrap_err().to_string();
+            assert!(e.contains("is a device, pipe or socket"), "{e}");
+        }
+        assert!(
+            std::fs::symlink_metadata(&null)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        // A symlink to an empty folder: the export goes into the folder.
+        let real = dir.join("real");
+        std::fs::create_dir(&real).unwrap();
+        let link = dir.join("link");
+        std::os::unix::fs::symlink(&real, &link).unwrap();
+        spawn(link.clone(), "abc".into(), |_| Ok(Summary::default()))
+            .join()
+            .unwrap();
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert!(real.join("manifest.json").exists());
+    }
+
+    #[test]
+    fn a_failed_export_removes_the_folders_it_made() {
+        let (scratch, _) = destination();
+        let dest = scratch.path().join("a/b/out");
+        let h = spawn(dest, "abc".into(), |_| {
+            Err(ExportError::param("--infill", "gives NaN"))
+        });
+        assert!(h.join().is_err());
+        assert_eq!(std::fs::read_dir(scratch.path()).unwrap().count(), 0);
+    }
 }
