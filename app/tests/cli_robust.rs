@@ -381,6 +381,7 @@ fn single_file_outputs_leave_nothing_on_failure() {
         err.contains("node 2 has a result but no coordinates"),
         "{err}"
     );
+    assert!(err.contains("job.inp: node 2"), "no line 0 named: {err}");
     assert_eq!(entries(d), ["existing", "job.frd", "job.inp", "points.csv"]);
     // The matching deck: the CSV, here on standard output.
     std::fs::write(&inp, "*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n").unwrap();

@@ -45,11 +45,12 @@ pub enum FrdError {
         err: std::io::Error,
     },
     /// A line is not what the format says.
-    #[error("{path}:{line}: {message}")]
+    #[error("{path}{}: {message}", line_place(.line))]
     Parse {
         /// The file.
         path: String,
-        /// 1-based line.
+        /// 1-based line; 0 where the fault is no one line's (a node that
+        /// has a result but no coordinates), and then not printed.
         line: usize,
         /// What is wrong.
         message: String,
@@ -57,6 +58,15 @@ pub enum FrdError {
     /// No displacement block.
     #[error("{0}: no DISP block (did ccx fail, or does the deck lack *NODE FILE / U?)")]
     NoDisplacement(String),
+}
+
+/// `:LINE` for a known line, nothing for 0 (`path:0:` reads as a place).
+fn line_place(line: &usize) -> String {
+    if *line > 0 {
+        format!(":{line}")
+    } else {
+        String::new()
+    }
 }
 
 fn io_err(path: &Path, err: std::io::Error) -> FrdError {
