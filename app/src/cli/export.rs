@@ -41,7 +41,7 @@ pub struct ExportArgs {
     /// Output folder (written to a staging folder and renamed when complete).
     #[arg(long)]
     pub out: PathBuf,
-    /// Voxel size in mm: one value, or X,Y,Z.
+    /// Voxel size in mm (each within 1e-6..=1e6): one value, or X,Y,Z.
     #[arg(long, allow_hyphen_values = true)]
     pub voxel: Option<String>,
     /// Printer preset for the voxel size (png): j750.
