@@ -95,10 +95,19 @@ fn main() {
         }
         eprintln!("--- volcad {}", shown_args(&case.args));
         match volcad_tests::fuzz::run_case(&bin, &case, limits, scratch.path()) {
-            Ok(r) => println!(
-                "{:?} exit {:?} in {:.1} s\n{}",
-                r.verdict, r.code, r.seconds, r.stderr_tail
-            ),
+            Ok(r) => {
+                println!(
+                    "{:?} exit {:?} in {:.1} s\n{}",
+                    r.verdict, r.code, r.seconds, r.stderr_tail
+                );
+                if a.save && r.verdict != Verdict::Clean {
+                    let dir = a.corpus.clone().unwrap_or_else(corpus::folder);
+                    match corpus::save(&dir, &corpus::Entry::new(&case, r.verdict)) {
+                        Ok(p) => eprintln!("saved {}", p.display()),
+                        Err(e) => eprintln!("error: cannot save {}: {e}", case.name),
+                    }
+                }
+            }
             Err(e) => eprintln!("error: {e}"),
         }
         return;
