@@ -312,32 +312,7 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
             })
         }
         Kind::Mesh => {
-            let by = match a.by.as_deref() {
-                None | Some("dominant") => SegmentBy::Dominant,
-                Some(name) => SegmentBy::Material(model.table().id(name).context("--by")?),
-            };
-            // Dominant segments are one per material: a range count would
-            // be silently ignored, and the files would not be what was asked.
-            if let (SegmentBy::Dominant, Some(n)) = (by, a.segments) {
-                bail!(
-                    "--segments {n}: ranges split one material's fraction; add --by MATERIAL \
-                     (for example --by {}), or leave --segments out for one segment per \
-                     dominant material",
-                    model
-                        .materials()
-                        .first()
-                        .map(|&id| model.table().name(id).to_string())
-                        .unwrap_or_else(|| "red".into())
-                );
-            }
-            let p = MeshParams {
-                voxel: voxel.context("--voxel is required for mesh (e.g. --voxel 0.25)")?,
-                segments: a.segments.unwrap_or(MeshParams::default().segments),
-                by,
-                formats: parse_formats(a.formats.as_deref().unwrap_or("stl,obj,3mf"))?,
-                infill_expr: a.infill.clone(),
-                threads,
-            };
+            let p = mesh_params(a, voxel, &model)?;
             let est = volcad_compilers::mesh::estimate_mesh(&model, &p)?;
             let [nx, ny, nz] = est.grid.dims;
             note!(
@@ -354,32 +329,75 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
             })
         }
         Kind::Fea => {
-            let element = parse_element(a.element.as_deref())?;
-            let voxel = voxel.map(|v| v.min_element());
-            // The default element size comes from the box: an unbounded
-            // design is refused first, as every export words it.
-            let size = volcad_compilers::design::bounded_box(&model)?
-                .size()
-                .min_element();
-            let min_cell = a.min_cell.or(voxel).unwrap_or(size / 10.0);
-            let p = FeaParams {
-                element,
-                voxel: voxel.unwrap_or(min_cell),
-                min_cell,
-                max_cell: a.max_cell.unwrap_or(min_cell * 4.0),
-                sizing: a.sizing.clone().map_or(Sizing::Heterogeneity, Sizing::Expr),
-                seed: a.seed,
-                step: a.step.map(|d| StepParams {
-                    top_displacement: d,
-                }),
-                threads,
-            };
+            let p = fea_params(a, voxel, &model)?;
             job::spawn(dest, hash, move |ctx| {
                 volcad_compilers::fea::export_fea(&model, &p, ctx)
             })
         }
     };
     follow(handle, &interrupted)
+}
+
+/// The mesh export's parameters from the options (`voxel` as parsed).
+fn mesh_params(
+    a: &ExportArgs,
+    voxel: Option<DVec3>,
+    model: &volcad_core::Model,
+) -> anyhow::Result<MeshParams> {
+    let by = match a.by.as_deref() {
+        None | Some("dominant") => SegmentBy::Dominant,
+        Some(name) => SegmentBy::Material(model.table().id(name).context("--by")?),
+    };
+    // Dominant segments are one per material: a range count would
+    // be silently ignored, and the files would not be what was asked.
+    if let (SegmentBy::Dominant, Some(n)) = (by, a.segments) {
+        bail!(
+            "--segments {n}: ranges split one material's fraction; add --by MATERIAL \
+             (for example --by {}), or leave --segments out for one segment per \
+             dominant material",
+            model
+                .materials()
+                .first()
+                .map(|&id| model.table().name(id).to_string())
+                .unwrap_or_else(|| "red".into())
+        );
+    }
+    Ok(MeshParams {
+        voxel: voxel.context("--voxel is required for mesh (e.g. --voxel 0.25)")?,
+        segments: a.segments.unwrap_or(MeshParams::default().segments),
+        by,
+        formats: parse_formats(a.formats.as_deref().unwrap_or("stl,obj,3mf"))?,
+        infill_expr: a.infill.clone(),
+        threads: a.threads,
+    })
+}
+
+/// The FEA export's parameters from the options (`voxel` as parsed).
+fn fea_params(
+    a: &ExportArgs,
+    voxel: Option<DVec3>,
+    model: &volcad_core::Model,
+) -> anyhow::Result<FeaParams> {
+    let element = parse_element(a.element.as_deref())?;
+    let voxel = voxel.map(|v| v.min_element());
+    // The default element size comes from the box: an unbounded
+    // design is refused first, as every export words it.
+    let size = volcad_compilers::design::bounded_box(model)?
+        .size()
+        .min_element();
+    let min_cell = a.min_cell.or(voxel).unwrap_or(size / 10.0);
+    Ok(FeaParams {
+        element,
+        voxel: voxel.unwrap_or(min_cell),
+        min_cell,
+        max_cell: a.max_cell.unwrap_or(min_cell * 4.0),
+        sizing: a.sizing.clone().map_or(Sizing::Heterogeneity, Sizing::Expr),
+        seed: a.seed,
+        step: a.step.map(|d| StepParams {
+            top_displacement: d,
+        }),
+        threads: a.threads,
+    })
 }
 
 /// A flag that Ctrl-C, SIGTERM and SIGHUP set, for [`follow`] to cancel the
