@@ -321,6 +321,7 @@ pub fn run_job<F>(
 where
     F: FnOnce(&JobContext) -> Result<Summary, ExportError>,
 {
+    let dest = resolve_destination(dest)?;
     if dest.exists() && !(dest.is_dir() && dest.join("manifest.json").exists()) {
         // Never replace something that is not one of our exports.
         if !(dest.is_dir()
@@ -337,11 +338,8 @@ where
         .unwrap_or(Path::new("."));
     // A file where a folder must be: "File exists" from the OS says neither
     // which path nor what is wrong with it.
-    if let Some(file) = parent
-        .ancestors()
-        .find(|a| a.exists())
-        .filter(|a| !a.is_dir())
-    {
+    let existing = parent.ancestors().find(|a| a.exists());
+    if let Some(file) = existing.filter(|a| !a.is_dir()) {
         return Err(ExportError::Other(format!(
             "{}: is a file, not a folder, so {} cannot be created in it",
             file.display(),
@@ -349,6 +347,71 @@ where
         )));
     }
     std::fs::create_dir_all(parent).map_err(|e| ExportError::io(parent, e))?;
+    // The folders made for this export go again if it fails: a refused
+    // export leaves the tree as it found it.
+    let made: Vec<PathBuf> = parent
+        .ancestors()
+        .take_while(|a| Some(*a) != existing)
+        .map(Path::to_path_buf)
+        .collect();
+    let out = stage_and_run(&dest, parent, cancel, tx, design_hash, work);
+    if out.is_err() {
+        for folder in &made {
+            if std::fs::remove_dir(folder).is_err() {
+                break;
+            }
+        }
+    }
+    out
+}
+
+/// `dest` as the export will write it: a symlink to a folder is followed
+/// (the folder it names is the destination, the link stays); a special
+/// file, or a symlink to one or to nothing, is refused, never renamed over
+/// (a rename would replace `/dev/stdout`'s link with a regular folder).
+fn resolve_destination(dest: PathBuf) -> Result<PathBuf, ExportError> {
+    let Ok(link) = std::fs::symlink_metadata(&dest) else {
+        return Ok(dest);
+    };
+    let meta = if link.file_type().is_symlink() {
+        std::fs::metadata(&dest).map_err(|e| {
+            ExportError::Other(format!(
+                "{}: a symlink whose target cannot be opened ({e}); remove it or choose another folder",
+                dest.display()
+            ))
+        })?
+    } else {
+        link.clone()
+    };
+    if meta.is_dir() {
+        return if link.file_type().is_symlink() {
+            dest.canonicalize().map_err(|e| ExportError::io(&dest, e))
+        } else {
+            Ok(dest)
+        };
+    }
+    if meta.is_file() {
+        return Err(ExportError::DestinationExists(dest));
+    }
+    Err(ExportError::Other(format!(
+        "{}: is a device, pipe or socket; an export writes a folder of files, so give a folder path",
+        dest.display()
+    )))
+}
+
+/// Make the staging folder beside `dest` in `parent`, run `work` in it and
+/// rename it into place (see [`run_job`]).
+fn stage_and_run<F>(
+    dest: &Path,
+    parent: &Path,
+    cancel: Arc<AtomicBool>,
+    tx: SyncSender<Progress>,
+    design_hash: String,
+    work: F,
+) -> Result<Summary, ExportError>
+where
+    F: FnOnce(&JobContext) -> Result<Summary, ExportError>,
+{
     let name = dest
         .file_name()
         .map(|n| n.to_string_lossy().to_string())
@@ -393,9 +456,9 @@ where
             .map_err(|e| ExportError::Other(e.to_string()))?;
         std::fs::write(&path, text).map_err(|e| ExportError::io(&path, e))?;
         if dest.exists() {
-            std::fs::remove_dir_all(&dest).map_err(|e| ExportError::io(&dest, e))?;
+            std::fs::remove_dir_all(dest).map_err(|e| ExportError::io(dest, e))?;
         }
-        std::fs::rename(&staging, &dest).map_err(|e| ExportError::io(&dest, e))?;
+        std::fs::rename(&staging, dest).map_err(|e| ExportError::io(dest, e))?;
         Ok(summary)
     };
     let out = result.and_then(finish);
@@ -552,5 +615,60 @@ mod tests {
         let e = h.join().unwrap_err().to_string();
         assert!(e.contains("plain.txt: is a file, not a folder"), "{e}");
         assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn devices_and_pipes_are_refused_and_folder_links_followed() {
+        let scratch = tempfile::tempdir().unwrap();
+        let dir = scratch.path();
+        // A symlink stands in for /dev/stdout: refused, and left a symlink.
+        let null = dir.join("stdout");
+        std::os::unix::fs::symlink("/dev/null", &null).unwrap();
+        let fifo = dir.join("pipe");
+        assert!(
+            std::process::Command::new("mkfifo")
+                .arg(&fifo)
+                .status()
+                .unwrap()
+                .success()
+        );
+        for dest in [&null, &fifo] {
+            let h = spawn(dest.clone(), "abc".into(), |_| Ok(Summary::default()));
+            let e = h.join().unwrap_err().to_string();
+            assert!(e.contains("is a device, pipe or socket"), "{e}");
+        }
+        assert!(
+            std::fs::symlink_metadata(&null)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        // A symlink to an empty folder: the export goes into the folder.
+        let real = dir.join("real");
+        std::fs::create_dir(&real).unwrap();
+        let link = dir.join("link");
+        std::os::unix::fs::symlink(&real, &link).unwrap();
+        spawn(link.clone(), "abc".into(), |_| Ok(Summary::default()))
+            .join()
+            .unwrap();
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert!(real.join("manifest.json").exists());
+    }
+
+    #[test]
+    fn a_failed_export_removes_the_folders_it_made() {
+        let (scratch, _) = destination();
+        let dest = scratch.path().join("a/b/out");
+        let h = spawn(dest, "abc".into(), |_| {
+            Err(ExportError::param("--infill", "gives NaN"))
+        });
+        assert!(h.join().is_err());
+        assert_eq!(std::fs::read_dir(scratch.path()).unwrap().count(), 0);
     }
 }

@@ -124,6 +124,8 @@ pub const J750_JSON: &str = include_str!("../../assets/materials/j750.json");
 impl MaterialTable {
     /// Parse a table from JSON text; `origin` names it in errors.
     pub fn from_json(text: &str, origin: &str) -> Result<Self, MaterialError> {
+        // A UTF-8 byte-order mark (some editors write one) is not JSON.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let file: MaterialFile = serde_json::from_str(text).map_err(|e| MaterialError::Parse {
             origin: origin.to_owned(),
             message: e.to_string(),

@@ -11,6 +11,7 @@ use volcad_core::script::{Design, Param, ScriptOptions};
 use volcad_core::vcad::run_design;
 
 use super::DesignArgs;
+use super::output::clip;
 
 /// A loaded, prepared design with its timings.
 pub struct Loaded {
@@ -28,13 +29,14 @@ pub struct Loaded {
 fn parse_params(params: &[String]) -> anyhow::Result<HashMap<String, f64>> {
     let mut out = HashMap::new();
     for p in params {
+        let shown = clip(p, 60);
         let Some((k, v)) = p.split_once('=') else {
-            bail!("--param {p}: expected NAME=VALUE");
+            bail!("--param {shown}: expected NAME=VALUE");
         };
         let v: f64 = v
             .trim()
             .parse()
-            .with_context(|| format!("--param {p}: {v:?} is not a number"))?;
+            .with_context(|| format!("--param {shown}: {:?} is not a number", clip(v, 40)))?;
         out.insert(k.trim().to_owned(), v);
     }
     Ok(out)
@@ -61,6 +63,7 @@ fn check_params(given: &HashMap<String, f64>, declared: &[Param]) -> anyhow::Res
                 let near = nearest_name(name, declared.iter().map(|p| p.name.as_str()));
                 let hint = near.map_or(String::new(), |n| format!("; did you mean `{n}`?"));
                 let list: Vec<&str> = declared.iter().map(|p| p.name.as_str()).collect();
+                let name = clip(name, 60);
                 bail!(
                     "--param {name}: the design declares no parameter `{name}`{hint} (its parameters: {})",
                     if list.is_empty() {
@@ -91,8 +94,7 @@ fn allowed_folders(dirs: &[std::path::PathBuf]) -> anyhow::Result<Vec<std::path:
 
 /// Run and prepare the design named by `args`; warnings go to stderr.
 pub fn load_design(args: &DesignArgs) -> anyhow::Result<Loaded> {
-    let source = std::fs::read_to_string(&args.design)
-        .with_context(|| format!("cannot read {}", args.design.display()))?;
+    let source = super::output::read_input(&args.design, "design script")?;
     let mut opts = ScriptOptions::for_file(&args.design);
     opts.params = parse_params(&args.params)?;
     opts.allow_read = allowed_folders(&args.allow_read)?;
@@ -103,10 +105,10 @@ pub fn load_design(args: &DesignArgs) -> anyhow::Result<Loaded> {
     let script_time = start.elapsed();
     check_params(&opts.params, &design.params)?;
     for line in &design.log {
-        eprintln!("[script] {line}");
+        note!("[script] {line}");
     }
     for w in &design.warnings {
-        eprintln!("warning: {w}");
+        note!("warning: {w}");
     }
     let model = Model::prepare(&design.root, design.materials.clone())
         .with_context(|| format!("{name}: cannot prepare the design"))?;

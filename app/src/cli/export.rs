@@ -41,19 +41,20 @@ pub struct ExportArgs {
     /// Output folder (written to a staging folder and renamed when complete).
     #[arg(long)]
     pub out: PathBuf,
-    /// Voxel size in mm: one value, or X,Y,Z.
+    /// Voxel size in mm (each within 1e-6..=1e6): one value, or X,Y,Z.
     #[arg(long, allow_hyphen_values = true)]
     pub voxel: Option<String>,
     /// Printer preset for the voxel size (png): j750.
     #[arg(long)]
     pub preset: Option<String>,
     /// Worker threads (default: all cores).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub threads: Option<usize>,
     /// Seed of the material draw (same seed, same bytes).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, allow_negative_numbers = true)]
     pub seed: u64,
-    /// png: only layers A..B (global indices kept in file names).
+    /// png: only layers A..B (A to B-1, B excluded) or A..=B (A to B
+    /// included); file names keep the global layer indices.
     #[arg(long)]
     pub layers: Option<String>,
     /// png: random (default) or diffusion.
@@ -63,7 +64,7 @@ pub struct ExportArgs {
     #[arg(long)]
     pub bitmaps: bool,
     /// mesh: number of fraction ranges with `--by MATERIAL` (default 4).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub segments: Option<usize>,
     /// mesh: material whose fraction splits the part, or `dominant`.
     #[arg(long)]
@@ -77,19 +78,22 @@ pub struct ExportArgs {
     /// fea: c3d8r (bricks, the default) or c3d4 (adaptive tets).
     #[arg(long)]
     pub element: Option<String>,
-    /// fea: smallest tet cell (mm).
-    #[arg(long)]
+    /// fea with c3d4: smallest tet cell (mm).
+    #[arg(long, allow_negative_numbers = true)]
     pub min_cell: Option<f64>,
-    /// fea: largest tet cell (mm).
-    #[arg(long)]
+    /// fea with c3d4: largest tet cell (mm).
+    #[arg(long, allow_negative_numbers = true)]
     pub max_cell: Option<f64>,
-    /// fea: cell size as a math string of h (heterogeneity) instead of the linear rule.
-    #[arg(long)]
+    /// fea with c3d4: cell size as a math string of h (heterogeneity) instead of the linear rule.
+    #[arg(long, allow_hyphen_values = true)]
     pub sizing: Option<String>,
     /// fea: append a static step: bottom fixed, top displaced by this many mm in z.
     #[arg(long, allow_negative_numbers = true)]
     pub step: Option<f64>,
 }
+
+/// The voxel sizes accepted, in mm: a nanometre to a kilometre.
+const VOXEL_RANGE: (f64, f64) = (1e-6, 1e6);
 
 fn parse_voxel(s: &str) -> anyhow::Result<DVec3> {
     let parts: Vec<f64> = s
@@ -108,25 +112,45 @@ fn parse_voxel(s: &str) -> anyhow::Result<DVec3> {
     if !(v.cmpgt(DVec3::ZERO).all() && v.is_finite()) {
         bail!("--voxel {s}: voxel sizes must be > 0");
     }
+    // A voxel's volume is their product: outside this range it overflows
+    // or vanishes in f64 (1e300 mm gives an infinite volume, NaN figures).
+    if !(v.cmpge(DVec3::splat(VOXEL_RANGE.0)).all() && v.cmple(DVec3::splat(VOXEL_RANGE.1)).all()) {
+        bail!(
+            "--voxel {s}: each voxel size must be within {:e}..={:e} mm",
+            VOXEL_RANGE.0,
+            VOXEL_RANGE.1
+        );
+    }
     Ok(v)
 }
 
 fn parse_layers(s: &str) -> anyhow::Result<std::ops::Range<usize>> {
-    let (a, b) = s
-        .split_once("..")
-        .with_context(|| format!("--layers {s}: expected A..B, e.g. 100..200"))?;
+    let (a, b, inclusive) = match s.split_once("..=") {
+        Some((a, b)) => (a, b, true),
+        None => {
+            let (a, b) = s.split_once("..").with_context(|| {
+                format!(
+                    "--layers {s}: expected A..B (B excluded) or A..=B (B included), e.g. 100..200"
+                )
+            })?;
+            (a, b, false)
+        }
+    };
     let a: usize = a
         .trim()
         .parse()
-        .with_context(|| format!("--layers {s}: bad start"))?;
+        .with_context(|| format!("--layers {s}: bad start (a layer index, 0 or more)"))?;
     let b: usize = b
         .trim()
         .parse()
-        .with_context(|| format!("--layers {s}: bad end"))?;
-    if a >= b {
-        bail!("--layers {s}: the start must be below the end");
+        .with_context(|| format!("--layers {s}: bad end (a layer index, 0 or more)"))?;
+    let end = if inclusive { b.checked_add(1) } else { Some(b) };
+    match end {
+        Some(end) if a < end => Ok(a..end),
+        _ => bail!(
+            "--layers {s}: the range holds no layer; A..B writes A to B-1, A..=B writes A to B"
+        ),
     }
-    Ok(a..b)
 }
 
 /// `--formats stl,obj,3mf` (any subset, any order).
@@ -173,6 +197,41 @@ fn foreign_options(a: &ExportArgs) -> Vec<&'static str> {
         .collect()
 }
 
+/// `--element` (default c3d8r).
+fn parse_element(e: Option<&str>) -> anyhow::Result<Element> {
+    Ok(match e.unwrap_or("c3d8r") {
+        "c3d8r" | "C3D8R" => Element::C3D8R,
+        "c3d4" | "C3D4" => Element::C3D4,
+        e => bail!("--element {e}: expected c3d8r or c3d4"),
+    })
+}
+
+/// Bricks are sized by `--voxel` alone: the tetrahedra's sizing options
+/// would be ignored, and the deck would not be what was asked for.
+fn refuse_tet_options(a: &ExportArgs, element: Element) -> anyhow::Result<()> {
+    if element != Element::C3D8R {
+        return Ok(());
+    }
+    let given: Vec<&str> = [
+        ("--min-cell", a.min_cell.is_some()),
+        ("--max-cell", a.max_cell.is_some()),
+        ("--sizing", a.sizing.is_some()),
+    ]
+    .iter()
+    .filter(|(_, on)| *on)
+    .map(|(name, _)| *name)
+    .collect();
+    if given.is_empty() {
+        return Ok(());
+    }
+    bail!(
+        "{} {} not apply to bricks (c3d8r, the default element), which --voxel sizes; \
+         add --element c3d4 for adaptive tetrahedra, or give --voxel MM for bricks",
+        given.join(", "),
+        if given.len() == 1 { "does" } else { "do" }
+    )
+}
+
 /// Run `volcad export`.
 pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
     // Options of another export kind would be ignored, and the files would
@@ -186,6 +245,9 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
             foreign.join(", "),
             if foreign.len() == 1 { "does" } else { "do" }
         );
+    }
+    if a.kind == Kind::Fea {
+        refuse_tet_options(a, parse_element(a.element.as_deref())?)?;
     }
     let l = load_design(&a.design)?;
     let model = l.model.clone();
@@ -235,10 +297,11 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
             };
             let est = png_stack::estimate(&model, &p)?;
             let [nx, ny, nz] = est.grid.dims;
-            eprintln!(
-                "grid {nx} x {ny} x {nz}; layers {}..{} ({} voxels); about {:.1} MB on disk, {:.1} MB working memory",
+            note!(
+                "grid {nx} x {ny} x {nz}; layers {} to {} included ({} of {nz}; {} voxels); about {:.1} MB on disk, {:.1} MB working memory",
                 est.layers.start,
-                est.layers.end,
+                est.layers.end.saturating_sub(1),
+                est.layers.len(),
                 est.voxels,
                 est.disk_bytes as f64 / 1e6,
                 est.memory_bytes as f64 / 1e6
@@ -249,35 +312,10 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
             })
         }
         Kind::Mesh => {
-            let by = match a.by.as_deref() {
-                None | Some("dominant") => SegmentBy::Dominant,
-                Some(name) => SegmentBy::Material(model.table().id(name).context("--by")?),
-            };
-            // Dominant segments are one per material: a range count would
-            // be silently ignored, and the files would not be what was asked.
-            if let (SegmentBy::Dominant, Some(n)) = (by, a.segments) {
-                bail!(
-                    "--segments {n}: ranges split one material's fraction; add --by MATERIAL \
-                     (for example --by {}), or leave --segments out for one segment per \
-                     dominant material",
-                    model
-                        .materials()
-                        .first()
-                        .map(|&id| model.table().name(id).to_string())
-                        .unwrap_or_else(|| "red".into())
-                );
-            }
-            let p = MeshParams {
-                voxel: voxel.context("--voxel is required for mesh (e.g. --voxel 0.25)")?,
-                segments: a.segments.unwrap_or(MeshParams::default().segments),
-                by,
-                formats: parse_formats(a.formats.as_deref().unwrap_or("stl,obj,3mf"))?,
-                infill_expr: a.infill.clone(),
-                threads,
-            };
+            let p = mesh_params(a, voxel, &model)?;
             let est = volcad_compilers::mesh::estimate_mesh(&model, &p)?;
             let [nx, ny, nz] = est.grid.dims;
-            eprintln!(
+            note!(
                 "grid {nx} x {ny} x {nz} ({} voxels), {} segments; about {:.1e} triangles and {:.1} MB on disk, {:.1} MB working memory",
                 est.voxels,
                 est.segments,
@@ -291,36 +329,75 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
             })
         }
         Kind::Fea => {
-            let element = match a.element.as_deref().unwrap_or("c3d8r") {
-                "c3d8r" | "C3D8R" => Element::C3D8R,
-                "c3d4" | "C3D4" => Element::C3D4,
-                e => bail!("--element {e}: expected c3d8r or c3d4"),
-            };
-            let voxel = voxel.map(|v| v.min_element());
-            // The default element size comes from the box: an unbounded
-            // design is refused first, as every export words it.
-            let size = volcad_compilers::design::bounded_box(&model)?
-                .size()
-                .min_element();
-            let min_cell = a.min_cell.or(voxel).unwrap_or(size / 10.0);
-            let p = FeaParams {
-                element,
-                voxel: voxel.unwrap_or(min_cell),
-                min_cell,
-                max_cell: a.max_cell.unwrap_or(min_cell * 4.0),
-                sizing: a.sizing.clone().map_or(Sizing::Heterogeneity, Sizing::Expr),
-                seed: a.seed,
-                step: a.step.map(|d| StepParams {
-                    top_displacement: d,
-                }),
-                threads,
-            };
+            let p = fea_params(a, voxel, &model)?;
             job::spawn(dest, hash, move |ctx| {
                 volcad_compilers::fea::export_fea(&model, &p, ctx)
             })
         }
     };
     follow(handle, &interrupted)
+}
+
+/// The mesh export's parameters from the options (`voxel` as parsed).
+fn mesh_params(
+    a: &ExportArgs,
+    voxel: Option<DVec3>,
+    model: &volcad_core::Model,
+) -> anyhow::Result<MeshParams> {
+    let by = match a.by.as_deref() {
+        None | Some("dominant") => SegmentBy::Dominant,
+        Some(name) => SegmentBy::Material(model.table().id(name).context("--by")?),
+    };
+    // Dominant segments are one per material: a range count would
+    // be silently ignored, and the files would not be what was asked.
+    if let (SegmentBy::Dominant, Some(n)) = (by, a.segments) {
+        bail!(
+            "--segments {n}: ranges split one material's fraction; add --by MATERIAL \
+             (for example --by {}), or leave --segments out for one segment per \
+             dominant material",
+            model
+                .materials()
+                .first()
+                .map(|&id| model.table().name(id).to_string())
+                .unwrap_or_else(|| "red".into())
+        );
+    }
+    Ok(MeshParams {
+        voxel: voxel.context("--voxel is required for mesh (e.g. --voxel 0.25)")?,
+        segments: a.segments.unwrap_or(MeshParams::default().segments),
+        by,
+        formats: parse_formats(a.formats.as_deref().unwrap_or("stl,obj,3mf"))?,
+        infill_expr: a.infill.clone(),
+        threads: a.threads,
+    })
+}
+
+/// The FEA export's parameters from the options (`voxel` as parsed).
+fn fea_params(
+    a: &ExportArgs,
+    voxel: Option<DVec3>,
+    model: &volcad_core::Model,
+) -> anyhow::Result<FeaParams> {
+    let element = parse_element(a.element.as_deref())?;
+    let voxel = voxel.map(|v| v.min_element());
+    // The default element size comes from the box: an unbounded
+    // design is refused first, as every export words it.
+    let size = volcad_compilers::design::bounded_box(model)?
+        .size()
+        .min_element();
+    let min_cell = a.min_cell.or(voxel).unwrap_or(size / 10.0);
+    Ok(FeaParams {
+        element,
+        voxel: voxel.unwrap_or(min_cell),
+        min_cell,
+        max_cell: a.max_cell.unwrap_or(min_cell * 4.0),
+        sizing: a.sizing.clone().map_or(Sizing::Heterogeneity, Sizing::Expr),
+        seed: a.seed,
+        step: a.step.map(|d| StepParams {
+            top_displacement: d,
+        }),
+        threads: a.threads,
+    })
 }
 
 /// A flag that Ctrl-C, SIGTERM and SIGHUP set, for [`follow`] to cancel the
@@ -335,7 +412,7 @@ fn interrupt_flag() -> Arc<AtomicBool> {
     // next export to the same place removes what it left).
     let _ = ctrlc::set_handler(move || {
         if flag.swap(true, Ordering::Relaxed) {
-            eprintln!("interrupted again: exiting without waiting for the export to stop");
+            note!("interrupted again: exiting without waiting for the export to stop");
             std::process::exit(130);
         }
     });
@@ -371,17 +448,17 @@ fn follow(handle: job::JobHandle, interrupted: &AtomicBool) -> anyhow::Result<()
     }
     bar.finish_and_clear();
     let summary = handle.join()?;
-    println!(
+    outln!(
         "{}: {} files in {}",
         summary.kind,
         summary.files.len(),
         dest.display()
     );
     for (name, count) in &summary.counts {
-        println!("  {name:<16} {count}");
+        outln!("  {name:<16} {count}");
     }
     if summary.seconds > 0.0 && summary.units > 0 {
-        println!(
+        outln!(
             "  {} {} in {:.2} s ({:.3e} {}/s)",
             summary.units,
             summary.unit,
@@ -391,15 +468,21 @@ fn follow(handle: job::JobHandle, interrupted: &AtomicBool) -> anyhow::Result<()
         );
     }
     for n in &summary.notes {
-        println!("  {n}");
+        outln!("  {n}");
     }
     Ok(())
 }
 
-/// `volcad fea-result JOB.frd --inp JOB.inp --out result.csv`.
+/// `volcad fea-result JOB.frd --inp JOB.inp --out result.csv` (`--out -`
+/// for standard output). The CSV is made in memory first: a deck that does
+/// not match the result leaves no file.
 pub fn fea_result(frd: &Path, inp: &Path, out: &Path) -> anyhow::Result<()> {
+    super::output::check_regular(frd, "CalculiX result (.frd)")?;
+    super::output::check_regular(inp, "deck (.inp)")?;
+    super::output::target(out, "--out")?;
     let r = volcad_compilers::fea::read_frd(frd)?;
-    volcad_compilers::fea::write_result_csv(&r, Some(inp), out)?;
-    eprintln!("{} nodes -> {}", r.displacements.len(), out.display());
+    let (text, _) = volcad_compilers::fea::result_csv(&r, Some(inp))?;
+    super::output::write_output(out, "--out", |w| w.write_all(text.as_bytes()))?;
+    note!("{} nodes -> {}", r.displacements.len(), out.display());
     Ok(())
 }

@@ -15,30 +15,39 @@ pub fn info(args: &DesignArgs) -> anyhow::Result<()> {
     let l = load_design(args)?;
     let m = &l.model;
     let b = m.bbox();
-    println!("design:      {}", args.design.display());
-    println!("root:        {}", l.design.root.kind().type_name());
-    println!("nodes:       {}", m.node_count());
-    println!(
+    outln!("design:      {}", args.design.display());
+    outln!("root:        {}", l.design.root.kind().type_name());
+    outln!("nodes:       {}", m.node_count());
+    outln!(
         "bbox (mm):   [{:.4}, {:.4}, {:.4}] .. [{:.4}, {:.4}, {:.4}]",
-        b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z
+        b.min.x,
+        b.min.y,
+        b.min.z,
+        b.max.x,
+        b.max.y,
+        b.max.z
     );
     let s = b.size();
-    println!("size (mm):   {:.4} x {:.4} x {:.4}", s.x, s.y, s.z);
+    outln!("size (mm):   {:.4} x {:.4} x {:.4}", s.x, s.y, s.z);
     let names: Vec<String> = m
         .materials()
         .iter()
         .map(|id| format!("{} ({id})", m.table().name(*id)))
         .collect();
-    println!("materials:   {}", names.join(", "));
-    println!("table:       {}", m.table().origin());
+    outln!("materials:   {}", names.join(", "));
+    outln!("table:       {}", m.table().origin());
     for p in &l.design.params {
-        println!(
+        outln!(
             "param:       {} = {} (default {}, range {}..{})",
-            p.name, p.value, p.default, p.min, p.max
+            p.name,
+            p.value,
+            p.default,
+            p.min,
+            p.max
         );
     }
-    println!("script time: {:.3} s", l.script_time.as_secs_f64());
-    println!("prepare:     {:.3} s", m.prepare_time().as_secs_f64());
+    outln!("script time: {:.3} s", l.script_time.as_secs_f64());
+    outln!("prepare:     {:.3} s", m.prepare_time().as_secs_f64());
     Ok(())
 }
 
@@ -51,12 +60,12 @@ pub fn eval(args: &DesignArgs, x: f64, y: f64, z: f64) -> anyhow::Result<()> {
     }
     let l = load_design(args)?;
     let (d, fracs) = l.model.eval_point(DVec3::new(x, y, z));
-    println!("distance: {d}");
+    outln!("distance: {d}");
     if fracs.is_empty() {
-        println!("outside: no material");
+        outln!("outside: no material");
     }
     for (id, f) in fracs {
-        println!("{}: {f}", l.model.table().name(id));
+        outln!("{}: {f}", l.model.table().name(id));
     }
     Ok(())
 }
@@ -67,11 +76,11 @@ pub struct BenchArgs {
     /// Designs to measure (default: every example in assets/examples).
     pub designs: Vec<PathBuf>,
     /// Points per measurement.
-    #[arg(long, default_value_t = 2_000_000)]
+    #[arg(long, default_value_t = 2_000_000, allow_negative_numbers = true)]
     pub points: usize,
     /// Voxels of each export grid: the voxel size per design is
     /// `cbrt(box volume / N)`.
-    #[arg(long, default_value_t = 10_000_000)]
+    #[arg(long, default_value_t = 10_000_000, allow_negative_numbers = true)]
     pub voxels: u64,
     /// Measure evaluation only (no slice-stack and mesh exports).
     #[arg(long)]
@@ -101,7 +110,7 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
     };
     // What the figures are of: points/s depends on how densely the points
     // fill the band (docs/PERFORMANCE.md, "How to measure").
-    println!(
+    outln!(
         "points/s: {} points within 2 mm of each design's surface, medians of up to 5 passes{}",
         args.points,
         if args.no_exports {
@@ -115,8 +124,8 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
     );
     // Which machine: figures differ by a factor of two between the
     // processors this project's machines have had (docs/PERFORMANCE.md).
-    println!("machine: {}", machine());
-    println!(
+    outln!("machine: {}", machine());
+    outln!(
         "{:<28} {:>8} {:>14} {:>16} {:>16} {:>11} {:>14} {:>14}",
         "design",
         "nodes",
@@ -127,6 +136,9 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
         "png voxels/s",
         "mesh voxels/s"
     );
+    // A design that cannot be measured is a row and, at the end, a failure:
+    // a script that benchmarks a missing file must not pass.
+    let mut failed = Vec::new();
     for path in designs {
         let d = super::DesignArgs {
             design: path.clone(),
@@ -136,7 +148,8 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
         let l = match load_design(&d) {
             Ok(l) => l,
             Err(e) => {
-                println!("{:<28} error: {e:#}", path.display());
+                outln!("{:<28} error: {e:#}", path.display());
+                failed.push(path.display().to_string());
                 continue;
             }
         };
@@ -151,7 +164,7 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
         } else {
             export_rates(&l.model, args.voxels)
         };
-        println!(
+        outln!(
             "{:<28} {:>8} {:>14.1} {:>16.3e} {:>16.3e}{exports}",
             path.file_name()
                 .map(|f| f.to_string_lossy().to_string())
@@ -160,6 +173,14 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
             l.model.prepare_time().as_secs_f64() * 1e3,
             pps,
             pps_z
+        );
+    }
+    if !failed.is_empty() {
+        anyhow::bail!(
+            "{} design{} could not be measured: {}",
+            failed.len(),
+            if failed.len() == 1 { "" } else { "s" },
+            failed.join(", ")
         );
     }
     Ok(())

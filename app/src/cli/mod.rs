@@ -2,9 +2,28 @@
 //! → one function per subcommand). Every failure is a message on stderr and
 //! a non-zero exit, never a panic.
 
+/// `println!` that returns the error instead of panicking: a closed pipe
+/// (`volcad info x | head -1`) ends the command quietly ([`is_broken_pipe`]).
+macro_rules! outln {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout().lock(), $($t)*).map_err(crate::cli::stdout_error)?;
+    }};
+}
+
+/// `eprintln!` that never panics (a closed standard error is not worth
+/// failing a command for).
+macro_rules! note {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr().lock(), $($t)*);
+    }};
+}
+
 mod design;
 mod export;
 mod info;
+mod output;
 mod render;
 mod sample;
 
@@ -16,12 +35,23 @@ pub use design::load_design;
 
 /// `volcad`: evaluate, render and export Volcad designs without a window.
 #[derive(Parser, Debug)]
-#[command(name = "volcad", version, about, long_about = None)]
+#[command(
+    name = "volcad",
+    version,
+    about,
+    long_about = None,
+    after_help = EXIT_STATUS
+)]
 pub struct Cli {
     /// What to do.
     #[command(subcommand)]
     pub command: Command,
 }
+
+/// The exit statuses, as `--help` states them.
+const EXIT_STATUS: &str = "Exit status: 0 on success (also when the reader of standard output \
+closes it early), 1 when a command fails (bad design, bad option value, write error), \
+2 for usage errors (unknown option, missing argument).";
 
 /// Options shared by every command that loads a design.
 #[derive(clap::Args, Debug, Clone)]
@@ -66,7 +96,7 @@ pub enum Command {
         /// Input CSV with header `x,y,z`.
         #[arg(long)]
         points: PathBuf,
-        /// Output CSV.
+        /// Output CSV (`-` for standard output).
         #[arg(long)]
         out: PathBuf,
     },
@@ -81,7 +111,7 @@ pub enum Command {
         /// The .inp the job ran (for node coordinates).
         #[arg(long)]
         inp: PathBuf,
-        /// Output CSV.
+        /// Output CSV (`-` for standard output).
         #[arg(long)]
         out: PathBuf,
     },
@@ -105,3 +135,20 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Bench(a) => info::bench(&a),
     }
 }
+
+/// The error of a failed write to standard output.
+pub(crate) fn stdout_error(e: std::io::Error) -> anyhow::Error {
+    anyhow::Error::new(e).context("cannot write to standard output")
+}
+
+/// True when `e` comes from writing to a pipe whose reader has gone
+/// (`volcad info x | head -1`): the command then ends quietly with status
+/// 0: the reader wanted no more, which is not a failure.
+pub fn is_broken_pipe(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| {
+        c.downcast_ref::<std::io::Error>()
+            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+    })
+}
+
+pub use output::clip;

@@ -15,7 +15,7 @@ pub struct RenderArgs {
     /// The design.
     #[command(flatten)]
     pub design: DesignArgs,
-    /// Output PNG.
+    /// Output PNG (`-` for standard output).
     #[arg(long)]
     pub out: PathBuf,
     /// Standard view: iso, top, front, side, bottom.
@@ -31,7 +31,7 @@ pub struct RenderArgs {
     #[arg(long, default_value = "solid")]
     pub mode: String,
     /// Bake resolution (voxels along the longest side).
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = 256, allow_negative_numbers = true)]
     pub resolution: u32,
     /// Orthographic projection.
     #[arg(long)]
@@ -82,7 +82,9 @@ fn parse_cut(s: &str) -> anyhow::Result<CutPlane> {
     let offset: f32 = off
         .trim()
         .parse()
-        .with_context(|| format!("--cut {s}: {off:?} is not a number"))?;
+        .ok()
+        .filter(|v: &f32| v.is_finite())
+        .with_context(|| format!("--cut {s}: {off:?} is not a finite number of mm"))?;
     Ok(CutPlane {
         axis,
         offset,
@@ -95,6 +97,8 @@ pub fn render(a: &RenderArgs) -> anyhow::Result<()> {
     let view = parse_view(&a.view)?;
     let size = parse_size(&a.size)?;
     let cut = a.cut.as_deref().map(parse_cut).transpose()?;
+    // A folder or socket as --out is refused before the work, not after.
+    super::output::target(&a.out, "--out")?;
     let mode = match a.mode.as_str() {
         "solid" => ViewMode::Solid,
         "volume" => ViewMode::Volume,
@@ -130,10 +134,11 @@ pub fn render(a: &RenderArgs) -> anyhow::Result<()> {
         ..ViewSettings::default()
     };
     let img = volcad_render::render_offscreen(&l.model, &settings, size, a.resolution)?;
-    let tmp = a.out.with_extension("png.partial");
-    img.save_with_format(&tmp, image::ImageFormat::Png)
-        .with_context(|| format!("cannot write {}", tmp.display()))?;
-    std::fs::rename(&tmp, &a.out).with_context(|| format!("cannot write {}", a.out.display()))?;
-    eprintln!("{} ({}x{}) written", a.out.display(), size[0], size[1]);
+    // The PNG encoder wants to seek: encode in memory, then write.
+    let mut png = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut png, image::ImageFormat::Png)
+        .context("cannot encode the PNG")?;
+    super::output::write_output(&a.out, "--out", |w| w.write_all(png.get_ref()))?;
+    note!("{} ({}x{}) written", a.out.display(), size[0], size[1]);
     Ok(())
 }

@@ -1,6 +1,5 @@
 //! `volcad sample`: batch evaluation of points from a CSV.
 
-use std::io::{BufWriter, Write};
 use std::path::Path;
 
 use anyhow::{Context, bail};
@@ -9,24 +8,25 @@ use rayon::prelude::*;
 
 use super::DesignArgs;
 use super::design::load_design;
+use super::output::{clip, read_input, target, write_output};
 
 /// Read `x,y,z` rows (header required, column order free).
 fn read_points(path: &Path) -> anyhow::Result<Vec<DVec3>> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let text = read_input(path, "points")?;
     let mut lines = text
         .lines()
         .enumerate()
         .filter(|(_, l)| !l.trim().is_empty());
-    let Some((_, header)) = lines.next() else {
+    let Some((hi, header)) = lines.next() else {
         bail!("{}: empty file; expected a header `x,y,z`", path.display());
     };
     let cols: Vec<String> = header.split(',').map(|c| c.trim().to_lowercase()).collect();
     let find = |n: &str| {
         cols.iter().position(|c| c == n).with_context(|| {
             format!(
-                "{}:1: no column `{n}` in the header (expected x,y,z)",
-                path.display()
+                "{}:{}: no column `{n}` in the header (expected x,y,z)",
+                path.display(),
+                hi + 1
             )
         })
     };
@@ -43,9 +43,10 @@ fn read_points(path: &Path) -> anyhow::Result<Vec<DVec3>> {
                 .filter(|v| v.is_finite())
                 .with_context(|| {
                     format!(
-                        "{}:{}: `{name}` = {s:?} is not a finite number",
+                        "{}:{}: `{name}` = {:?} is not a finite number",
                         path.display(),
-                        i + 1
+                        i + 1,
+                        clip(s, 40)
                     )
                 })
         };
@@ -56,6 +57,8 @@ fn read_points(path: &Path) -> anyhow::Result<Vec<DVec3>> {
 
 /// `volcad sample DESIGN --points in.csv --out out.csv`.
 pub fn sample(args: &DesignArgs, points: &Path, out: &Path) -> anyhow::Result<()> {
+    // A folder or socket as --out is refused before the work, not after.
+    target(out, "--out")?;
     let pts = read_points(points)?;
     let l = load_design(args)?;
     let model = &l.model;
@@ -75,9 +78,7 @@ pub fn sample(args: &DesignArgs, points: &Path, out: &Path) -> anyhow::Result<()
             },
         )
         .collect();
-    let tmp = out.with_extension("csv.partial");
-    let write = || -> std::io::Result<()> {
-        let mut w = BufWriter::new(std::fs::File::create(&tmp)?);
+    write_output(out, "--out", |w| {
         write!(w, "x,y,z,distance")?;
         for id in model.materials() {
             write!(w, ",{}", model.table().name(*id))?;
@@ -86,10 +87,8 @@ pub fn sample(args: &DesignArgs, points: &Path, out: &Path) -> anyhow::Result<()
         for r in &rows {
             writeln!(w, "{r}")?;
         }
-        w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
-        std::fs::rename(&tmp, out)
-    };
-    write().with_context(|| format!("cannot write {}", out.display()))?;
-    eprintln!("{} points -> {}", rows.len(), out.display());
+        Ok(())
+    })?;
+    note!("{} points -> {}", rows.len(), out.display());
     Ok(())
 }

@@ -20,7 +20,7 @@
 //! (the last increment) is the displacement.
 
 use std::collections::BTreeMap;
-use std::io::{BufRead, BufReader, BufWriter, Write};
+use std::io::{BufRead, BufReader};
 use std::path::Path;
 
 /// Nodes and displacements from a `.frd`.
@@ -45,11 +45,12 @@ pub enum FrdError {
         err: std::io::Error,
     },
     /// A line is not what the format says.
-    #[error("{path}:{line}: {message}")]
+    #[error("{path}{}: {message}", line_place(.line))]
     Parse {
         /// The file.
         path: String,
-        /// 1-based line.
+        /// 1-based line; 0 where the fault is no one line's (a node that
+        /// has a result but no coordinates), and then not printed.
         line: usize,
         /// What is wrong.
         message: String,
@@ -57,6 +58,15 @@ pub enum FrdError {
     /// No displacement block.
     #[error("{0}: no DISP block (did ccx fail, or does the deck lack *NODE FILE / U?)")]
     NoDisplacement(String),
+}
+
+/// `:LINE` for a known line, nothing for 0 (`path:0:` reads as a place).
+fn line_place(line: &usize) -> String {
+    if *line > 0 {
+        format!(":{line}")
+    } else {
+        String::new()
+    }
 }
 
 fn io_err(path: &Path, err: std::io::Error) -> FrdError {
@@ -264,22 +274,16 @@ pub struct CsvStats {
     pub max_displacement: f64,
 }
 
-/// Write `node_id,x,y,z,dx,dy,dz`, one row per node with a result, ascending
-/// id. Coordinates come from `inp`'s `*NODE` block when given (exact), else
-/// from the `.frd` (6 significant digits).
-pub fn write_result_csv(
-    frd: &FrdResult,
-    inp: Option<&Path>,
-    out: &Path,
-) -> Result<CsvStats, FrdError> {
+/// The result CSV's text (`node_id,x,y,z,dx,dy,dz`, one row a node with a
+/// result) and its figures; nothing is written, so a deck that does not
+/// match leaves no file behind.
+pub fn result_csv(frd: &FrdResult, inp: Option<&Path>) -> Result<(String, CsvStats), FrdError> {
+    use std::fmt::Write as _;
     let coords: BTreeMap<u32, [f64; 3]> = match inp {
         Some(p) => read_inp_nodes(p)?,
         None => frd.nodes.iter().copied().collect(),
     };
-    let file = std::fs::File::create(out).map_err(|e| io_err(out, e))?;
-    let mut w = BufWriter::new(file);
-    let werr = |e| io_err(out, e);
-    writeln!(w, "node_id,x,y,z,dx,dy,dz").map_err(werr)?;
+    let mut text = String::from("node_id,x,y,z,dx,dy,dz\n");
     let mut stats = CsvStats::default();
     for (id, u) in &frd.displacements {
         let p = coords.get(id).ok_or_else(|| FrdError::Parse {
@@ -289,18 +293,29 @@ pub fn write_result_csv(
                 "node {id} has a result but no coordinates (is this the deck that was run?)"
             ),
         })?;
-        writeln!(
-            w,
+        let _ = writeln!(
+            text,
             "{id},{},{},{},{},{},{}",
             p[0], p[1], p[2], u[0], u[1], u[2]
-        )
-        .map_err(werr)?;
+        );
         stats.rows += 1;
         stats.max_displacement = stats
             .max_displacement
             .max((u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt());
     }
-    w.flush().map_err(werr)?;
+    Ok((text, stats))
+}
+
+/// Write `node_id,x,y,z,dx,dy,dz`, one row per node with a result, ascending
+/// id. Coordinates come from `inp`'s `*NODE` block when given (exact), else
+/// from the `.frd` (6 significant digits).
+pub fn write_result_csv(
+    frd: &FrdResult,
+    inp: Option<&Path>,
+    out: &Path,
+) -> Result<CsvStats, FrdError> {
+    let (text, stats) = result_csv(frd, inp)?;
+    std::fs::write(out, text).map_err(|e| io_err(out, e))?;
     Ok(stats)
 }
 

@@ -37,7 +37,9 @@ use volcad_core::Model;
 use volcad_core::material::VOID;
 use volcad_core::model::MAX_MATERIALS;
 
-pub use frd::{CsvStats, FrdError, FrdResult, read_frd, read_inp_nodes, write_result_csv};
+pub use frd::{
+    CsvStats, FrdError, FrdResult, read_frd, read_inp_nodes, result_csv, write_result_csv,
+};
 pub use materials::{draw, elastic_materials};
 pub use quality::{QualityReport, dihedral_range, signed_volume, tet_quality};
 pub use sizing::{SizeRule, heterogeneity};

@@ -76,6 +76,19 @@ impl SizeRule {
             Some(src) => {
                 let e = Expr::compile(src, &["h"])
                     .map_err(|e| ExportError::param("--sizing", format!("\"{src}\": {e} (a math string of h, 0 mixed … 1 pure, giving the edge length in mm)")))?;
+                // NaN has no length to clamp: refused as `--infill` refuses
+                // it, at the first of 101 heterogeneities where it appears.
+                if let Some(h) = (0..=100)
+                    .map(|i| f64::from(i) / 100.0)
+                    .find(|&h| e.eval(&[h]).is_nan())
+                {
+                    return Err(ExportError::param(
+                        "--sizing",
+                        format!(
+                            "\"{src}\" gives NaN at h = {h}; write an edge length in mm for every h in 0..=1"
+                        ),
+                    ));
+                }
                 Some(e)
             }
             None => None,

@@ -195,6 +195,8 @@ impl MeshArgs {
 /// A CSV with a header row into an array of maps (column name -> value);
 /// numeric cells become floats, others strings.
 fn parse_csv(text: &str) -> Result<rhai::Array, String> {
+    // A UTF-8 byte-order mark (some spreadsheets write one) is not data.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut lines = text
         .lines()
         .enumerate()

@@ -219,6 +219,8 @@ pub fn model_of_file(path: &Path) -> Result<crate::Model, String> {
 
 /// Run a design script.
 pub fn run_script(source: &str, name: &str, opts: &ScriptOptions) -> Result<Design, ScriptError> {
+    // Some editors start UTF-8 files with a byte-order mark; it is not code.
+    let source = source.strip_prefix('\u{feff}').unwrap_or(source);
     let ctx = RunContext {
         base_dir: opts.base_dir.clone(),
         allow_read: Arc::new(opts.allow_read.clone()),
@@ -246,7 +248,7 @@ pub fn run_script(source: &str, name: &str, opts: &ScriptOptions) -> Result<Desi
             file: name.to_owned(),
             line: pos.line(),
             column: pos.position(),
-            message: e.err_type().to_string(),
+            message: clip(&e.err_type().to_string(), MAX_MESSAGE),
         }
     })?;
     let value: Dynamic = engine
@@ -391,7 +393,25 @@ fn to_script_error(e: &EvalAltResult, file: &str, engine: &Engine, max_heap: u64
         file: file.to_owned(),
         line: pos.line(),
         column: pos.position(),
-        message,
+        message: clip(&message, MAX_MESSAGE),
+    }
+}
+
+/// The longest message kept whole: messages quote the script's tokens and
+/// values, which can be megabytes (a 10 MB string literal).
+const MAX_MESSAGE: usize = 400;
+
+/// At most `max` characters of `text`, saying how many were left out:
+/// messages that quote user input (a token, a CSV cell, an option value)
+/// must not echo megabytes of it.
+pub fn clip(text: &str, max: usize) -> String {
+    match text.char_indices().nth(max) {
+        None => text.to_owned(),
+        Some((cut, _)) => format!(
+            "{}… ({} more characters)",
+            &text[..cut],
+            text[cut..].chars().count()
+        ),
     }
 }
 
@@ -420,13 +440,14 @@ fn not_found(sig: &str, engine: &Engine) -> String {
     }
     if matches!(name, ".." | "..=") {
         return format!(
-            "a range's bounds must be integers, got ({}); {INTEGER_HINT}",
+            "a range `a{name}b` takes integers, not ({}): loop over integers and scale, \
+             e.g. `for k in 1..6 {{ let x = k * 0.5; }}`; {INTEGER_HINT}",
             args.join(", ")
         );
     }
     // Rhai's standard functions (`range`, `sub_string`) count as known.
-    let mut known: Vec<String> = engine
-        .gen_fn_signatures(true)
+    let sigs = engine.gen_fn_signatures(true);
+    let mut known: Vec<String> = sigs
         .iter()
         .filter_map(|s| s.split('(').next())
         .map(|n| n.trim().to_owned())
@@ -446,7 +467,34 @@ fn not_found(sig: &str, engine: &Engine) -> String {
             args.join(", ")
         );
     }
-    match crate::material::nearest_name(name, known.iter().map(String::as_str)) {
+    // An identifier is not suggested an operator (`m.i(..)` is not `*`), and
+    // a method is suggested among those its first argument's type has.
+    let is_ident = |n: &str| n.chars().all(|c| c.is_alphanumeric() || c == '_');
+    let first = args.first().copied().unwrap_or("");
+    let takes_first = |n: &str| {
+        sigs.iter().any(|s| {
+            s.split_once('(').is_some_and(|(k, rest)| {
+                k.trim() == n
+                    && rest
+                        .split([',', ')'])
+                        .next()
+                        .is_some_and(|p| p.contains(first))
+            })
+        })
+    };
+    let candidates: Vec<&str> = known
+        .iter()
+        .map(String::as_str)
+        .filter(|k| is_ident(k) == is_ident(name))
+        .collect();
+    let methods: Vec<&str> = candidates
+        .iter()
+        .copied()
+        .filter(|k| !first.is_empty() && takes_first(k))
+        .collect();
+    let near = crate::material::nearest_name(name, methods.iter().copied())
+        .or_else(|| crate::material::nearest_name(name, candidates.iter().copied()));
+    match near {
         Some(k) => format!("unknown function `{name}`; did you mean `{k}`?"),
         None => format!("unknown function `{name}`"),
     }
