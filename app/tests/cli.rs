@@ -569,3 +569,35 @@ fn scripts_read_inside_their_project_and_allow_read_adds_folders() {
     std::fs::write(root.join("volcad.toml"), "").unwrap();
     ok(&run(&[]));
 }
+
+/// `--params FILE --set NAME` applies a set the studio saved beside the
+/// design (`--param` still wins); an unknown set lists the ones there are.
+#[test]
+fn parameter_sets_apply_on_the_command_line() {
+    let scratch = tmp("param-sets");
+    let dir = scratch.path();
+    let design = dir.join("plate.rhai");
+    std::fs::write(
+        &design,
+        "let m = default_materials();\nlet w = param(\"width\", 15.0, 5.0, 30.0);\nRectPrism(Vec3(0, 0, 0), Vec3(w, 10, 5), m.id(\"gray\"))\n",
+    )
+    .unwrap();
+    let sets = dir.join("plate.params.json");
+    std::fs::write(
+        &sets,
+        r#"{"fileFormatVersion": "1", "parameterSets": {"wide": {"width": "22"}}}"#,
+    )
+    .unwrap();
+    let (d, s) = (design.to_str().unwrap(), sets.to_str().unwrap());
+    let out = ok(&volcad(&["info", d, "--params", s, "--set", "wide"]));
+    assert!(out.contains("size (mm):   22.0000 x"), "{out}");
+    let out = ok(&volcad(&[
+        "info", d, "--params", s, "--set", "wide", "--param", "width=9",
+    ]));
+    assert!(out.contains("size (mm):   9.0000 x"), "{out}");
+    let err = fails(&volcad(&["info", d, "--params", s, "--set", "narrow"]));
+    assert!(
+        err.contains("no parameter set \"narrow\"; the file has wide"),
+        "{err}"
+    );
+}

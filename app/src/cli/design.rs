@@ -7,6 +7,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, bail};
 use volcad_core::Model;
 use volcad_core::material::nearest_name;
+use volcad_core::script::param_sets::ParamSets;
 use volcad_core::script::{Design, Param, ScriptOptions};
 use volcad_core::vcad::run_design;
 
@@ -78,6 +79,16 @@ fn check_params(given: &HashMap<String, f64>, declared: &[Param]) -> anyhow::Res
     Ok(())
 }
 
+/// The values of `--params FILE --set NAME` (none without them).
+fn set_params(args: &DesignArgs) -> anyhow::Result<HashMap<String, f64>> {
+    let (Some(file), Some(name)) = (&args.params_file, &args.set) else {
+        return Ok(HashMap::new());
+    };
+    let sets = ParamSets::load(file).map_err(|e| anyhow::anyhow!("--params {e}"))?;
+    sets.values(name)
+        .map_err(|e| anyhow::anyhow!("--set {name}: {e} ({})", file.display()))
+}
+
 /// Each `--allow-read DIR` must be a folder that exists: a typo would
 /// otherwise surface only as a refused file later.
 fn allowed_folders(dirs: &[std::path::PathBuf]) -> anyhow::Result<Vec<std::path::PathBuf>> {
@@ -96,7 +107,8 @@ fn allowed_folders(dirs: &[std::path::PathBuf]) -> anyhow::Result<Vec<std::path:
 pub fn load_design(args: &DesignArgs) -> anyhow::Result<Loaded> {
     let source = super::output::read_input(&args.design, "design script")?;
     let mut opts = ScriptOptions::for_file(&args.design);
-    opts.params = parse_params(&args.params)?;
+    opts.params = set_params(args)?;
+    opts.params.extend(parse_params(&args.params)?);
     opts.allow_read = allowed_folders(&args.allow_read)?;
     let name = args.design.display().to_string();
     let start = Instant::now();

@@ -144,6 +144,8 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
             design: path.clone(),
             params: vec![],
             allow_read: args.allow_read.clone(),
+            params_file: None,
+            set: None,
         };
         let l = match load_design(&d) {
             Ok(l) => l,

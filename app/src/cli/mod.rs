@@ -66,6 +66,13 @@ pub struct DesignArgs {
     /// folder): `--allow-read DIR` (repeatable).
     #[arg(long = "allow-read", value_name = "DIR")]
     pub allow_read: Vec<PathBuf>,
+    /// A parameter-set file (`design.params.json`, as the studio saves
+    /// it); with `--set NAME` its set NAME is applied (`--param` wins).
+    #[arg(long = "params", value_name = "FILE", requires = "set")]
+    pub params_file: Option<PathBuf>,
+    /// The set of `--params FILE` to apply.
+    #[arg(long = "set", value_name = "NAME", requires = "params_file")]
+    pub set: Option<String>,
 }
 
 /// The subcommands.
