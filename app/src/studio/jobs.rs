@@ -100,7 +100,7 @@ impl Jobs {
                 j.state = match h.join() {
                     Ok(s) => JobState::Done(s),
                     Err(volcad_compilers::ExportError::Cancelled) => JobState::Cancelled,
-                    Err(e) => JobState::Failed(e.to_string()),
+                    Err(e) => JobState::Failed(in_panel_words(&e.to_string())),
                 };
                 finished.push(match &j.state {
                     JobState::Done(s) => format!(
@@ -232,6 +232,30 @@ pub fn duration_text(d: Duration) -> String {
     }
 }
 
+/// A compiler's message in the panel's words: its command-line option
+/// names become the fields that set them (`--voxel` → "Voxel (mm)").
+pub fn in_panel_words(message: &str) -> String {
+    const FIELDS: [(&str, &str); 12] = [
+        ("--min-cell", "\"Cell min\""),
+        ("--max-cell", "\"Cell max\""),
+        ("--sizing", "\"Size of h\""),
+        ("--voxel", "\"Voxel (mm)\""),
+        ("--out", "\"Output folder\""),
+        ("--infill", "\"3MF infill\""),
+        ("--segments", "\"Segments\""),
+        ("--material", "\"Split by\""),
+        ("--format", "\"Formats\""),
+        ("--threads", "the thread count"),
+        ("--layers", "the layer range"),
+        ("--step", "\"Static step\""),
+    ];
+    let mut m = message.to_owned();
+    for (flag, field) in FIELDS {
+        m = m.replace(flag, field);
+    }
+    m
+}
+
 /// "1 file", "2 files".
 pub fn count(n: usize, noun: &str) -> String {
     if n == 1 {
@@ -271,6 +295,17 @@ pub fn fresh_destination(base: &Path, name: &str) -> PathBuf {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn messages_name_panel_fields_not_flags() {
+        assert_eq!(
+            in_panel_words("--voxel: one layer needs 3 GiB; use a larger --voxel"),
+            "\"Voxel (mm)\": one layer needs 3 GiB; use a larger \"Voxel (mm)\""
+        );
+        assert_eq!(count(1, "file"), "1 file");
+        assert_eq!(count(2, "file"), "2 files");
+    }
+
     use super::*;
 
     #[test]
