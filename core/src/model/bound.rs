@@ -95,6 +95,12 @@ fn tile_box(b: &Aabb, cell: DVec3) -> Aabb {
     }
 }
 
+/// The box of `m·p + t` over the points `p` of `b`.
+fn affine_box(b: &Aabb, m: &glam::DMat3, t: DVec3) -> Aabb {
+    let q = b.transformed(m, DVec3::ZERO);
+    Aabb::new(q.min + t, q.max + t)
+}
+
 /// Intervals of the coordinate slots over `b` (x y z rho phic r theta phis d).
 pub fn coord_intervals(b: &Aabb, d: Interval) -> [Interval; COORD_SLOTS] {
     let x = Interval::new(b.min.x, b.max.x);
@@ -132,6 +138,7 @@ impl PNode {
             | PNode::Shell { child, .. }
             | PNode::Blend { child, .. } => child.is_lipschitz(),
             PNode::FGrade(g) => g.child.is_lipschitz(),
+            PNode::Affine(a) => a.child.is_lipschitz(),
             PNode::Union(n) | PNode::Intersection(n) => n.lipschitz,
             PNode::Difference { a, b, smooth } => {
                 *smooth <= 0.0 && a.is_lipschitz() && b.is_lipschitz()
@@ -171,6 +178,10 @@ impl PNode {
             PNode::Scale { inv, k, child } => {
                 let i = child.interval(&b.scaled(*inv));
                 Interval::new(i.lo * *k, i.hi * *k)
+            }
+            PNode::Affine(a) => {
+                let i = a.child.interval(&affine_box(b, &a.m, a.t));
+                Interval::new(i.lo * a.k, i.hi * a.k)
             }
             // A sharp union of 1-Lipschitz children is 1-Lipschitz: one
             // indexed query at the centre gives the same interval as the
@@ -258,6 +269,7 @@ impl PNode {
                 to_local, around, ..
             } => b.transformed(to_local, *around),
             PNode::Scale { inv, .. } => b.scaled(*inv),
+            PNode::Affine(a) => affine_box(b, &a.m, a.t),
             PNode::Tile { cell, .. } => tile_box(b, *cell),
             _ => *b, // offset, shell: the same points
         };

@@ -54,6 +54,7 @@ impl PNode {
                 child,
             } => child.frac(*to_local * (p - *around) + *around, out),
             PNode::Scale { inv, child, .. } => child.frac(p * *inv, out),
+            PNode::Affine(a) => a.child.frac(a.m * p + a.t, out),
             PNode::Union(u) => u.union_frac(p, out),
             PNode::Intersection(n) => {
                 if n.blend {
@@ -83,6 +84,7 @@ impl PNode {
             | PNode::Offset { child, .. }
             | PNode::Shell { child, .. }
             | PNode::Tile { child, .. } => Some(child),
+            PNode::Affine(a) => Some(&a.child),
             _ => None,
         }
     }

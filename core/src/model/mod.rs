@@ -8,6 +8,7 @@
 //! are `k = materials().len()` numbers in that order.
 
 mod bound;
+mod flatten;
 mod frac_bound;
 mod fractions;
 mod pnode;
