@@ -142,3 +142,45 @@ fn sizes_beyond_1e9_mm_are_refused_where_they_are_given() {
         );
     }
 }
+
+#[test]
+fn scripts_that_nest_their_design_in_a_loop_prepare_and_evaluate() {
+    // The fuzzing run's reproducers: each overflowed the stack of `volcad
+    // info`, `eval` and `export`.
+    let cases = [
+        (
+            "for i in 0..10000 { n = Union(false, [n, Sphere(Vec3(i, 0, 0), 1, red)]); }",
+            DVec3::new(9999.0, 0.0, 0.0),
+            -1.0,
+        ),
+        (
+            "for i in 0..3000 { n = Union(false, [n]); }",
+            DVec3::ZERO,
+            -1.0,
+        ),
+        (
+            "for i in 0..200000 { n = Translate(0.00001, 0, 0, n); }",
+            DVec3::new(2.0, 0.0, 0.0),
+            -1.0,
+        ),
+    ];
+    for (body, p, want) in cases {
+        let src = format!(
+            "let m = default_materials();\nlet red = m.id(\"red\");\n\
+             let n = Sphere(Vec3(0,0,0), 1, red);\n{body}\nn"
+        );
+        let handle = std::thread::Builder::new()
+            .stack_size(2 << 20)
+            .spawn(move || {
+                let m = prepare(&src).expect("prepares");
+                let d = m.distance(p);
+                let (d2, fracs) = m.eval_point(p);
+                assert_eq!(d, d2);
+                assert!(!fracs.is_empty());
+                d
+            })
+            .expect("spawn");
+        let d = handle.join().expect("no panic");
+        assert!((d - want).abs() < 1e-6, "{body}: {d}");
+    }
+}
