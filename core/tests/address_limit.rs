@@ -29,7 +29,7 @@ fn vm_size() -> u64 {
 #[test]
 fn a_doubling_string_under_ulimit_v_meets_the_script_budget() {
     let old = getrlimit(Resource::As);
-    let mut limit = old.clone();
+    let mut limit = old;
     limit.current = Some(vm_size() + (1 << 30));
     setrlimit(Resource::As, limit).expect("lower the address-space limit");
     let left = address_space_left().expect("a limit is set");

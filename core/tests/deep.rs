@@ -96,7 +96,7 @@ fn a_million_single_child_unions_and_intersections() {
         let mut n = sphere(DVec3::ZERO, 2.0, RED);
         for i in 0..DEPTH {
             let children = vec![n];
-            n = if i % 2 == 0 {
+            n = if i.is_multiple_of(2) {
                 union(0.5, children)
             } else {
                 Node::new(NodeKind::Intersection {
@@ -121,7 +121,7 @@ fn a_million_nested_intersections_and_differences() {
         let hole = sphere(DVec3::new(5.0, 0.0, 0.0), 1.0, BLUE);
         let mut n = sphere(DVec3::ZERO, 10.0, RED);
         for i in 0..DEPTH {
-            n = if i % 2 == 0 {
+            n = if i.is_multiple_of(2) {
                 Node::new(NodeKind::Intersection {
                     smooth: 0.0,
                     blend: false,
@@ -214,7 +214,7 @@ fn a_million_moves_of_each_kind() {
 
         let mut n = leaf();
         for i in 0..DEPTH {
-            let s = if i % 2 == 0 { 2.0 } else { 0.5 };
+            let s = if i.is_multiple_of(2) { 2.0 } else { 0.5 };
             n = Node::new(NodeKind::Scale {
                 factors: DVec3::splat(s),
                 child: Some(n),
@@ -225,7 +225,7 @@ fn a_million_moves_of_each_kind() {
         // All three in turn, against the nested nodes' mapping of the
         // point written out by hand (outermost first).
         let levels = DEPTH - DEPTH % 6;
-        let scale = |i: usize| if i % 2 == 0 { 2.0 } else { 0.5 };
+        let scale = |i: usize| if i.is_multiple_of(2) { 2.0 } else { 0.5 };
         let mut n = leaf();
         for i in 0..levels {
             n = Node::new(match i % 3 {

@@ -74,7 +74,7 @@ impl<'a> Shape<'a> {
 /// True when a union or intersection with this `smooth` takes a plain
 /// minimum or maximum (the prepared node clamps `smooth` to ≥ 0).
 fn sharp(smooth: f64) -> bool {
-    !(smooth > 0.0)
+    smooth.is_nan() || smooth <= 0.0
 }
 
 /// The node that `n` stands for once unions and intersections of one
