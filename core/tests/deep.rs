@@ -85,6 +85,12 @@ fn a_million_nested_sharp_unions() {
         for _ in 0..DEPTH {
             n = union(0.0, vec![n, s.clone()]);
         }
+        // Debug printing shows one level (the fields would recurse).
+        let printed = format!("{n:?}");
+        assert!(
+            printed.contains("Union") && printed.len() < 200,
+            "{printed}"
+        );
         exercise(n.clone(), DVec3::new(3.0, 0.0, 0.0), -1.0);
         exercise(n, DVec3::ZERO, -1.0);
     });
