@@ -27,7 +27,7 @@ use std::collections::HashSet;
 use glam::{DMat3, DVec3};
 
 use super::pnode::{Affine, PNode};
-use super::prepare::{Prepared, rotation};
+use super::prepare::Prepared;
 use crate::bounds::Aabb;
 use crate::node::{Node, NodeKind};
 
@@ -286,4 +286,12 @@ pub(super) fn compose_moves(chain: &[&NodeKind], child: &Prepared) -> (PNode, Aa
         child: child.node.clone(),
     }));
     (node, bbox)
+}
+
+/// R = Rz(roll)·Ry(yaw)·Rx(pitch), degrees (pyvcad's convention for its
+/// bounding box; we rotate the geometry by the same R, see docs/PYVCAD.md).
+pub fn rotation(pitch: f64, yaw: f64, roll: f64) -> DMat3 {
+    DMat3::from_rotation_z(roll.to_radians())
+        * DMat3::from_rotation_y(yaw.to_radians())
+        * DMat3::from_rotation_x(pitch.to_radians())
 }

@@ -32,7 +32,7 @@ use crate::material::{MaterialId, MaterialTable};
 use crate::node::Node;
 use pnode::PNode;
 
-pub use prepare::rotation;
+pub use flatten::rotation;
 
 /// Most distinct materials one design may use (fractions live on the stack).
 pub const MAX_MATERIALS: usize = 64;

@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use glam::{DMat3, DVec2, DVec3};
 
-use super::flatten::{self, Shape, compose_moves};
+use super::flatten::{self, Shape, compose_moves, rotation};
 use super::pnode::{Capsule, Grade, LineCapsule, NAry, PNode, Prism, SimGrade, Slot};
 use super::strut_grid::StrutGrid;
 use super::tpms::Tpms;
@@ -210,128 +210,6 @@ impl Preparer {
 
     fn build(&mut self, n: &Node) -> Result<(PNode, Aabb), PrepareError> {
         Ok(match n.kind() {
-            NodeKind::Sphere {
-                center,
-                radius,
-                material,
-            } => (
-                PNode::Sphere {
-                    c: *center,
-                    r: *radius,
-                    m: self.slot(*material),
-                },
-                Aabb::from_center_size(*center, DVec3::splat(2.0 * radius)),
-            ),
-            NodeKind::RectPrism {
-                center,
-                size,
-                material,
-            } => (
-                PNode::Box {
-                    c: *center,
-                    h: *size * 0.5,
-                    m: self.slot(*material),
-                },
-                Aabb::from_center_size(*center, *size),
-            ),
-            NodeKind::Cylinder {
-                center,
-                radius,
-                height,
-                material,
-            } => (
-                PNode::Cylinder {
-                    c: *center,
-                    r: *radius,
-                    hh: height * 0.5,
-                    m: self.slot(*material),
-                },
-                Aabb::from_center_size(*center, DVec3::new(2.0 * radius, 2.0 * radius, *height)),
-            ),
-            NodeKind::Strut {
-                a,
-                b,
-                radius,
-                material,
-            } => {
-                let s = Capsule::new(*a, *b, *radius);
-                (
-                    PNode::Strut {
-                        s,
-                        m: self.slot(*material),
-                    },
-                    s.bbox(),
-                )
-            }
-            NodeKind::PolygonExtrude {
-                vertices,
-                height,
-                symmetric,
-                material,
-            } => {
-                let (prism, bbox) = prism(vertices, *height, *symmetric).map_err(|m| err(n, &m))?;
-                (
-                    PNode::Prism {
-                        p: Box::new(prism),
-                        m: self.slot(*material),
-                    },
-                    bbox,
-                )
-            }
-            NodeKind::Function {
-                expr,
-                material,
-                min,
-                max,
-            } => {
-                let clip = Aabb::new(*min, *max);
-                (
-                    PNode::Function {
-                        expr: expr.clone(),
-                        clip_c: clip.center(),
-                        clip_h: clip.size() * 0.5,
-                        m: self.slot(*material),
-                    },
-                    clip,
-                )
-            }
-            NodeKind::Tpms {
-                kind,
-                cell,
-                thickness,
-                material,
-            } => (
-                PNode::Tpms {
-                    t: Tpms::new(*kind, *cell, *thickness),
-                    m: self.slot(*material),
-                },
-                Aabb::EVERYTHING,
-            ),
-            NodeKind::GraphLattice {
-                edges,
-                cell,
-                radius,
-                material,
-            } => {
-                let struts: Vec<Capsule> = edges
-                    .iter()
-                    .map(|(a, b)| Capsule::new(*a, *b, *radius))
-                    .collect();
-                let bbox = match cell {
-                    Some(c) => Aabb::from_center_size(DVec3::ZERO, *c),
-                    None => struts.iter().fold(Aabb::EMPTY, |b, s| b.union(&s.bbox())),
-                };
-                (
-                    PNode::Lattice {
-                        grid: cell.and_then(|c| StrutGrid::new(&struts, c * 0.5).map(Box::new)),
-                        struts,
-                        r: *radius,
-                        clip_h: cell.map(|c| c * 0.5),
-                        m: self.slot(*material),
-                    },
-                    bbox,
-                )
-            }
             NodeKind::Translate { offset, child } => {
                 let (c, b) = self.child(n, child)?;
                 (
@@ -447,6 +325,143 @@ impl Preparer {
                     b,
                 )
             }
+            _ => self.build_leaf(n)?,
+        })
+    }
+
+    /// A leaf: a primitive, lattice, mesh or FEA field.
+    fn build_leaf(&self, n: &Node) -> Result<(PNode, Aabb), PrepareError> {
+        Ok(match n.kind() {
+            NodeKind::Sphere {
+                center,
+                radius,
+                material,
+            } => (
+                PNode::Sphere {
+                    c: *center,
+                    r: *radius,
+                    m: self.slot(*material),
+                },
+                Aabb::from_center_size(*center, DVec3::splat(2.0 * radius)),
+            ),
+            NodeKind::RectPrism {
+                center,
+                size,
+                material,
+            } => (
+                PNode::Box {
+                    c: *center,
+                    h: *size * 0.5,
+                    m: self.slot(*material),
+                },
+                Aabb::from_center_size(*center, *size),
+            ),
+            NodeKind::Cylinder {
+                center,
+                radius,
+                height,
+                material,
+            } => (
+                PNode::Cylinder {
+                    c: *center,
+                    r: *radius,
+                    hh: height * 0.5,
+                    m: self.slot(*material),
+                },
+                Aabb::from_center_size(*center, DVec3::new(2.0 * radius, 2.0 * radius, *height)),
+            ),
+            NodeKind::Strut {
+                a,
+                b,
+                radius,
+                material,
+            } => {
+                let s = Capsule::new(*a, *b, *radius);
+                (
+                    PNode::Strut {
+                        s,
+                        m: self.slot(*material),
+                    },
+                    s.bbox(),
+                )
+            }
+            NodeKind::PolygonExtrude {
+                vertices,
+                height,
+                symmetric,
+                material,
+            } => {
+                let (prism, bbox) = prism(vertices, *height, *symmetric).map_err(|m| err(n, &m))?;
+                (
+                    PNode::Prism {
+                        p: Box::new(prism),
+                        m: self.slot(*material),
+                    },
+                    bbox,
+                )
+            }
+            _ => self.build_field(n)?,
+        })
+    }
+
+    /// A leaf defined by a field or a list: a math string, TPMS,
+    /// lattice, mesh or FEA field.
+    fn build_field(&self, n: &Node) -> Result<(PNode, Aabb), PrepareError> {
+        Ok(match n.kind() {
+            NodeKind::Function {
+                expr,
+                material,
+                min,
+                max,
+            } => {
+                let clip = Aabb::new(*min, *max);
+                (
+                    PNode::Function {
+                        expr: expr.clone(),
+                        clip_c: clip.center(),
+                        clip_h: clip.size() * 0.5,
+                        m: self.slot(*material),
+                    },
+                    clip,
+                )
+            }
+            NodeKind::Tpms {
+                kind,
+                cell,
+                thickness,
+                material,
+            } => (
+                PNode::Tpms {
+                    t: Tpms::new(*kind, *cell, *thickness),
+                    m: self.slot(*material),
+                },
+                Aabb::EVERYTHING,
+            ),
+            NodeKind::GraphLattice {
+                edges,
+                cell,
+                radius,
+                material,
+            } => {
+                let struts: Vec<Capsule> = edges
+                    .iter()
+                    .map(|(a, b)| Capsule::new(*a, *b, *radius))
+                    .collect();
+                let bbox = match cell {
+                    Some(c) => Aabb::from_center_size(DVec3::ZERO, *c),
+                    None => struts.iter().fold(Aabb::EMPTY, |b, s| b.union(&s.bbox())),
+                };
+                (
+                    PNode::Lattice {
+                        grid: cell.and_then(|c| StrutGrid::new(&struts, c * 0.5).map(Box::new)),
+                        struts,
+                        r: *radius,
+                        clip_h: cell.map(|c| c * 0.5),
+                        m: self.slot(*material),
+                    },
+                    bbox,
+                )
+            }
             NodeKind::Mesh { mesh, material } => (
                 PNode::Mesh {
                     mesh: mesh.clone(),
@@ -474,6 +489,7 @@ impl Preparer {
                     bbox,
                 )
             }
+            _ => return Err(err(n, "is not a leaf (a bug in volcad)")),
         })
     }
 
@@ -600,14 +616,6 @@ fn err(n: &Node, message: &str) -> PrepareError {
         node: n.describe(),
         message: message.to_owned(),
     }
-}
-
-/// R = Rz(roll)·Ry(yaw)·Rx(pitch), degrees (pyvcad's convention for its
-/// bounding box; we rotate the geometry by the same R, see docs/PYVCAD.md).
-pub fn rotation(pitch: f64, yaw: f64, roll: f64) -> DMat3 {
-    DMat3::from_rotation_z(roll.to_radians())
-        * DMat3::from_rotation_y(yaw.to_radians())
-        * DMat3::from_rotation_x(pitch.to_radians())
 }
 
 /// A planar polygon (right-hand rule normal) extruded by `height` along the
