@@ -169,8 +169,8 @@ impl Preparer {
                 n,
                 &format!(
                     "is nested {depth} levels deep, more than the {MAX_DEPTH} an evaluation can follow \
-                     (chains of sharp Unions, Intersections, Differences, FGrades and of moves are \
-                     read flat; this one alternates other nodes); a loop that wraps the design again \
+                     (chains of sharp Unions, Intersections, Differences, FGrades, moves and Offsets \
+                     are read flat; smooth unions, Blends, Shells, Tiles and mixed chains are not); a loop that wraps the design again \
                      on every pass builds this: collect the parts in an array and make one node of \
                      it, Union(false, parts), or wrap fewer times"
                 ),
