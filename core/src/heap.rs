@@ -116,15 +116,33 @@ pub fn budget_from_env() -> Result<Option<u64>, String> {
     }
 }
 
+/// Bytes the process may still map before it reaches its address-space
+/// limit (`ulimit -v`, `RLIMIT_AS`): the limit less the virtual size it
+/// has now (`VmSize`, which counts the allocator's reserved arenas and the
+/// thread stacks too). `None` when there is no limit or it is not known.
+pub fn address_space_left() -> Option<u64> {
+    let limit = rustix::process::getrlimit(rustix::process::Resource::As).current?;
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmSize:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(limit.saturating_sub(kib * 1024))
+}
+
 /// The default heap budget of a script: [`BUDGET_VAR`] when set, else a
 /// quarter of the memory available when it starts, or 4 GiB where that is
-/// not known. A design script needs megabytes; the budget only has to stop
-/// a runaway while its peak (about three budgets, see the module doc)
-/// still fits.
+/// not known; either way at most a quarter of the address space the
+/// process has left under `ulimit -v` (an allocation past that limit
+/// fails, and a failed allocation aborts a Rust process). A design script
+/// needs megabytes; the budget only has to stop a runaway while its peak
+/// (about three budgets, see the module doc) still fits.
 pub fn default_script_budget() -> u64 {
-    match budget_from_env() {
+    let budget = match budget_from_env() {
         Ok(Some(b)) => b,
         _ => available_memory().map_or(4 << 30, |a| a / 4),
+    };
+    match address_space_left() {
+        Some(left) => budget.min(left / 4),
+        None => budget,
     }
 }
 

@@ -68,7 +68,11 @@ pub enum CapMode {
 }
 
 /// A handle to a node of the design tree.
-#[derive(Clone, Debug)]
+///
+/// Dropping and debug-printing do not recurse: a script can nest a million
+/// nodes (`n = Union(false, [n, s])` in a loop), and a recursive walk of
+/// that depth overflows a thread's stack.
+#[derive(Clone)]
 pub struct Node {
     pub(crate) kind: Arc<NodeKind>,
     pub(crate) origin: Option<Origin>,
@@ -403,5 +407,51 @@ impl Node {
     /// The identity of the shared node (for caches during prepare).
     pub(crate) fn ptr(&self) -> *const NodeKind {
         Arc::as_ptr(&self.kind)
+    }
+}
+
+/// Moves the children out of `kind` into `out` when this is its last
+/// handle (so they are dropped from the caller's loop, not from inside
+/// this node's drop).
+fn take_children(kind: &mut Arc<NodeKind>, out: &mut Vec<Node>) {
+    let Some(k) = Arc::get_mut(kind) else {
+        return;
+    };
+    if let Some(slot) = k.child_slot() {
+        out.extend(slot.take());
+        return;
+    }
+    match k {
+        NodeKind::Union { children, .. } | NodeKind::Intersection { children, .. } => {
+            out.append(children)
+        }
+        NodeKind::Difference { left, right, .. } => {
+            out.extend(left.take());
+            out.extend(right.take());
+        }
+        _ => {}
+    }
+}
+
+impl Drop for Node {
+    fn drop(&mut self) {
+        let mut pending = Vec::new();
+        take_children(&mut self.kind, &mut pending);
+        while let Some(mut n) = pending.pop() {
+            take_children(&mut n.kind, &mut pending);
+            // `n` now holds no children: its own drop does not descend.
+        }
+    }
+}
+
+impl std::fmt::Debug for Node {
+    /// One level: the type, where it was made and how many children (the
+    /// children's own fields would recurse as deep as the tree).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Node")
+            .field("type", &self.kind.type_name())
+            .field("origin", &self.origin)
+            .field("children", &self.kind.children().len())
+            .finish()
     }
 }

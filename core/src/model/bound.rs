@@ -100,6 +100,12 @@ pub fn reflection(n: DVec3) -> glam::DMat3 {
     glam::DMat3::IDENTITY - 2.0 * glam::DMat3::from_cols(n * n.x, n * n.y, n * n.z)
 }
 
+/// The box of `m·p + t` over the points `p` of `b`.
+fn affine_box(b: &Aabb, m: &glam::DMat3, t: DVec3) -> Aabb {
+    let q = b.transformed(m, DVec3::ZERO);
+    Aabb::new(q.min + t, q.max + t)
+}
+
 /// Intervals of the coordinate slots over `b` (x y z rho phic r theta phis d).
 pub fn coord_intervals(b: &Aabb, d: Interval) -> [Interval; COORD_SLOTS] {
     let x = Interval::new(b.min.x, b.max.x);
@@ -142,6 +148,7 @@ impl PNode {
             | PNode::Blend { child, .. }
             | PNode::Mirror { child, .. } => child.is_lipschitz(),
             PNode::FGrade(g) => g.child.is_lipschitz(),
+            PNode::Affine(a) => a.child.is_lipschitz(),
             PNode::Union(n) | PNode::Intersection(n) => n.lipschitz,
             PNode::Difference { a, b, smooth } => {
                 *smooth <= 0.0 && a.is_lipschitz() && b.is_lipschitz()
@@ -198,6 +205,10 @@ impl PNode {
             PNode::Scale { inv, k, child } => {
                 let i = child.interval(&b.scaled(*inv));
                 Interval::new(i.lo * *k, i.hi * *k)
+            }
+            PNode::Affine(a) => {
+                let i = a.child.interval(&affine_box(b, &a.m, a.t));
+                Interval::new(i.lo * a.k, i.hi * a.k)
             }
             // A sharp union of 1-Lipschitz children is 1-Lipschitz: one
             // indexed query at the centre gives the same interval as the
@@ -286,6 +297,7 @@ impl PNode {
             } => b.transformed(to_local, *around),
             PNode::Scale { inv, .. } => b.scaled(*inv),
             PNode::Mirror { point, normal, .. } => b.transformed(&reflection(*normal), *point),
+            PNode::Affine(a) => affine_box(b, &a.m, a.t),
             PNode::Tile { cell, .. } => tile_box(b, *cell),
             _ => *b, // offset, shell: the same points
         };

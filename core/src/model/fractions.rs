@@ -59,6 +59,7 @@ impl PNode {
                 child,
             } => child.frac(super::pnode::reflect(p, *point, *normal), out),
             PNode::Scale { inv, child, .. } => child.frac(p * *inv, out),
+            PNode::Affine(a) => a.child.frac(a.m * p + a.t, out),
             PNode::Union(u) => u.union_frac(p, out),
             PNode::Intersection(n) => {
                 if n.blend {
@@ -95,6 +96,7 @@ impl PNode {
             | PNode::Shell { child, .. }
             | PNode::Tile { child, .. }
             | PNode::Mirror { child, .. } => Some(child),
+            PNode::Affine(a) => Some(&a.child),
             _ => None,
         }
     }

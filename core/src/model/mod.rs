@@ -8,6 +8,7 @@
 //! are `k = materials().len()` numbers in that order.
 
 mod bound;
+mod flatten;
 mod frac_bound;
 mod fractions;
 mod pnode;
@@ -33,7 +34,7 @@ use crate::material::{MaterialId, MaterialTable};
 use crate::node::Node;
 use pnode::PNode;
 
-pub use prepare::rotation;
+pub use flatten::rotation;
 
 /// Check a `PolygonRevolve` half-profile as prepare will (for errors at
 /// the script call): the reason it is refused, if it is.

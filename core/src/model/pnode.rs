@@ -164,6 +164,9 @@ pub enum PNode {
         k: f64,
         child: Arc<PNode>,
     },
+    /// `child(m·p + t)·k`: a long chain of moves composed at prepare
+    /// (`flatten`); `k` is the product of the Scales' `min |s|`.
+    Affine(Box<Affine>),
     Union(Box<NAry>),
     Intersection(Box<NAry>),
     Difference {
@@ -216,6 +219,15 @@ pub enum PNode {
         hz: f64,
         m: Slot,
     },
+}
+
+/// `child(m·p + t)·k` (boxed: the other variants are smaller).
+#[derive(Debug)]
+pub struct Affine {
+    pub m: DMat3,
+    pub t: DVec3,
+    pub k: f64,
+    pub child: Arc<PNode>,
 }
 
 /// Union or intersection over many children.
@@ -337,6 +349,7 @@ impl PNode {
                 child,
             } => child.dist(*to_local * (p - *around) + *around),
             PNode::Scale { inv, k, child } => child.dist(p * *inv) * *k,
+            PNode::Affine(a) => a.child.dist(a.m * p + a.t) * a.k,
             PNode::Union(u) => u.union_dist(p),
             PNode::Intersection(n) => {
                 let mut d = n.children[0].dist(p);
@@ -379,6 +392,32 @@ impl PNode {
                 sdf::extrude(shape.signed_distance(DVec2::new(p.x, p.y)), p.z.abs() - *hz)
             }
         }
+    }
+}
+
+impl PNode {
+    /// The bits of a sphere, box, cylinder or strut (kind, parameters,
+    /// material): two leaves with the same key are the same node.
+    pub fn leaf_key(&self) -> Option<[u64; 9]> {
+        let v = |a: DVec3| [a.x.to_bits(), a.y.to_bits(), a.z.to_bits()];
+        let (kind, a, b, r, m) = match self {
+            PNode::Sphere { c, r, m } => (0, v(*c), [0; 3], *r, *m),
+            PNode::Box { c, h, m } => (1, v(*c), v(*h), 0.0, *m),
+            PNode::Cylinder { c, r, hh, m } => (2, v(*c), [hh.to_bits(), 0, 0], *r, *m),
+            PNode::Strut { s, m } => (3, v(s.a), v(s.ab), s.r, *m),
+            _ => return None,
+        };
+        Some([
+            kind,
+            a[0],
+            a[1],
+            a[2],
+            b[0],
+            b[1],
+            b[2],
+            r.to_bits(),
+            u64::from(m),
+        ])
     }
 }
 

@@ -8,23 +8,46 @@ use std::sync::Arc;
 
 use glam::{DMat3, DVec2, DVec3};
 
+use super::flatten::{self, Shape, compose_moves, rotation};
 use super::pnode::{Capsule, Grade, LineCapsule, NAry, PNode, Prism, SimGrade, Slot};
-use super::shapes::{Beam, Cone, Revolve, Shape};
 use super::strut_grid::StrutGrid;
 use super::tpms::Tpms;
 use super::union_index::UnionIndex;
 use super::{MAX_MATERIALS, PrepareError};
 use crate::bounds::Aabb;
 use crate::material::MaterialId;
-use crate::node::{CapMode, Node, NodeKind};
+use crate::node::{Node, NodeKind};
 
 /// Unions with at least this many sharp children get a spatial index.
 const INDEX_MIN_CHILDREN: usize = 8;
 
+#[path = "prepare_pyvcad3.rs"]
+mod pyvcad3;
+
 pub(super) struct Preparer {
     slots: HashMap<MaterialId, Slot>,
-    cache: HashMap<*const NodeKind, (Arc<PNode>, Aabb)>,
+    cache: HashMap<*const NodeKind, Prepared>,
 }
+
+/// A prepared node, with what the limits below need.
+#[derive(Clone)]
+pub(super) struct Prepared {
+    pub(super) node: Arc<PNode>,
+    pub(super) bbox: Aabb,
+    /// Levels of prepared nodes down to the deepest leaf.
+    depth: u32,
+    /// Nodes when each shared one is counted at every use (what an
+    /// evaluation may visit), saturating.
+    size: u64,
+}
+
+/// Deepest prepared tree: evaluation, intervals and fraction bounds recurse
+/// once a level, each level a few hundred bytes of a thread's stack (the
+/// fraction bounds' scratch arrays are 1 KiB), and a thread may have 2 MiB.
+pub(super) const MAX_DEPTH: u32 = 1_000;
+
+/// Most nodes a prepared tree may expand to (see [`Prepared::size`]).
+pub(super) const MAX_EXPANDED: u64 = 1 << 24;
 
 /// Every material id used in the tree, ascending.
 pub(super) fn collect_materials(root: &Node) -> Vec<MaterialId> {
@@ -73,29 +96,114 @@ impl Preparer {
         self.slots.get(&m).copied().unwrap_or(0)
     }
 
-    /// Prepare `n` (cached by identity, so shared subtrees are prepared once).
-    pub(super) fn prepare(&mut self, n: &Node) -> Result<(Arc<PNode>, Aabb), PrepareError> {
-        if let Some(hit) = self.cache.get(&n.ptr()) {
-            return Ok(hit.clone());
+    /// Prepare `root`: every node once (cached by identity, so shared
+    /// subtrees are prepared once), children before parents, in a loop
+    /// with its own stack (trees can be a million levels deep before
+    /// `flatten` reads their chains flat).
+    pub(super) fn prepare(&mut self, root: &Node) -> Result<(Arc<PNode>, Aabb), PrepareError> {
+        let mut stack = vec![(root, false)];
+        while let Some((n, ready)) = stack.pop() {
+            if self.cache.contains_key(&n.ptr()) {
+                continue;
+            }
+            let shape = flatten::shape(n);
+            if ready {
+                let out = self.build_shape(n, shape)?;
+                self.cache.insert(n.ptr(), out);
+                continue;
+            }
+            stack.push((n, true));
+            for c in shape.operands(n).into_iter().rev() {
+                if !self.cache.contains_key(&c.ptr()) {
+                    stack.push((c, false));
+                }
+            }
         }
-        // Identity only marks a frame in the script's tree: it prepares to
-        // its child itself.
-        if let NodeKind::Identity { child } = n.kind() {
-            return self.child(n, child);
-        }
-        let out = self.build(n)?;
-        let out = (Arc::new(out.0), out.1);
-        self.cache.insert(n.ptr(), out.clone());
-        Ok(out)
+        let out = self.get(root)?;
+        Ok((out.node.clone(), out.bbox))
     }
 
-    fn child(
-        &mut self,
-        parent: &Node,
-        c: &Option<Node>,
-    ) -> Result<(Arc<PNode>, Aabb), PrepareError> {
+    /// An operand already prepared (operands are prepared first).
+    fn get(&self, n: &Node) -> Result<&Prepared, PrepareError> {
+        self.cache
+            .get(&n.ptr())
+            .ok_or_else(|| err(n, "was not prepared before its parent (a bug in volcad)"))
+    }
+
+    fn build_shape(&mut self, n: &Node, shape: Shape<'_>) -> Result<Prepared, PrepareError> {
+        let (mut depth, mut size) = (0u32, 1u64);
+        for c in shape.operands(n) {
+            let p = self.get(c)?;
+            depth = depth.max(p.depth);
+            size = size.saturating_add(p.size);
+        }
+        let (node, bbox) = match shape {
+            Shape::Same(end) => return Ok(self.get(end)?.clone()),
+            Shape::Plain => self.build(n)?,
+            Shape::NAry(ops) => self.nary_node(n, &ops)?,
+            Shape::Moves(chain, end) => compose_moves(&chain, self.get(end)?),
+            Shape::Offsets(distances, end) => {
+                let c = self.get(end)?;
+                let bbox = distances.iter().rev().fold(c.bbox, |b, d| b.expand(*d));
+                let o = distances.iter().rev().sum();
+                let child = c.node.clone();
+                (PNode::Offset { o, child }, bbox)
+            }
+            Shape::Differences(a, rights) => {
+                let a = self.get(a)?.clone();
+                let b = self.union_of(&rights)?;
+                (
+                    PNode::Difference {
+                        a: a.node,
+                        b,
+                        smooth: 0.0,
+                    },
+                    a.bbox,
+                )
+            }
+            Shape::Grade(end) => {
+                let child = self.get(end)?.clone();
+                self.grade(n, child)?
+            }
+        };
+        let depth = depth + 1;
+        if depth > MAX_DEPTH {
+            return Err(err(
+                n,
+                &format!(
+                    "is nested {depth} levels deep, more than the {MAX_DEPTH} an evaluation can follow \
+                     (chains of sharp Unions, Intersections, Differences, FGrades, moves and Offsets \
+                     are read flat; smooth unions, Blends, Shells, Tiles and mixed chains are not); a loop that wraps the design again \
+                     on every pass builds this: collect the parts in an array and make one node of \
+                     it, Union(false, parts), or wrap fewer times"
+                ),
+            ));
+        }
+        if size > MAX_EXPANDED {
+            return Err(err(
+                n,
+                &format!(
+                    "expands to {size} nodes when each shared part is counted at every use (at most \
+                     {MAX_EXPANDED}), and an evaluation may visit them all; a node added to itself \
+                     in a loop (a.add_child(a)) doubles it on every pass: build each part once and \
+                     list the parts in one Union"
+                ),
+            ));
+        }
+        Ok(Prepared {
+            node: Arc::new(node),
+            bbox,
+            depth,
+            size,
+        })
+    }
+
+    fn child(&self, parent: &Node, c: &Option<Node>) -> Result<(Arc<PNode>, Aabb), PrepareError> {
         match c {
-            Some(c) => self.prepare(c),
+            Some(c) => {
+                let p = self.get(c)?;
+                Ok((p.node.clone(), p.bbox))
+            }
             None => Err(err(
                 parent,
                 "has no child; give one in the constructor or with set_child",
@@ -104,6 +212,128 @@ impl Preparer {
     }
 
     fn build(&mut self, n: &Node) -> Result<(PNode, Aabb), PrepareError> {
+        Ok(match n.kind() {
+            NodeKind::Translate { offset, child } => {
+                let (c, b) = self.child(n, child)?;
+                (
+                    PNode::Translate {
+                        t: *offset,
+                        child: c,
+                    },
+                    Aabb::new(b.min + *offset, b.max + *offset),
+                )
+            }
+            NodeKind::Rotate {
+                pitch,
+                yaw,
+                roll,
+                around,
+                child,
+            } => {
+                let (c, b) = self.child(n, child)?;
+                let r = rotation(*pitch, *yaw, *roll);
+                (
+                    PNode::Rotate {
+                        to_local: r.transpose(),
+                        around: *around,
+                        child: c,
+                    },
+                    b.transformed(&r, *around),
+                )
+            }
+            NodeKind::Scale { factors, child } => {
+                let (c, b) = self.child(n, child)?;
+                let k = factors.abs().min_element();
+                (
+                    PNode::Scale {
+                        inv: DVec3::ONE / *factors,
+                        k,
+                        child: c,
+                    },
+                    b.scaled(*factors),
+                )
+            }
+            // With children, these are `Shape::NAry` or `Shape::Same`.
+            NodeKind::Union { .. } | NodeKind::Intersection { .. } => {
+                return Err(err(
+                    n,
+                    "has no children; add some with add_child or pass a list",
+                ));
+            }
+            NodeKind::Difference {
+                smooth,
+                left,
+                right,
+            } => {
+                let (a, ba) = self.child(n, left)?;
+                let b = match right {
+                    Some(r) => self.get(r)?.node.clone(),
+                    None => return Err(err(n, "has no right child (the part to subtract)")),
+                };
+                (
+                    PNode::Difference {
+                        a,
+                        b,
+                        smooth: *smooth,
+                    },
+                    ba,
+                )
+            }
+            NodeKind::Offset { distance, child } => {
+                let (c, b) = self.child(n, child)?;
+                (
+                    PNode::Offset {
+                        o: *distance,
+                        child: c,
+                    },
+                    b.expand(*distance),
+                )
+            }
+            NodeKind::Shell { thickness, child } => {
+                let (c, b) = self.child(n, child)?;
+                (
+                    PNode::Shell {
+                        t: thickness.abs(),
+                        child: c,
+                    },
+                    b,
+                )
+            }
+            NodeKind::Tile { cell, child } => {
+                let (c, b) = self.child(n, child)?;
+                let cell = match cell {
+                    Some(c) => *c,
+                    None if b.is_finite() && b.size().min_element() > 0.0 => b.size(),
+                    None => {
+                        return Err(err(
+                            n,
+                            "cannot take its cell size from a child with an unbounded or flat box; give the cell size: Tile(cx, cy, cz, child)",
+                        ));
+                    }
+                };
+                (PNode::Tile { cell, child: c }, Aabb::EVERYTHING)
+            }
+            // With a child, this is `Shape::Grade`.
+            NodeKind::FGrade { child, .. } => {
+                self.child(n, child)?;
+                return Err(err(n, "was not read as a grade (a bug in volcad)"));
+            }
+            NodeKind::Blend { radius, child } => {
+                let (c, b) = self.child(n, child)?;
+                (
+                    PNode::Blend {
+                        r: *radius,
+                        child: c,
+                    },
+                    b,
+                )
+            }
+            _ => self.build_leaf(n)?,
+        })
+    }
+
+    /// A leaf: a primitive, lattice, mesh or FEA field.
+    fn build_leaf(&self, n: &Node) -> Result<(PNode, Aabb), PrepareError> {
         Ok(match n.kind() {
             NodeKind::Sphere {
                 center,
@@ -173,6 +403,14 @@ impl Preparer {
                     bbox,
                 )
             }
+            _ => self.build_field(n)?,
+        })
+    }
+
+    /// A leaf defined by a field or a list: a math string, TPMS,
+    /// lattice, mesh or FEA field.
+    fn build_field(&self, n: &Node) -> Result<(PNode, Aabb), PrepareError> {
+        Ok(match n.kind() {
             NodeKind::Function {
                 expr,
                 material,
@@ -227,150 +465,6 @@ impl Preparer {
                     bbox,
                 )
             }
-            NodeKind::Translate { offset, child } => {
-                let (c, b) = self.child(n, child)?;
-                (
-                    PNode::Translate {
-                        t: *offset,
-                        child: c,
-                    },
-                    Aabb::new(b.min + *offset, b.max + *offset),
-                )
-            }
-            NodeKind::Rotate {
-                pitch,
-                yaw,
-                roll,
-                around,
-                child,
-            } => {
-                let (c, b) = self.child(n, child)?;
-                let r = rotation(*pitch, *yaw, *roll);
-                (
-                    PNode::Rotate {
-                        to_local: r.transpose(),
-                        around: *around,
-                        child: c,
-                    },
-                    b.transformed(&r, *around),
-                )
-            }
-            NodeKind::Scale { factors, child } => {
-                let (c, b) = self.child(n, child)?;
-                let k = factors.abs().min_element();
-                (
-                    PNode::Scale {
-                        inv: DVec3::ONE / *factors,
-                        k,
-                        child: c,
-                    },
-                    b.scaled(*factors),
-                )
-            }
-            NodeKind::Union {
-                smooth,
-                blend,
-                children,
-            } => {
-                let (nary, bbox) = self.nary(n, children, *smooth, *blend, true)?;
-                (PNode::Union(Box::new(nary)), bbox.expand(smooth.max(0.0)))
-            }
-            NodeKind::Intersection {
-                smooth,
-                blend,
-                children,
-            } => {
-                let (nary, _) = self.nary(n, children, *smooth, *blend, false)?;
-                let bbox = nary
-                    .boxes
-                    .iter()
-                    .fold(Aabb::EVERYTHING, |a, b| a.intersection(b));
-                (PNode::Intersection(Box::new(nary)), bbox)
-            }
-            NodeKind::Difference {
-                smooth,
-                left,
-                right,
-            } => {
-                let (a, ba) = self.child(n, left)?;
-                let (b, _) = match right {
-                    Some(r) => self.prepare(r)?,
-                    None => return Err(err(n, "has no right child (the part to subtract)")),
-                };
-                (
-                    PNode::Difference {
-                        a,
-                        b,
-                        smooth: *smooth,
-                    },
-                    ba,
-                )
-            }
-            NodeKind::Offset { distance, child } => {
-                let (c, b) = self.child(n, child)?;
-                (
-                    PNode::Offset {
-                        o: *distance,
-                        child: c,
-                    },
-                    b.expand(*distance),
-                )
-            }
-            NodeKind::Shell { thickness, child } => {
-                let (c, b) = self.child(n, child)?;
-                (
-                    PNode::Shell {
-                        t: thickness.abs(),
-                        child: c,
-                    },
-                    b,
-                )
-            }
-            NodeKind::Tile { cell, child } => {
-                let (c, b) = self.child(n, child)?;
-                let cell = match cell {
-                    Some(c) => *c,
-                    None if b.is_finite() && b.size().min_element() > 0.0 => b.size(),
-                    None => {
-                        return Err(err(
-                            n,
-                            "cannot take its cell size from a child with an unbounded or flat box; give the cell size: Tile(cx, cy, cz, child)",
-                        ));
-                    }
-                };
-                (PNode::Tile { cell, child: c }, Aabb::EVERYTHING)
-            }
-            NodeKind::FGrade {
-                exprs,
-                materials,
-                child,
-                ..
-            } => {
-                too_many_expressions(n, exprs.len())?;
-                let (c, b) = self.child(n, child)?;
-                let used = exprs.iter().fold(0, |m, e| m | e.used_vars());
-                let mats = materials.iter().map(|m| self.slot(*m)).collect();
-                (
-                    PNode::FGrade(Box::new(Grade {
-                        exprs: exprs.clone(),
-                        set: ExprSet::new(exprs.clone()),
-                        mats,
-                        used,
-                        child: c,
-                    })),
-                    b,
-                )
-            }
-            NodeKind::Blend { radius, child } => {
-                let (c, b) = self.child(n, child)?;
-                (
-                    PNode::Blend {
-                        r: *radius,
-                        child: c,
-                    },
-                    b,
-                )
-            }
             NodeKind::Mesh { mesh, material } => (
                 PNode::Mesh {
                     mesh: mesh.clone(),
@@ -398,207 +492,111 @@ impl Preparer {
                     bbox,
                 )
             }
-            NodeKind::Text {
-                shape,
-                depth,
-                material,
-                ..
-            } => {
-                let (lo, hi) = shape.bounds();
-                let hz = depth * 0.5;
-                (
-                    PNode::Text {
-                        shape: shape.clone(),
-                        hz,
-                        m: self.slot(*material),
-                    },
-                    Aabb::new(DVec3::new(lo.x, lo.y, -hz), DVec3::new(hi.x, hi.y, hz)),
-                )
-            }
-            kind => self.build_shape(n, kind)?,
+            _ => self.build_pyvcad3(n)?,
         })
     }
 
-    /// The nodes of `shapes` and the Mirror and Sum composites.
-    fn build_shape(&mut self, n: &Node, kind: &NodeKind) -> Result<(PNode, Aabb), PrepareError> {
-        let shape = |s: Shape, m: MaterialId, this: &Self| {
-            let b = s.bbox();
-            (
-                PNode::Shape {
-                    s: Box::new(s),
-                    m: this.slot(m),
-                },
-                b,
-            )
+    /// An FGrade node `n` over the prepared `child`.
+    fn grade(&self, n: &Node, child: Prepared) -> Result<(PNode, Aabb), PrepareError> {
+        let NodeKind::FGrade {
+            exprs, materials, ..
+        } = n.kind()
+        else {
+            return Err(err(n, "is not an FGrade (a bug in volcad)"));
         };
-        Ok(match kind {
-            NodeKind::Cone {
-                angle,
-                height,
-                material,
-            } => shape(Shape::Cone(Cone::new(*angle, *height)), *material, self),
-            NodeKind::Torus {
-                major,
-                minor,
-                material,
-            } => shape(
-                Shape::Torus {
-                    major: *major,
-                    minor: *minor,
-                },
-                *material,
-                self,
-            ),
-            NodeKind::PolygonRevolve {
-                vertices,
-                axis_start,
-                axis_end,
-                sweep_degrees,
-                material,
-            } => {
-                let r = Revolve::build(vertices, *axis_start, *axis_end, *sweep_degrees)
-                    .map_err(|m| err(n, &m))?;
-                shape(Shape::Revolve(Box::new(r)), *material, self)
-            }
-            NodeKind::TaperedStrut {
-                a,
-                b,
-                radius_a,
-                radius_b,
-                cap_a,
-                cap_b,
-                material,
-            } => {
-                let rounded = |c: &CapMode| *c != CapMode::Butt;
-                if radius_a == radius_b && rounded(cap_a) && rounded(cap_b) {
-                    // Equal radii with round ends: a capsule, exactly.
-                    let s = Capsule::new(*a, *b, *radius_a);
-                    (
-                        PNode::Strut {
-                            s,
-                            m: self.slot(*material),
-                        },
-                        s.bbox(),
-                    )
-                } else if a == b {
-                    return Err(err(
-                        n,
-                        "start and end are the same point; a tapered strut needs a length",
-                    ));
-                } else {
-                    let beam = Beam::new(*a, *b, *radius_a, *radius_b, *cap_a, *cap_b);
-                    shape(Shape::Beam(beam), *material, self)
-                }
-            }
-            NodeKind::Mirror {
-                point,
-                normal,
-                child,
-            } => {
-                let (c, b) = self.child(n, child)?;
-                let m = super::bound::reflection(*normal);
-                (
-                    PNode::Mirror {
-                        point: *point,
-                        normal: *normal,
-                        child: c,
-                    },
-                    b.transformed(&m, *point),
-                )
-            }
-            NodeKind::Sum { iso, children } => {
-                if children.is_empty() {
-                    return Err(err(
-                        n,
-                        "has no children; add some with add_child or pass a list",
-                    ));
-                }
-                let mut nodes = Vec::with_capacity(children.len());
-                let mut bbox = Aabb::EMPTY;
-                for c in children {
-                    let (p, b) = self.prepare(c)?;
-                    nodes.push(p);
-                    bbox = bbox.union(&b);
-                }
-                // Outside every child's box each dᵢ > 0, so Σdᵢ + iso ≤ 0
-                // needs every dᵢ ≤ −iso: within −iso of every box.
-                (
-                    PNode::Sum {
-                        iso: *iso,
-                        children: nodes,
-                    },
-                    bbox.expand((-iso).max(0.0)),
-                )
-            }
-            // Identity never gets here (`prepare` answers it with its
-            // child); the other kinds are built in `build`.
-            other => {
-                return Err(err(
-                    n,
-                    &format!("{} cannot be prepared here", other.type_name()),
-                ));
-            }
-        })
+        too_many_expressions(n, exprs.len())?;
+        let used = exprs.iter().fold(0, |m, e| m | e.used_vars());
+        let mats = materials.iter().map(|m| self.slot(*m)).collect();
+        let grade = Grade {
+            exprs: exprs.clone(),
+            set: ExprSet::new(exprs.clone()),
+            mats,
+            used,
+            child: child.node,
+        };
+        Ok((PNode::FGrade(Box::new(grade)), child.bbox))
     }
 
-    fn nary(
-        &mut self,
-        n: &Node,
-        children: &[Node],
-        smooth: f64,
-        blend: bool,
-        is_union: bool,
-    ) -> Result<(NAry, Aabb), PrepareError> {
-        if children.is_empty() {
-            return Err(err(
-                n,
-                "has no children; add some with add_child or pass a list",
-            ));
-        }
-        let mut nodes = Vec::with_capacity(children.len());
-        let mut boxes = Vec::with_capacity(children.len());
-        let mut bbox = Aabb::EMPTY;
-        for c in children {
-            let (p, b) = self.prepare(c)?;
-            nodes.push(p);
-            boxes.push(b);
-            bbox = bbox.union(&b);
-        }
-        let lipschitz = smooth <= 0.0 && nodes.iter().all(|n| n.is_lipschitz());
-        // 1-Lipschitz children are listed by `d(centre) − half diagonal`, so
-        // queries can tighten it to `d(centre) − |p − centre|` (the slack).
-        let index =
-            (is_union && smooth <= 0.0 && children.len() >= INDEX_MIN_CHILDREN).then(|| {
-                UnionIndex::build(&boxes, |i, cell| {
-                    if lipschitz {
-                        nodes[i].dist(cell.center()) - cell.half_diagonal()
-                    } else {
-                        nodes[i].interval(cell).lo
-                    }
-                })
-            });
-        let capsules = if nodes.iter().any(|n| NAry::capsule_of(n).is_some()) {
-            nodes
-                .iter()
-                .map(|n| LineCapsule::of(NAry::capsule_of(n)))
-                .collect()
+    /// A union or intersection node `n` over its (flattened) operands.
+    fn nary_node(&self, n: &Node, ops: &[&Node]) -> Result<(PNode, Aabb), PrepareError> {
+        let (smooth, blend, is_union) = match n.kind() {
+            NodeKind::Union { smooth, blend, .. } => (*smooth, *blend, true),
+            NodeKind::Intersection { smooth, blend, .. } => (*smooth, *blend, false),
+            _ => return Err(err(n, "is not a union or intersection (a bug in volcad)")),
+        };
+        let parts = ops
+            .iter()
+            .map(|c| self.get(c).cloned())
+            .collect::<Result<Vec<_>, _>>()?;
+        let nary = nary(parts, smooth, blend, is_union);
+        Ok(if is_union {
+            let bbox = nary.boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(b));
+            (PNode::Union(Box::new(nary)), bbox.expand(smooth.max(0.0)))
         } else {
-            Vec::new()
-        };
-        let fixed = nodes.iter().map(|n| n.fixed_fractions()).collect();
-        Ok((
-            NAry {
-                children: nodes,
-                boxes,
-                smooth: smooth.max(0.0),
-                blend,
-                index,
-                capsules,
-                fixed,
-                lipschitz,
-            },
-            bbox,
-        ))
+            let bbox = nary
+                .boxes
+                .iter()
+                .fold(Aabb::EVERYTHING, |a, b| a.intersection(b));
+            (PNode::Intersection(Box::new(nary)), bbox)
+        })
+    }
+
+    /// The sharp union of `ops` (one operand: itself).
+    fn union_of(&self, ops: &[&Node]) -> Result<Arc<PNode>, PrepareError> {
+        let parts = ops
+            .iter()
+            .map(|c| self.get(c).cloned())
+            .collect::<Result<Vec<_>, _>>()?;
+        if parts.len() == 1 {
+            return Ok(parts[0].node.clone());
+        }
+        Ok(Arc::new(PNode::Union(Box::new(nary(
+            parts, 0.0, false, true,
+        )))))
+    }
+}
+
+/// A union or intersection over prepared children (at least one).
+fn nary(mut parts: Vec<Prepared>, smooth: f64, blend: bool, is_union: bool) -> NAry {
+    if !blend && smooth <= 0.0 {
+        // A leaf equal to an earlier one changes neither the minimum (or
+        // maximum) nor which child first contains a point; a union of
+        // thousands of coincident spheres lists one.
+        let mut seen = std::collections::HashSet::new();
+        parts.retain(|p| p.node.leaf_key().is_none_or(|k| seen.insert(k)));
+    }
+    let boxes: Vec<Aabb> = parts.iter().map(|p| p.bbox).collect();
+    let nodes: Vec<Arc<PNode>> = parts.into_iter().map(|p| p.node).collect();
+    let lipschitz = smooth <= 0.0 && nodes.iter().all(|n| n.is_lipschitz());
+    // 1-Lipschitz children are listed by `d(centre) − half diagonal`, so
+    // queries can tighten it to `d(centre) − |p − centre|` (the slack).
+    let index = (is_union && smooth <= 0.0 && nodes.len() >= INDEX_MIN_CHILDREN).then(|| {
+        UnionIndex::build(&boxes, |i, cell| {
+            if lipschitz {
+                nodes[i].dist(cell.center()) - cell.half_diagonal()
+            } else {
+                nodes[i].interval(cell).lo
+            }
+        })
+    });
+    let capsules = if nodes.iter().any(|n| NAry::capsule_of(n).is_some()) {
+        nodes
+            .iter()
+            .map(|n| LineCapsule::of(NAry::capsule_of(n)))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let fixed = nodes.iter().map(|n| n.fixed_fractions()).collect();
+    NAry {
+        children: nodes,
+        boxes,
+        smooth: smooth.max(0.0),
+        blend,
+        index,
+        capsules,
+        fixed,
+        lipschitz,
     }
 }
 
@@ -621,14 +619,6 @@ fn err(n: &Node, message: &str) -> PrepareError {
         node: n.describe(),
         message: message.to_owned(),
     }
-}
-
-/// R = Rz(roll)·Ry(yaw)·Rx(pitch), degrees (pyvcad's convention for its
-/// bounding box; we rotate the geometry by the same R, see docs/PYVCAD.md).
-pub fn rotation(pitch: f64, yaw: f64, roll: f64) -> DMat3 {
-    DMat3::from_rotation_z(roll.to_radians())
-        * DMat3::from_rotation_y(yaw.to_radians())
-        * DMat3::from_rotation_x(pitch.to_radians())
 }
 
 /// A planar polygon (right-hand rule normal) extruded by `height` along the

@@ -21,6 +21,51 @@ use glam::DVec3;
 use crate::bounds::Aabb;
 use crate::cells::CellLattice;
 
+/// Cell-list entries per child (on average) that the grid may hold before
+/// its cells are made coarser, within [`MIN_ENTRIES`, `MAX_ENTRIES`]
+/// (8 bytes each, twice while building). A child is listed in at least the
+/// 5³ cells around it; struts of the bunny lattice in a few hundred.
+const ENTRIES_PER_CHILD: usize = 1024;
+const MIN_ENTRIES: usize = 1 << 24;
+const MAX_ENTRIES: usize = 1 << 27;
+
+/// Cells per axis for cubic cells of side `cell` over a box of `size`.
+fn grid_dims(size: DVec3, cell: f64) -> [usize; 3] {
+    [
+        ((size.x / cell).ceil() as usize).clamp(1, 1024),
+        ((size.y / cell).ceil() as usize).clamp(1, 1024),
+        ((size.z / cell).ceil() as usize).clamp(1, 1024),
+    ]
+}
+
+/// How many (child, cell) pairs the grid of `dims` over `grid_box` may
+/// list: the cells of each finite child's box grown by the two-cell
+/// margin (an upper bound of the lists' length; saturating).
+fn covered_cells(
+    boxes: &[Aabb],
+    finite: &[u32],
+    grid_box: Aabb,
+    size: DVec3,
+    dims: [usize; 3],
+) -> usize {
+    let d = DVec3::new(dims[0] as f64, dims[1] as f64, dims[2] as f64);
+    let cell_size = size / d;
+    let margin = 2.0 * cell_size.max_element();
+    finite.iter().fold(0usize, |acc, &i| {
+        let b = boxes[i as usize].expand(margin);
+        let lo = ((b.min - grid_box.min) / cell_size)
+            .floor()
+            .max(DVec3::ZERO)
+            .min(d - 1.0);
+        let hi = ((b.max - grid_box.min) / cell_size)
+            .floor()
+            .max(DVec3::ZERO)
+            .min(d - 1.0);
+        let n = (hi - lo + 1.0).element_product();
+        acc.saturating_add(n as usize)
+    })
+}
+
 /// Grid + BVH over child boxes. Children with infinite boxes are kept in
 /// `always` and visited for every query.
 #[derive(Debug)]
@@ -95,12 +140,23 @@ impl UnionIndex {
         let n = finite.len().max(1) as f64;
         let size = grid_box.size().max(DVec3::splat(1e-9));
         let volume = size.x * size.y * size.z;
-        let cell = (volume / (32.0 * n)).cbrt().max((volume / 2.0e6).cbrt());
-        let dims = [
-            ((size.x / cell).ceil() as usize).clamp(1, 1024),
-            ((size.y / cell).ceil() as usize).clamp(1, 1024),
-            ((size.z / cell).ceil() as usize).clamp(1, 1024),
-        ];
+        let mut cell = (volume / (32.0 * n)).cbrt().max((volume / 2.0e6).cbrt());
+        let mut dims = grid_dims(size, cell);
+        // Children that overlap (a thousand coincident spheres) are each
+        // listed in every cell: the lists grow as children × cells, so
+        // quadratically in the children. Coarser cells until the lists'
+        // upper bound (every cell of each child's box grown by the margin)
+        // fits the budget; each coarsening costs the queries there
+        // candidates, not correctness.
+        let budget = (ENTRIES_PER_CHILD * finite.len()).clamp(MIN_ENTRIES, MAX_ENTRIES);
+        for _ in 0..32 {
+            let listed = covered_cells(boxes, &finite, grid_box, size, dims);
+            if listed <= budget {
+                break;
+            }
+            cell *= (listed as f64 / budget as f64).cbrt().max(1.25);
+            dims = grid_dims(size, cell);
+        }
         let cell_size = size / DVec3::new(dims[0] as f64, dims[1] as f64, dims[2] as f64);
         // Two cells: points within two cells of a child never need the BVH;
         // lists are sorted by lower bound, so long lists cost little.

@@ -75,6 +75,12 @@ pub struct ScriptOptions {
     pub max_heap: u64,
 }
 
+/// The default operation limit. Scripts run 10 to 20 million operations a
+/// second (the studio's live runs and the CLI alike), so an endless loop
+/// stops within a few seconds; the bundled examples need well under a
+/// tenth of it (a loop over a 3,286-strut list included).
+pub const DEFAULT_MAX_OPERATIONS: u64 = 50_000_000;
+
 impl Default for ScriptOptions {
     fn default() -> Self {
         Self {
@@ -83,7 +89,7 @@ impl Default for ScriptOptions {
             home: read_policy::home_dir(),
             params: HashMap::new(),
             cancel: None,
-            max_operations: 500_000_000,
+            max_operations: DEFAULT_MAX_OPERATIONS,
             max_heap: crate::heap::default_script_budget(),
         }
     }

@@ -56,6 +56,13 @@ pub fn register_composites(engine: &mut Engine) {
             if name == "Scale" && v.cmpeq(DVec3::ZERO).any() {
                 return fail(p, "Scale: factors must not be 0");
             }
+            // Scaling divides the point by the factor: 1/1e-300 overflows.
+            if name == "Scale" && v.abs().min_element() < 1.0 / MAX_MAGNITUDE {
+                return fail(
+                    p,
+                    format!("Scale: factors must be at least 1e-9 in magnitude, got {v}"),
+                );
+            }
             Ok(mk(
                 make(v, optional_child(child, &format!("{name}: child"), p)?),
                 p,

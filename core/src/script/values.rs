@@ -73,13 +73,32 @@ pub fn num(v: &Dynamic, what: &str, pos: Position) -> RResult<f64> {
     }
 }
 
-/// A finite number.
+/// Largest magnitude of a number a design gives (sizes, positions and
+/// moves in mm, angles in degrees, smoothing radii): 10⁹ mm is 1,000 km.
+/// Distances square their inputs (|p − c|², the TPMS and tile maps divide
+/// and floor), so a size of 1e308 became infinite or NaN at evaluation and
+/// an export failed far from the line that gave it.
+pub const MAX_MAGNITUDE: f64 = 1e9;
+
+/// A finite number below [`MAX_MAGNITUDE`] in magnitude.
 pub fn finite(v: &Dynamic, what: &str, pos: Position) -> RResult<f64> {
     let f = num(v, what, pos)?;
-    if f.is_finite() {
-        Ok(f)
-    } else {
+    sane(f, what, pos)
+}
+
+/// `f` if it is finite and below [`MAX_MAGNITUDE`] in magnitude.
+fn sane(f: f64, what: &str, pos: Position) -> RResult<f64> {
+    if !f.is_finite() {
         fail(pos, format!("{what} must be finite, got {f}"))
+    } else if f.abs() >= MAX_MAGNITUDE {
+        fail(
+            pos,
+            format!(
+                "{what} is {f:e}; give a value below 1e9 in magnitude (sizes are in mm: 1e9 mm is 1,000 km)"
+            ),
+        )
+    } else {
+        Ok(f)
     }
 }
 
@@ -106,6 +125,11 @@ pub fn non_negative(v: &Dynamic, what: &str, pos: Position) -> RResult<f64> {
 /// A Vec3 (or a 3-element array of numbers, as pyvcad's Vec3-from-list).
 pub fn vec3(v: &Dynamic, what: &str, pos: Position) -> RResult<DVec3> {
     if let Some(v) = v.clone().try_cast::<Vec3>() {
+        // Vec3 arithmetic (`Vec3(1, 0, 0) * 1e308`) makes values that no
+        // constructor checked.
+        for (c, axis) in v.0.to_array().into_iter().zip(["x", "y", "z"]) {
+            sane(c, &format!("{what} ({axis})"), pos)?;
+        }
         return Ok(v.0);
     }
     if let Some(a) = v.clone().try_cast::<rhai::Array>()

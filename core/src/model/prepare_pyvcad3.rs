@@ -1,0 +1,156 @@
+//! Preparing the nodes pyvcad 3 added (cone, torus, revolve, tapered
+//! strut, mirror, sum), and Text: split from `prepare.rs` to keep each file
+//! readable; the same `Preparer`, whose operands are prepared first.
+
+use glam::DVec3;
+
+use super::super::PrepareError;
+use super::super::pnode::{Capsule, PNode};
+use super::super::shapes::{Beam, Cone, Revolve, Shape};
+use super::{Preparer, err};
+use crate::bounds::Aabb;
+use crate::material::MaterialId;
+use crate::node::{CapMode, Node, NodeKind};
+
+impl Preparer {
+    /// The nodes of pyvcad 3 (`shapes`), Text, and the Mirror and Sum
+    /// composites, over their operands prepared before them.
+    pub(super) fn build_pyvcad3(&self, n: &Node) -> Result<(PNode, Aabb), PrepareError> {
+        let kind = n.kind();
+        let shape = |s: Shape, m: MaterialId, this: &Self| {
+            let b = s.bbox();
+            (
+                PNode::Shape {
+                    s: Box::new(s),
+                    m: this.slot(m),
+                },
+                b,
+            )
+        };
+        Ok(match kind {
+            NodeKind::Cone {
+                angle,
+                height,
+                material,
+            } => shape(Shape::Cone(Cone::new(*angle, *height)), *material, self),
+            NodeKind::Torus {
+                major,
+                minor,
+                material,
+            } => shape(
+                Shape::Torus {
+                    major: *major,
+                    minor: *minor,
+                },
+                *material,
+                self,
+            ),
+            NodeKind::PolygonRevolve {
+                vertices,
+                axis_start,
+                axis_end,
+                sweep_degrees,
+                material,
+            } => {
+                let r = Revolve::build(vertices, *axis_start, *axis_end, *sweep_degrees)
+                    .map_err(|m| err(n, &m))?;
+                shape(Shape::Revolve(Box::new(r)), *material, self)
+            }
+            NodeKind::TaperedStrut {
+                a,
+                b,
+                radius_a,
+                radius_b,
+                cap_a,
+                cap_b,
+                material,
+            } => {
+                let rounded = |c: &CapMode| *c != CapMode::Butt;
+                if radius_a == radius_b && rounded(cap_a) && rounded(cap_b) {
+                    // Equal radii with round ends: a capsule, exactly.
+                    let s = Capsule::new(*a, *b, *radius_a);
+                    (
+                        PNode::Strut {
+                            s,
+                            m: self.slot(*material),
+                        },
+                        s.bbox(),
+                    )
+                } else if a == b {
+                    return Err(err(
+                        n,
+                        "start and end are the same point; a tapered strut needs a length",
+                    ));
+                } else {
+                    let beam = Beam::new(*a, *b, *radius_a, *radius_b, *cap_a, *cap_b);
+                    shape(Shape::Beam(beam), *material, self)
+                }
+            }
+            NodeKind::Mirror {
+                point,
+                normal,
+                child,
+            } => {
+                let (c, b) = self.child(n, child)?;
+                let m = super::super::bound::reflection(*normal);
+                (
+                    PNode::Mirror {
+                        point: *point,
+                        normal: *normal,
+                        child: c,
+                    },
+                    b.transformed(&m, *point),
+                )
+            }
+            NodeKind::Sum { iso, children } => {
+                if children.is_empty() {
+                    return Err(err(
+                        n,
+                        "has no children; add some with add_child or pass a list",
+                    ));
+                }
+                let mut nodes = Vec::with_capacity(children.len());
+                let mut bbox = Aabb::EMPTY;
+                for c in children {
+                    let p = self.get(c)?;
+                    nodes.push(p.node.clone());
+                    bbox = bbox.union(&p.bbox);
+                }
+                // Outside every child's box each dᵢ > 0, so Σdᵢ + iso ≤ 0
+                // needs every dᵢ ≤ −iso: within −iso of every box.
+                (
+                    PNode::Sum {
+                        iso: *iso,
+                        children: nodes,
+                    },
+                    bbox.expand((-iso).max(0.0)),
+                )
+            }
+            NodeKind::Text {
+                shape,
+                depth,
+                material,
+                ..
+            } => {
+                let (lo, hi) = shape.bounds();
+                let hz = depth * 0.5;
+                (
+                    PNode::Text {
+                        shape: shape.clone(),
+                        hz,
+                        m: self.slot(*material),
+                    },
+                    Aabb::new(DVec3::new(lo.x, lo.y, -hz), DVec3::new(hi.x, hi.y, hz)),
+                )
+            }
+            // Identity with a child is read as its child (`flatten::shape`).
+            NodeKind::Identity { child: None } => {
+                return Err(err(
+                    n,
+                    "has no child; give one in the constructor or with set_child",
+                ));
+            }
+            _ => return Err(err(n, "is not a leaf (a bug in volcad)")),
+        })
+    }
+}
