@@ -9,7 +9,7 @@
 //! *NODE, NSET=NALL            ids 1..N
 //! **                          (closes the node block for simple readers)
 //! *ELEMENT, TYPE=C3D4, ELSET=E_<name>      one block per material, ids 1..M
-//! *ELSET, ELSET=EALL          the material sets
+//! *ELSET, ELSET=EALL          the material sets, one name a line
 //! *NSET, NSET=NBOTTOM / NTOP  nodes within tolerance of min / max z
 //! *MATERIAL, NAME=<name> + *ELASTIC E, ν    per material with elements
 //! *SOLID SECTION, ELSET=E_<name>, MATERIAL=<name>
@@ -161,8 +161,12 @@ pub fn write(w: &mut impl Write, d: &Deck<'_>) -> io::Result<()> {
             next += 1;
         }
     }
+    // One set name per line: Abaqus allows several, but meshio (and other
+    // simple readers) take only the first name of each line.
     writeln!(w, "*ELSET, ELSET=EALL")?;
-    id_lines(w, d.materials.iter().map(|m| format!("E_{}", m.name)))?;
+    for mat in d.materials {
+        writeln!(w, "E_{}", mat.name)?;
+    }
     for (name, ids) in [("NBOTTOM", d.bottom), ("NTOP", d.top)] {
         if !ids.is_empty() {
             writeln!(w, "*NSET, NSET={name}")?;

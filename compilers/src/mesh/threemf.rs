@@ -10,6 +10,12 @@
 //! `.ini` syntax: `fill_density` must carry `%`. Vertices are world
 //! coordinates in millimetres; no transform.
 //!
+//! Conformance (3MF core 1.3 and OPC): every part has a content type (the
+//! `.config` part is plain XML, so `text/xml`), and `<item>` carries only
+//! core attributes; PrusaSlicer's own `printable` is left out because
+//! lib3mf's strict reader refuses unknown attributes in the core namespace,
+//! and PrusaSlicer reads a missing `printable` as printable.
+//!
 //! The ZIP is written by [`crate::zip_writer`]: entries deflated (level 1)
 //! on every core with a fixed 1980-01-01 time stamp, so the bytes repeat run
 //! to run and on any thread count. The model XML is formatted in parallel
@@ -37,6 +43,7 @@ const CONTENT_TYPES: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
 <Types xmlns="http://schemas.openxmlformats.org/package/2006/content-types">
  <Default Extension="rels" ContentType="application/vnd.openxmlformats-package.relationships+xml"/>
  <Default Extension="model" ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/>
+ <Default Extension="config" ContentType="text/xml"/>
 </Types>
 "#;
 
@@ -120,10 +127,7 @@ fn write_model(parts: &[Part<'_>], object_name: &str, m: &mut impl Write) -> io:
         m,
         "    </triangles>\n   </mesh>\n  </object>\n </resources>"
     )?;
-    writeln!(
-        m,
-        " <build>\n  <item objectid=\"1\" printable=\"1\"/>\n </build>\n</model>"
-    )?;
+    writeln!(m, " <build>\n  <item objectid=\"1\"/>\n </build>\n</model>")?;
     Ok(())
 }
 
