@@ -27,6 +27,7 @@
 //! share their interfaces exactly instead of being contoured one by one
 //! (which leaves gaps and overlaps); fractions are normalised by their sum.
 
+pub mod bodies;
 pub mod contour;
 mod field;
 mod flat;
@@ -567,6 +568,7 @@ pub fn export_meshes(
 ) -> Result<Summary, ExportError> {
     let pl = plan(model, p, Look::Probe)?;
     check_disk(pl.estimate.disk_bytes, ctx.folder(), "a larger voxel size")?;
+    let thin = crate::thin::thin_feature_notes(model, p.voxel.max_element(), "--voxel");
     run_with_threads(p.threads, || {
         let nz = pl.grid.dims[2];
         let segs = build(model, p, &pl, ctx.cancel_flag(), &|done, total| {
@@ -592,8 +594,14 @@ pub fn export_meshes(
         ctx.progress("writing", 0, 1, "files", 0.9);
         // The checks read the meshes as the writers do: both at once, so a
         // core left idle by the last (longest) file checks the meshes.
-        let (files, checks) = rayon::join(|| write_files(&segs, p, ctx), || checks(&segs));
-        Ok(summary(model, p, &pl, &segs, files?, &checks))
+        let (files, (checks, bodies)) = rayon::join(
+            || write_files(&segs, p, ctx),
+            || rayon::join(|| checks(&segs), || bodies::bodies(&segs)),
+        );
+        let mut s = summary(model, p, &pl, &segs, files?, &checks);
+        s.notes.extend(thin);
+        s.notes.extend(body_notes(&bodies, p.voxel.max_element()));
+        Ok(s)
     })
 }
 
@@ -664,6 +672,20 @@ fn write_files(
             Ok(name)
         })
         .collect()
+}
+
+/// The body count, and a warning when the part fell into several bodies.
+fn body_notes(b: &bodies::Bodies, voxel: f64) -> Vec<String> {
+    let total: f64 = b.volumes.iter().sum();
+    let mut out = vec![format!("bodies: {}", b.count())];
+    if b.count() > 1 {
+        out.push(format!(
+            "warning: the part is {} separate bodies (the largest holds {:.1} % of the volume); a design in one piece has features thinner than about two voxels of {voxel} mm that broke apart: use a smaller --voxel",
+            b.count(),
+            100.0 * b.volumes[0] / total.max(f64::MIN_POSITIVE)
+        ));
+    }
+    out
 }
 
 /// Volume and watertightness of every segment. The contouring guarantees

@@ -14,8 +14,11 @@ mod pnode;
 mod prepare;
 pub mod sdf;
 mod strut_grid;
+mod thinnest;
 mod tpms;
 mod union_index;
+
+pub use thinnest::{Feature, Thinnest};
 
 #[cfg(test)]
 pub(crate) mod tests;
