@@ -89,6 +89,17 @@ fn bcc_sphere_at_a_quarter_millimetre_is_one_body_without_warnings() {
     let s = mesh(&m, 0.25, &dir);
     assert!(s.notes.iter().any(|n| n == "bodies: 1"), "{:?}", s.notes);
     assert!(warnings(&s).is_empty(), "{:?}", s.notes);
+    let shape = s
+        .notes
+        .iter()
+        .find_map(|n| n.strip_prefix("triangle shape: smallest angle "))
+        .expect("the triangle shape note");
+    let angle: f64 = shape
+        .split('°')
+        .next()
+        .and_then(|a| a.parse().ok())
+        .expect("an angle");
+    assert!(angle > 0.0 && angle < 60.0, "{shape}");
 }
 
 #[test]

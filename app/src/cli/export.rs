@@ -357,7 +357,12 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
                 solver_memory: None,
                 threads,
             };
-            fea_estimate(&model, &p)?;
+            if p.element == Element::C3D8R {
+                fea_estimate(&model, &p)?;
+            } else {
+                let (size, option) = p.cell();
+                warn_thin(&model, size, option);
+            }
             job::spawn(dest, hash, move |ctx| {
                 volcad_compilers::fea::export_fea(&model, &p, ctx)
             })
@@ -376,10 +381,11 @@ fn warn_thin(model: &volcad_core::Model, size: f64, option: &str) {
     }
 }
 
-/// Print the deck's estimated size and solver memory, and refuse before
-/// meshing when even half the estimated nodes would not fit the solving
-/// machine (the estimate is within a factor of about two; the export
-/// checks the exact count before writing).
+/// Print the brick deck's estimated size and solver memory, and refuse
+/// before meshing when even half the estimated nodes would not fit the
+/// solving machine (the estimate is within a factor of about two; the
+/// export checks the exact count before writing). Tetrahedra skip it: their
+/// estimate grades a coarse lattice, as long as meshing itself.
 fn fea_estimate(model: &volcad_core::Model, p: &FeaParams) -> anyhow::Result<()> {
     let est = volcad_compilers::fea::estimate_fea(model, p)?;
     eprintln!(

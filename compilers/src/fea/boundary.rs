@@ -37,6 +37,13 @@ pub struct EndSets {
     pub load: Option<String>,
 }
 
+impl NodeSet {
+    /// Set the areas from the mesh's boundary faces.
+    pub fn measure(&mut self, nodes: &[DVec3], boundary: &[Face]) {
+        (self.area, self.projected) = covered(nodes, boundary, &self.ids);
+    }
+}
+
 /// One chosen set.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NodeSet {
@@ -108,7 +115,9 @@ fn triangles(f: &Face) -> impl Iterator<Item = [usize; 3]> + '_ {
     std::iter::once(first).chain(quad.then_some(second))
 }
 
-fn covered(nodes: &[DVec3], boundary: &[Face], ids: &[u32]) -> (f64, f64) {
+/// The boundary area (mm²) whose faces lie wholly in the set `ids`
+/// (1-based), and its projection on the xy plane.
+pub fn covered(nodes: &[DVec3], boundary: &[Face], ids: &[u32]) -> (f64, f64) {
     let mut member = vec![false; nodes.len()];
     for &i in ids {
         member[i as usize - 1] = true;
@@ -183,11 +192,12 @@ pub fn z_span(nodes: &[DVec3]) -> (f64, f64) {
         })
 }
 
-/// `NBOTTOM` and `NTOP` of a mesh with these nodes and boundary faces;
-/// `element` is the element size the default band uses.
+/// `NBOTTOM` and `NTOP` of a mesh with these nodes; `element` is the
+/// element size the default band uses. Their areas are left at 0 for
+/// [`NodeSet::measure`] (the boundary faces come later, computed while the
+/// deck is written).
 pub fn end_sets(
     nodes: &[DVec3],
-    boundary: &[Face],
     rule: &EndSets,
     element: f64,
 ) -> Result<(NodeSet, NodeSet), ExportError> {
@@ -233,14 +243,11 @@ pub fn end_sets(
             ),
         ));
     }
-    let set = |ids: Vec<u32>, rule: String| {
-        let (area, projected) = covered(nodes, boundary, &ids);
-        NodeSet {
-            ids,
-            area,
-            projected,
-            rule,
-        }
+    let set = |ids: Vec<u32>, rule: String| NodeSet {
+        ids,
+        area: 0.0,
+        projected: 0.0,
+        rule,
     };
     Ok((set(bottom, b_rule), set(top, t_rule)))
 }
@@ -329,7 +336,14 @@ mod tests {
     fn bands_expressions_areas_and_footprint() {
         let (nodes, faces) = plate();
         assert!((footprint(&nodes, &faces) - 1.0).abs() < 0.01);
-        let (b, t) = end_sets(&nodes, &faces, &EndSets::default(), 0.5).unwrap();
+        let sets = |rule: &EndSets| {
+            end_sets(&nodes, rule, 0.5).map(|(mut b, mut t)| {
+                b.measure(&nodes, &faces);
+                t.measure(&nodes, &faces);
+                (b, t)
+            })
+        };
+        let (b, t) = sets(&EndSets::default()).unwrap();
         assert_eq!(
             (b.ids.clone(), t.ids.clone()),
             (vec![1, 2, 3, 4], vec![5, 6, 7])
@@ -341,7 +355,7 @@ mod tests {
             fix: Some("z<0.5 and x<0.5".into()),
             ..EndSets::default()
         };
-        let (b, _) = end_sets(&nodes, &faces, &rule, 0.5).unwrap();
+        let (b, _) = sets(&rule).unwrap();
         assert_eq!((b.ids.clone(), b.area), (vec![1, 4], 0.0));
         let n = notes(&b, &t, 1.0, (0.0, 30.0));
         assert!(
@@ -353,23 +367,19 @@ mod tests {
             load: Some("z>2".into()),
             ..EndSets::default()
         };
-        let e = end_sets(&nodes, &faces, &empty, 0.5)
-            .unwrap_err()
-            .to_string();
+        let e = sets(&empty).unwrap_err().to_string();
         assert!(e.contains("--load") && e.contains("selects no node"), "{e}");
         let wide = EndSets {
             band: Some(2.0),
             ..EndSets::default()
         };
-        let e = end_sets(&nodes, &faces, &wide, 0.5)
-            .unwrap_err()
-            .to_string();
+        let e = sets(&wide).unwrap_err().to_string();
         assert!(e.contains("share 7 nodes"), "{e}");
         let bad = EndSets {
             fix: Some("z<".into()),
             ..EndSets::default()
         };
-        let e = end_sets(&nodes, &faces, &bad, 0.5).unwrap_err().to_string();
+        let e = sets(&bad).unwrap_err().to_string();
         assert!(e.contains("--fix") && e.contains("z<"), "{e}");
     }
 }

@@ -518,9 +518,7 @@ pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summ
         p.force,
         &p.size_options(),
     )?);
-    let topo = topology::topology(&mesh);
-    notes.extend(check_pieces(&topo.pieces, p.allow_pieces, size_option)?);
-    let (bottom, top) = boundary::end_sets(&mesh.nodes, &topo.boundary, &p.ends, element_size)?;
+    let (mut bottom, mut top) = boundary::end_sets(&mesh.nodes, &p.ends, element_size)?;
     if bottom.ids.len() < 3 || top.ids.len() < 3 {
         notes.push(format!("warning: NBOTTOM has {} and NTOP {} nodes; fewer than 3 leaves rigid-body modes under the --step boundary conditions", bottom.ids.len(), top.ids.len()));
     }
@@ -530,9 +528,6 @@ pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summ
         mesh.nodes.len(),
         mesh.len(),
     ));
-    let footprint = boundary::footprint(&mesh.nodes, &topo.boundary);
-    let zspan = boundary::z_span(&mesh.nodes);
-    notes.extend(boundary::notes(&bottom, &top, footprint, zspan));
     let counts: Vec<(String, u64)> = used
         .iter()
         .map(|m| {
@@ -564,11 +559,28 @@ pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summ
     )?;
     ctx.progress("writing model.inp", 0, mesh.len() as u64, "elements", 0.92);
     let path = ctx.staging().join("model.inp");
-    let file = std::fs::File::create(&path).map_err(|e| ExportError::io(&path, e))?;
-    let mut w = BufWriter::with_capacity(1 << 20, file);
-    inp_writer::write(&mut w, &deck)
-        .and_then(|_| w.flush())
-        .map_err(|e| ExportError::io(&path, e))?;
+    // The faces' checks (pieces, set areas, footprint) run while the deck
+    // is written: the writer is one core's work. A deck refused for its
+    // pieces is then removed with the staging folder.
+    let write = || {
+        let file = std::fs::File::create(&path).map_err(|e| ExportError::io(&path, e))?;
+        let mut w = BufWriter::with_capacity(1 << 20, file);
+        inp_writer::write(&mut w, &deck)
+            .and_then(|_| w.flush())
+            .map_err(|e| ExportError::io(&path, e))
+    };
+    let faces = || {
+        let topo = topology::topology(&mesh);
+        let footprint = boundary::footprint(&mesh.nodes, &topo.boundary);
+        (topo, footprint)
+    };
+    let (written, (topo, footprint)) = rayon::join(write, faces);
+    written?;
+    notes.extend(check_pieces(&topo.pieces, p.allow_pieces, size_option)?);
+    bottom.measure(&mesh.nodes, &topo.boundary);
+    top.measure(&mesh.nodes, &topo.boundary);
+    let zspan = boundary::z_span(&mesh.nodes);
+    notes.extend(boundary::notes(&bottom, &top, footprint, zspan));
     ctx.progress(
         "done",
         mesh.len() as u64,

@@ -688,13 +688,25 @@ fn body_notes(b: &bodies::Bodies, voxel: f64) -> Vec<String> {
     out
 }
 
-/// Volume and watertightness of every segment. The contouring guarantees
-/// watertightness; checked anyway (a linear pass over the edges), every
-/// segment on its own thread.
-fn checks(segs: &[SegmentMesh]) -> Vec<(f64, bool)> {
+/// Volume, watertightness and shape (smallest angle, shortest edge) of
+/// every segment. The contouring guarantees watertightness; checked anyway
+/// (a linear pass over the edges), every segment on its own thread.
+fn checks(segs: &[SegmentMesh]) -> Vec<Check> {
     segs.par_iter()
-        .map(|s| (s.mesh.volume(), s.mesh.is_watertight()))
+        .map(|s| Check {
+            volume: s.mesh.volume(),
+            watertight: s.mesh.is_watertight(),
+            shape: s.mesh.shape(),
+        })
         .collect()
+}
+
+/// What [`checks`] finds for one segment.
+struct Check {
+    volume: f64,
+    watertight: bool,
+    /// Smallest triangle angle (degrees) and shortest edge (mm).
+    shape: (f64, f64),
 }
 
 fn summary(
@@ -703,7 +715,7 @@ fn summary(
     pl: &Plan,
     segs: &[SegmentMesh],
     files: Vec<String>,
-    checks: &[(f64, bool)],
+    checks: &[Check],
 ) -> Summary {
     let [nx, ny, nz] = pl.grid.dims;
     let mut notes = vec![format!(
@@ -719,7 +731,9 @@ fn summary(
         ));
     }
     let mut total_volume = 0.0;
-    for (s, &(v, watertight)) in segs.iter().zip(checks) {
+    let (mut angle, mut edge) = (180.0f64, f64::INFINITY);
+    for (s, c) in segs.iter().zip(checks) {
+        let (v, watertight) = (c.volume, c.watertight);
         if s.mesh.is_empty() {
             notes.push(format!(
                 "{}: empty (no voxel in this range), no file",
@@ -728,6 +742,8 @@ fn summary(
             continue;
         }
         total_volume += v;
+        angle = angle.min(c.shape.0);
+        edge = edge.min(c.shape.1);
         let tight = if watertight {
             "watertight"
         } else {
@@ -742,6 +758,11 @@ fn summary(
         ));
     }
     notes.push(format!("total volume {total_volume:.3} mm³"));
+    if edge.is_finite() {
+        notes.push(format!(
+            "triangle shape: smallest angle {angle:.3}°, shortest edge {edge:.3e} mm"
+        ));
+    }
     let by = match p.by {
         SegmentBy::Material(id) => {
             json!({ "material": model.table().name(id), "id": id, "segments": p.segments })
