@@ -23,6 +23,8 @@ pub mod png_stack;
 mod presets;
 mod probe;
 pub mod resources;
+pub mod thin;
+mod union_find;
 pub mod zip_writer;
 
 pub use job::{ExportError, JobHandle, Progress, Summary};

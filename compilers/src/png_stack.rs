@@ -573,6 +573,11 @@ fn summary(
             *c as f64 * voxel_mm3
         ));
     }
+    notes.extend(crate::thin::thin_feature_notes(
+        model,
+        est.grid.voxel.max_element(),
+        "--voxel",
+    ));
     if counts.iter().all(|(_, c)| *c == 0) {
         notes.push(
             "warning: no voxel centre is inside the design, so every slice is blank (the part is empty, or thinner than a voxel)"

@@ -353,7 +353,7 @@ FGrade(["x/6+0.5", "-x/6+0.5"], [m.id("VeroCyan"), m.id("Agilus30")], true, Rect
         "*NODE, NSET=NALL\n1, -3.0, -2.0, -1.5\n",
         "*ELEMENT, TYPE=C3D8R, ELSET=E_VeroCyan\n1, ",
         "*ELEMENT, TYPE=C3D8R, ELSET=E_Agilus30Clr\n",
-        "*ELSET, ELSET=EALL\nE_VeroCyan, E_Agilus30Clr\n",
+        "*ELSET, ELSET=EALL\nE_VeroCyan\nE_Agilus30Clr\n",
         "*MATERIAL, NAME=VeroCyan\n*ELASTIC\n2850.0, 0.39\n*SOLID SECTION, ELSET=E_VeroCyan, MATERIAL=VeroCyan\n",
         "*MATERIAL, NAME=Agilus30Clr\n*ELASTIC\n0.383, 0.49\n",
         "*BOUNDARY\nNBOTTOM, 1, 3\n*STEP\n*STATIC\n*BOUNDARY\nNTOP, 3, 3, -0.5\n*NODE FILE\nU\n*EL FILE\nS\n",

@@ -9,11 +9,13 @@ use std::time::Duration;
 
 use anyhow::{Context, bail};
 use glam::DVec3;
-use volcad_compilers::fea::{Element, FeaParams, Sizing, StepParams};
+use volcad_compilers::fea::solver::{check_solver_memory, machine_memory, solver_bytes};
+use volcad_compilers::fea::{Element, EndSets, FeaParams, Sizing, StepParams};
 use volcad_compilers::job::{self, design_hash};
 use volcad_compilers::mesh::{MeshFormats, MeshParams, SegmentBy};
 use volcad_compilers::png_stack::{self, Dither, PngParams};
 use volcad_compilers::resources::check_disk_for;
+use volcad_compilers::thin::thin_feature_notes;
 
 use super::DesignArgs;
 use super::design::load_design;
@@ -90,6 +92,31 @@ pub struct ExportArgs {
     /// fea: append a static step: bottom fixed, top displaced by this many mm in z.
     #[arg(long, allow_negative_numbers = true)]
     pub step: Option<f64>,
+    /// fea: end sets, pieces and solver memory.
+    #[command(flatten)]
+    pub fea_checks: Box<FeaChecks>,
+}
+
+/// `volcad export fea` options that choose the end node sets and let a
+/// deck through its checks (boxed: they would make every command's
+/// arguments larger).
+#[derive(clap::Args, Debug)]
+pub struct FeaChecks {
+    /// fea: NBOTTOM/NTOP are the nodes closer than this many mm to the lowest/highest z (default: one element size).
+    #[arg(long, allow_negative_numbers = true)]
+    pub fix_band: Option<f64>,
+    /// fea: NBOTTOM (clamped) is the nodes where this condition on x, y, z holds, e.g. "z<0.5".
+    #[arg(long, allow_hyphen_values = true)]
+    pub fix: Option<String>,
+    /// fea: NTOP (moved by --step) is the nodes where this condition holds, e.g. "z>29.5".
+    #[arg(long, allow_hyphen_values = true)]
+    pub load: Option<String>,
+    /// fea: write a deck whose elements fall into several pieces (refused otherwise).
+    #[arg(long)]
+    pub allow_pieces: bool,
+    /// fea: write a deck even when CalculiX would need more memory than this machine has.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// The voxel sizes accepted, in mm: a nanometre to a kilometre.
@@ -189,6 +216,11 @@ fn foreign_options(a: &ExportArgs) -> Vec<&'static str> {
         ("--max-cell", a.max_cell.is_some(), Kind::Fea),
         ("--sizing", a.sizing.is_some(), Kind::Fea),
         ("--step", a.step.is_some(), Kind::Fea),
+        ("--fix-band", a.fea_checks.fix_band.is_some(), Kind::Fea),
+        ("--fix", a.fea_checks.fix.is_some(), Kind::Fea),
+        ("--load", a.fea_checks.load.is_some(), Kind::Fea),
+        ("--allow-pieces", a.fea_checks.allow_pieces, Kind::Fea),
+        ("--force", a.fea_checks.force, Kind::Fea),
     ];
     given
         .iter()
@@ -307,6 +339,7 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
                 est.memory_bytes as f64 / 1e6
             );
             check_disk_for(est.disk_bytes, &dest, "a larger voxel size")?;
+            warn_thin(&model, p.voxel.max_element(), "--voxel");
             job::spawn(dest, hash, move |ctx| {
                 png_stack::export_png_stack(&model, &p, ctx)
             })
@@ -324,12 +357,19 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
                 est.memory_bytes as f64 / 1e6
             );
             check_disk_for(est.disk_bytes, &dest, "a larger voxel size")?;
+            warn_thin(&model, p.voxel.max_element(), "--voxel");
             job::spawn(dest, hash, move |ctx| {
                 volcad_compilers::mesh::export_meshes(&model, &p, ctx)
             })
         }
         Kind::Fea => {
             let p = fea_params(a, voxel, &model)?;
+            if p.element == Element::C3D8R {
+                fea_estimate(&model, &p)?;
+            } else {
+                let (size, option) = p.cell();
+                warn_thin(&model, size, option);
+            }
             job::spawn(dest, hash, move |ctx| {
                 volcad_compilers::fea::export_fea(&model, &p, ctx)
             })
@@ -396,8 +436,46 @@ fn fea_params(
         step: a.step.map(|d| StepParams {
             top_displacement: d,
         }),
+        ends: EndSets {
+            band: a.fea_checks.fix_band,
+            fix: a.fea_checks.fix.clone(),
+            load: a.fea_checks.load.clone(),
+        },
+        allow_pieces: a.fea_checks.allow_pieces,
+        force: a.fea_checks.force,
+        solver_memory: None,
         threads: a.threads,
     })
+}
+
+/// Print the warnings about features thinner than `size` can resolve
+/// before the export starts (the summary repeats them).
+fn warn_thin(model: &volcad_core::Model, size: f64, option: &str) {
+    for n in thin_feature_notes(model, size, option) {
+        if n.starts_with("warning") {
+            eprintln!("{n}");
+        }
+    }
+}
+
+/// Print the brick deck's estimated size and solver memory, and refuse
+/// before meshing when even half the estimated nodes would not fit the
+/// solving machine (the estimate is within a factor of about two; the
+/// export checks the exact count before writing). Tetrahedra skip it: their
+/// estimate grades a coarse lattice, as long as meshing itself.
+fn fea_estimate(model: &volcad_core::Model, p: &FeaParams) -> anyhow::Result<()> {
+    let est = volcad_compilers::fea::estimate_fea(model, p)?;
+    eprintln!(
+        "about {} elements, {} nodes, {:.1} MB .inp; CalculiX's direct solver about {:.1} GB",
+        est.elements,
+        est.nodes,
+        est.file_bytes as f64 / 1e6,
+        solver_bytes(est.nodes) as f64 / 1e9
+    );
+    let (size, option) = p.cell();
+    warn_thin(model, size, option);
+    check_solver_memory(est.nodes / 2, machine_memory()?, p.force, &p.size_options())?;
+    Ok(())
 }
 
 /// A flag that Ctrl-C, SIGTERM and SIGHUP set, for [`follow`] to cancel the

@@ -14,11 +14,13 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, Sender, channel};
 
 use glam::DVec3;
+use volcad_compilers::fea::solver::solver_bytes;
 use volcad_compilers::fea::{Element, FeaParams, Sizing, StepParams};
 use volcad_compilers::job::{self, design_hash};
 use volcad_compilers::mesh::{MeshFormats, MeshParams, SegmentBy};
 use volcad_compilers::png_stack::{self, Dither, PngParams};
 use volcad_compilers::resources::{check_disk_for, human_bytes};
+use volcad_compilers::thin::thin_feature_notes;
 use volcad_core::Model;
 
 use super::jobs::{Jobs, fresh_destination};
@@ -174,10 +176,21 @@ impl EstimateWorker {
 struct Estimated {
     text: String,
     disk_bytes: Option<u64>,
+    /// `warning: …` lines (features thinner than the cells resolve).
+    warnings: Vec<String>,
 }
 
 fn estimate(model: &Model, p: &Params) -> Result<Estimated, String> {
     let e = |e: volcad_compilers::ExportError| e.to_string();
+    let (size, option) = match p {
+        Params::Png(p) => (p.voxel.max_element(), "--voxel"),
+        Params::Mesh(p) => (p.voxel.max_element(), "--voxel"),
+        Params::Fea(p) => p.cell(),
+    };
+    let warnings: Vec<String> = thin_feature_notes(model, size, option)
+        .into_iter()
+        .filter(|n| n.starts_with("warning"))
+        .collect();
     Ok(match p {
         Params::Png(p) => {
             let est = png_stack::estimate(model, p).map_err(e)?;
@@ -191,6 +204,7 @@ fn estimate(model: &Model, p: &Params) -> Result<Estimated, String> {
                     human_bytes(est.memory_bytes)
                 ),
                 disk_bytes: Some(est.disk_bytes),
+                warnings,
             }
         }
         Params::Mesh(p) => {
@@ -205,18 +219,21 @@ fn estimate(model: &Model, p: &Params) -> Result<Estimated, String> {
                     human_bytes(est.disk_bytes)
                 ),
                 disk_bytes: Some(est.disk_bytes),
+                warnings,
             }
         }
         Params::Fea(p) => {
             let est = volcad_compilers::fea::estimate_fea(model, p).map_err(e)?;
             Estimated {
                 text: format!(
-                    "about {} elements, {} nodes, {} .inp",
+                    "about {} elements, {} nodes, {} .inp, {} for CalculiX's solver",
                     est.elements,
                     est.nodes,
-                    human_bytes(est.file_bytes)
+                    human_bytes(est.file_bytes),
+                    human_bytes(solver_bytes(est.nodes))
                 ),
                 disk_bytes: None,
+                warnings,
             }
         }
     })
@@ -334,6 +351,9 @@ impl ExportPanels {
             }
             Some(Ok(t)) => {
                 ui.label(egui::RichText::new(format!("Estimate: {}", t.text)).small());
+                for w in &t.warnings {
+                    ui.colored_label(ui.visuals().warn_fg_color, w);
+                }
             }
             Some(Err(e)) => {
                 ui.colored_label(ui.visuals().error_fg_color, e);

@@ -9,7 +9,7 @@
 //! *NODE, NSET=NALL            ids 1..N
 //! **                          (closes the node block for simple readers)
 //! *ELEMENT, TYPE=C3D4, ELSET=E_<name>      one block per material, ids 1..M
-//! *ELSET, ELSET=EALL          the material sets
+//! *ELSET, ELSET=EALL          the material sets, one name a line
 //! *NSET, NSET=NBOTTOM / NTOP  nodes within tolerance of min / max z
 //! *MATERIAL, NAME=<name> + *ELASTIC E, ν    per material with elements
 //! *SOLID SECTION, ELSET=E_<name>, MATERIAL=<name>
@@ -117,6 +117,37 @@ pub fn ascii(text: &str) -> String {
     out
 }
 
+/// Characters of comment text a line: with `** ` the lines stay within
+/// CalculiX's 132 columns.
+const COMMENT_WIDTH: usize = 120;
+
+/// `text` in lines of at most `width` characters, broken at spaces (a
+/// longer word is cut).
+fn wrap(text: &str, width: usize) -> Vec<String> {
+    let (mut lines, mut line) = (Vec::new(), String::new());
+    for word in text.split(' ') {
+        let mut word = word;
+        while !word.is_empty() || line.is_empty() {
+            let sep = usize::from(!line.is_empty());
+            if line.len() + sep + word.len() <= width {
+                if sep == 1 {
+                    line.push(' ');
+                }
+                line.push_str(word);
+                break;
+            }
+            if line.is_empty() {
+                // ASCII by now: any byte is a char boundary.
+                line.push_str(&word[..width]);
+                word = &word[width..];
+            }
+            lines.push(std::mem::take(&mut line));
+        }
+    }
+    lines.push(line);
+    lines
+}
+
 fn id_lines(w: &mut impl Write, ids: impl IntoIterator<Item = String>) -> io::Result<()> {
     let mut line = Vec::with_capacity(16);
     for id in ids {
@@ -140,7 +171,9 @@ pub fn write(w: &mut impl Write, d: &Deck<'_>) -> io::Result<()> {
     writeln!(w, "*HEADING")?;
     writeln!(w, "{}", ascii(&d.title))?;
     for c in &d.comments {
-        writeln!(w, "** {}", ascii(c))?;
+        for line in wrap(&ascii(c), COMMENT_WIDTH) {
+            writeln!(w, "** {line}")?;
+        }
     }
     writeln!(w, "*NODE, NSET=NALL")?;
     for (i, p) in m.nodes.iter().enumerate() {
@@ -161,8 +194,12 @@ pub fn write(w: &mut impl Write, d: &Deck<'_>) -> io::Result<()> {
             next += 1;
         }
     }
+    // One set name per line: Abaqus allows several, but meshio (and other
+    // simple readers) take only the first name of each line.
     writeln!(w, "*ELSET, ELSET=EALL")?;
-    id_lines(w, d.materials.iter().map(|m| format!("E_{}", m.name)))?;
+    for mat in d.materials {
+        writeln!(w, "E_{}", mat.name)?;
+    }
     for (name, ids) in [("NBOTTOM", d.bottom), ("NTOP", d.top)] {
         if !ids.is_empty() {
             writeln!(w, "*NSET, NSET={name}")?;
@@ -223,6 +260,8 @@ mod tests {
         assert_eq!(sanitize("gray 128", &mut taken), "gray_128");
         assert_eq!(sanitize("Gray_128", &mut taken), "Gray_128_2");
         assert_eq!(sanitize("3d-red", &mut taken), "M3d_red");
+        assert_eq!(wrap("aa bb cc", 5), vec!["aa bb", "cc"]);
+        assert_eq!(wrap("abcdefg h", 3), vec!["abc", "def", "g h"]);
         assert_eq!(
             ascii("10° … 165°, 1 mm³ ×2\n"),
             "10 deg ... 165 deg, 1 mm3 x2 "

@@ -17,6 +17,7 @@
 //! with [`StepParams`] a static step that runs as written. Results come back
 //! through [`read_frd`] and [`write_result_csv`].
 
+pub mod boundary;
 pub mod bricks;
 pub mod frd;
 pub mod inp_writer;
@@ -25,7 +26,9 @@ pub mod materials;
 pub mod quality;
 pub mod refine;
 pub mod sizing;
+pub mod solver;
 pub mod tets;
+pub mod topology;
 
 use std::io::{BufWriter, Write};
 use std::sync::atomic::AtomicBool;
@@ -37,6 +40,7 @@ use volcad_core::Model;
 use volcad_core::material::VOID;
 use volcad_core::model::MAX_MATERIALS;
 
+pub use boundary::EndSets;
 pub use frd::{
     CsvStats, FrdError, FrdResult, read_frd, read_inp_nodes, result_csv, write_result_csv,
 };
@@ -103,6 +107,17 @@ pub struct FeaParams {
     pub seed: u64,
     /// Append a ready static step.
     pub step: Option<StepParams>,
+    /// How the `NBOTTOM` and `NTOP` node sets are chosen.
+    pub ends: EndSets,
+    /// Write a deck whose elements fall into several pieces (joined at
+    /// edges or corners only, or apart), which is refused otherwise.
+    pub allow_pieces: bool,
+    /// Write a deck whose solve needs more memory than the machine has.
+    pub force: bool,
+    /// Memory (bytes) of the machine that will solve the deck (`None`:
+    /// [`solver::machine_memory`]).
+    #[serde(skip)]
+    pub solver_memory: Option<u64>,
     /// Worker threads (`None`: all cores). The output does not depend on
     /// it, so the manifest does not record it either.
     #[serde(skip)]
@@ -119,7 +134,29 @@ impl Default for FeaParams {
             sizing: Sizing::Heterogeneity,
             seed: 0,
             step: None,
+            ends: EndSets::default(),
+            allow_pieces: false,
+            force: false,
+            solver_memory: None,
             threads: None,
+        }
+    }
+}
+
+impl FeaParams {
+    /// The smallest element size (mm) and the option that sets it.
+    pub fn cell(&self) -> (f64, &'static str) {
+        match self.element {
+            Element::C3D8R => (self.voxel, "--voxel"),
+            Element::C3D4 => (self.min_cell, "--min-cell"),
+        }
+    }
+
+    /// The element size options with their values, for suggestions.
+    pub fn size_options(&self) -> Vec<(&'static str, f64)> {
+        match self.element {
+            Element::C3D8R => vec![("--voxel", self.voxel)],
+            Element::C3D4 => vec![("--min-cell", self.min_cell), ("--max-cell", self.max_cell)],
         }
     }
 }
@@ -413,10 +450,44 @@ fn check_step(d: f64, h: f64, notes: &mut Vec<String>) -> Result<(), ExportError
     Ok(())
 }
 
+/// Refuse a mesh in several pieces (elements joined through faces) unless
+/// `allow`: a piece held at an edge or a corner, or not at all, has no
+/// stiffness there, and the solver's answer for it means nothing.
+fn check_pieces(pieces: &[usize], allow: bool, option: &str) -> Result<Vec<String>, ExportError> {
+    if pieces.len() <= 1 {
+        return Ok(vec![
+            "pieces: 1 (every element joined to the rest through faces)".into(),
+        ]);
+    }
+    let total: usize = pieces.iter().sum();
+    let what = format!(
+        "the elements form {} pieces that share no face (the largest holds {:.1} % of the elements; the rest touch it only at edges or corners, or not at all), so the solver's answer for them means nothing",
+        pieces.len(),
+        100.0 * pieces[0] as f64 / total as f64
+    );
+    if !allow {
+        return Err(ExportError::param(
+            option,
+            format!(
+                "{what}; use a smaller {option} (the summary of `volcad export mesh` names the size that resolves the design), or --allow-pieces to write the deck anyway"
+            ),
+        ));
+    }
+    Ok(vec![format!(
+        "warning: {what} (written because of --allow-pieces)"
+    )])
+}
+
 /// Mesh `model` and write `<staging>/model.inp` (see the module doc).
 pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summary, ExportError> {
     let start = Instant::now();
     let (materials, mut notes) = elastic_materials(model)?;
+    let (element_size, size_option) = p.cell();
+    notes.extend(crate::thin::thin_feature_notes(
+        model,
+        element_size,
+        size_option,
+    ));
     if let Some(s) = &p.step {
         check_step(s.top_displacement, model.bbox().size().z, &mut notes)?;
     }
@@ -440,17 +511,24 @@ pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summ
         .into_iter()
         .filter(|m| mesh.mat.contains(&m.slot))
         .collect();
-    let (bottom, top) = end_sets(&mesh.nodes);
-    if bottom.len() < 3 || top.len() < 3 {
-        notes.push(format!("NBOTTOM has {} and NTOP {} nodes; fewer than 3 leaves rigid-body modes under the --step boundary conditions", bottom.len(), top.len()));
+    notes.push(solver::check_solver_memory(
+        mesh.nodes.len() as u64,
+        match p.solver_memory {
+            Some(m) => Some(m),
+            None => solver::machine_memory()?,
+        },
+        p.force,
+        &p.size_options(),
+    )?);
+    let (mut bottom, mut top) = boundary::end_sets(&mesh.nodes, &p.ends, element_size)?;
+    if bottom.ids.len() < 3 || top.ids.len() < 3 {
+        notes.push(format!("warning: NBOTTOM has {} and NTOP {} nodes; fewer than 3 leaves rigid-body modes under the --step boundary conditions", bottom.ids.len(), top.ids.len()));
     }
     notes.extend(mesh.notes.iter().cloned());
     notes.push(format!(
-        "{} nodes, {} elements; NBOTTOM {} nodes, NTOP {} nodes",
+        "{} nodes, {} elements",
         mesh.nodes.len(),
         mesh.len(),
-        bottom.len(),
-        top.len()
     ));
     let counts: Vec<(String, u64)> = used
         .iter()
@@ -472,8 +550,8 @@ pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summ
         comments: std::iter::once(format!("volcad-compilers {}; design {}; one material per element, drawn from the fractions at its centre (seed {})", env!("CARGO_PKG_VERSION"), ctx.design_hash, p.seed))
             .chain(notes.iter().cloned())
             .collect(),
-        bottom: &bottom,
-        top: &top,
+        bottom: &bottom.ids,
+        top: &top.ids,
         step: p.step.map(|s| s.top_displacement),
     };
     crate::resources::check_disk(
@@ -483,11 +561,28 @@ pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summ
     )?;
     ctx.progress("writing model.inp", 0, mesh.len() as u64, "elements", 0.92);
     let path = ctx.staging().join("model.inp");
-    let file = std::fs::File::create(&path).map_err(|e| ExportError::io(&path, e))?;
-    let mut w = BufWriter::with_capacity(1 << 20, file);
-    inp_writer::write(&mut w, &deck)
-        .and_then(|_| w.flush())
-        .map_err(|e| ExportError::io(&path, e))?;
+    // The faces' checks (pieces, set areas, footprint) run while the deck
+    // is written: the writer is one core's work. A deck refused for its
+    // pieces is then removed with the staging folder.
+    let write = || {
+        let file = std::fs::File::create(&path).map_err(|e| ExportError::io(&path, e))?;
+        let mut w = BufWriter::with_capacity(1 << 20, file);
+        inp_writer::write(&mut w, &deck)
+            .and_then(|_| w.flush())
+            .map_err(|e| ExportError::io(&path, e))
+    };
+    let faces = || {
+        let topo = topology::topology(&mesh);
+        let footprint = boundary::footprint(&mesh.nodes, &topo.boundary);
+        (topo, footprint)
+    };
+    let (written, (topo, footprint)) = rayon::join(write, faces);
+    written?;
+    notes.extend(check_pieces(&topo.pieces, p.allow_pieces, size_option)?);
+    bottom.measure(&mesh.nodes, &topo.boundary);
+    top.measure(&mesh.nodes, &topo.boundary);
+    let zspan = boundary::z_span(&mesh.nodes);
+    notes.extend(boundary::notes(&bottom, &top, footprint, zspan));
     ctx.progress(
         "done",
         mesh.len() as u64,
@@ -505,25 +600,4 @@ pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summ
         notes,
         seconds: start.elapsed().as_secs_f64(),
     })
-}
-
-/// 1-based ids of the nodes within tolerance of the lowest and highest z
-/// (tolerance 1e-5 of the mesh diagonal: bricks sit exactly on their layer,
-/// stuffed surface vertices within the root finder's 1e-12).
-pub fn end_sets(nodes: &[DVec3]) -> (Vec<u32>, Vec<u32>) {
-    let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-    for p in nodes {
-        lo = lo.min(*p);
-        hi = hi.max(*p);
-    }
-    let tol = 1e-5 * (hi - lo).length().max(1e-9);
-    let pick = |z: f64| -> Vec<u32> {
-        nodes
-            .iter()
-            .enumerate()
-            .filter(|(_, p)| (p.z - z).abs() <= tol)
-            .map(|(i, _)| i as u32 + 1)
-            .collect()
-    };
-    (pick(lo.z), pick(hi.z))
 }

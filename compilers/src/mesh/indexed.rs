@@ -48,6 +48,10 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     ]
 }
 
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
@@ -87,6 +91,28 @@ impl IndexedMesh {
                 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
             })
             .sum()
+    }
+
+    /// The smallest interior angle (degrees) of any triangle and the
+    /// shortest edge (mm): slivers and needles show here before another
+    /// program trips on them. `(180, inf)` without triangles.
+    pub fn shape(&self) -> (f64, f64) {
+        let (mut angle, mut edge) = (180.0f64, f64::INFINITY);
+        for t in 0..self.triangles.len() {
+            let p = self.corners(t);
+            for k in 0..3 {
+                let (a, b, c) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
+                let (u, v) = (sub(b, a), sub(c, a));
+                let (lu, lv) = (dot(u, u).sqrt(), dot(v, v).sqrt());
+                edge = edge.min(lu);
+                // atan2(|u × v|, u · v) stays exact for needles, where the
+                // acos of the normalised dot product rounds to 0.
+                let n = cross(u, v);
+                let deg = dot(n, n).sqrt().atan2(dot(u, v)).to_degrees();
+                angle = angle.min(if lu > 0.0 && lv > 0.0 { deg } else { 0.0 });
+            }
+        }
+        (angle, edge)
     }
 
     /// Unit normal of triangle `t` (zero for a degenerate one).
@@ -243,6 +269,17 @@ mod tests {
         assert!((m.volume() - 1.0).abs() < 1e-12);
         assert!((m.area() - 6.0).abs() < 1e-12);
         assert_eq!(m.normal(0), [0.0, 0.0, -1.0]);
+        let (angle, edge) = m.shape();
+        assert!((angle - 45.0).abs() < 1e-9 && edge == 1.0, "{angle} {edge}");
+        let needle = IndexedMesh {
+            vertices: vec![[0., 0., 0.], [1., 0., 0.], [0.5, 1e-4, 0.]],
+            triangles: vec![[0, 1, 2]],
+        };
+        let (angle, edge) = needle.shape();
+        assert!(
+            angle > 0.0 && angle < 0.02 && (edge - 0.5).abs() < 1e-6,
+            "{angle} {edge}"
+        );
     }
 
     #[test]

@@ -27,6 +27,7 @@
 //! share their interfaces exactly instead of being contoured one by one
 //! (which leaves gaps and overlaps); fractions are normalised by their sum.
 
+pub mod bodies;
 pub mod contour;
 mod field;
 mod flat;
@@ -567,6 +568,7 @@ pub fn export_meshes(
 ) -> Result<Summary, ExportError> {
     let pl = plan(model, p, Look::Probe)?;
     check_disk(pl.estimate.disk_bytes, ctx.folder(), "a larger voxel size")?;
+    let thin = crate::thin::thin_feature_notes(model, p.voxel.max_element(), "--voxel");
     run_with_threads(p.threads, || {
         let nz = pl.grid.dims[2];
         let segs = build(model, p, &pl, ctx.cancel_flag(), &|done, total| {
@@ -592,8 +594,14 @@ pub fn export_meshes(
         ctx.progress("writing", 0, 1, "files", 0.9);
         // The checks read the meshes as the writers do: both at once, so a
         // core left idle by the last (longest) file checks the meshes.
-        let (files, checks) = rayon::join(|| write_files(&segs, p, ctx), || checks(&segs));
-        Ok(summary(model, p, &pl, &segs, files?, &checks))
+        let (files, (checks, bodies)) = rayon::join(
+            || write_files(&segs, p, ctx),
+            || rayon::join(|| checks(&segs), || bodies::bodies(&segs)),
+        );
+        let mut s = summary(model, p, &pl, &segs, files?, &checks);
+        s.notes.extend(thin);
+        s.notes.extend(body_notes(&bodies, p.voxel.max_element()));
+        Ok(s)
     })
 }
 
@@ -666,13 +674,39 @@ fn write_files(
         .collect()
 }
 
-/// Volume and watertightness of every segment. The contouring guarantees
-/// watertightness; checked anyway (a linear pass over the edges), every
-/// segment on its own thread.
-fn checks(segs: &[SegmentMesh]) -> Vec<(f64, bool)> {
+/// The body count, and a warning when the part fell into several bodies.
+fn body_notes(b: &bodies::Bodies, voxel: f64) -> Vec<String> {
+    let total: f64 = b.volumes.iter().sum();
+    let mut out = vec![format!("bodies: {}", b.count())];
+    if b.count() > 1 {
+        out.push(format!(
+            "warning: the part is {} separate bodies (the largest holds {:.1} % of the volume); a design in one piece has features thinner than about two voxels of {voxel} mm that broke apart: use a smaller --voxel",
+            b.count(),
+            100.0 * b.volumes[0] / total.max(f64::MIN_POSITIVE)
+        ));
+    }
+    out
+}
+
+/// Volume, watertightness and shape (smallest angle, shortest edge) of
+/// every segment. The contouring guarantees watertightness; checked anyway
+/// (a linear pass over the edges), every segment on its own thread.
+fn checks(segs: &[SegmentMesh]) -> Vec<Check> {
     segs.par_iter()
-        .map(|s| (s.mesh.volume(), s.mesh.is_watertight()))
+        .map(|s| Check {
+            volume: s.mesh.volume(),
+            watertight: s.mesh.is_watertight(),
+            shape: s.mesh.shape(),
+        })
         .collect()
+}
+
+/// What [`checks`] finds for one segment.
+struct Check {
+    volume: f64,
+    watertight: bool,
+    /// Smallest triangle angle (degrees) and shortest edge (mm).
+    shape: (f64, f64),
 }
 
 fn summary(
@@ -681,7 +715,7 @@ fn summary(
     pl: &Plan,
     segs: &[SegmentMesh],
     files: Vec<String>,
-    checks: &[(f64, bool)],
+    checks: &[Check],
 ) -> Summary {
     let [nx, ny, nz] = pl.grid.dims;
     let mut notes = vec![format!(
@@ -697,7 +731,9 @@ fn summary(
         ));
     }
     let mut total_volume = 0.0;
-    for (s, &(v, watertight)) in segs.iter().zip(checks) {
+    let (mut angle, mut edge) = (180.0f64, f64::INFINITY);
+    for (s, c) in segs.iter().zip(checks) {
+        let (v, watertight) = (c.volume, c.watertight);
         if s.mesh.is_empty() {
             notes.push(format!(
                 "{}: empty (no voxel in this range), no file",
@@ -706,6 +742,8 @@ fn summary(
             continue;
         }
         total_volume += v;
+        angle = angle.min(c.shape.0);
+        edge = edge.min(c.shape.1);
         let tight = if watertight {
             "watertight"
         } else {
@@ -720,6 +758,11 @@ fn summary(
         ));
     }
     notes.push(format!("total volume {total_volume:.3} mm³"));
+    if edge.is_finite() {
+        notes.push(format!(
+            "triangle shape: smallest angle {angle:.3}°, shortest edge {edge:.3e} mm"
+        ));
+    }
     let by = match p.by {
         SegmentBy::Material(id) => {
             json!({ "material": model.table().name(id), "id": id, "segments": p.segments })

@@ -1,6 +1,7 @@
 //! One 3MF holding every segment as a part of one object, with per-part
-//! print settings that PrusaSlicer reads (layout verified in
-//! `shared/docs/3MF.md`).
+//! print settings that PrusaSlicer reads (checked by slicing it with
+//! PrusaSlicer and opening it in lib3mf's strict reader,
+//! `compilers/tests/conformance.rs`).
 //!
 //! Package: `[Content_Types].xml`, `_rels/.rels`, `3D/3dmodel.model` (one
 //! `<object id="1">` whose mesh holds every part's vertices and triangles in
@@ -9,6 +10,12 @@
 //! indices, with `name` and the part's settings). Values use PrusaSlicer's
 //! `.ini` syntax: `fill_density` must carry `%`. Vertices are world
 //! coordinates in millimetres; no transform.
+//!
+//! Conformance (3MF core 1.3 and OPC): every part has a content type (the
+//! `.config` part is plain XML, so `text/xml`), and `<item>` carries only
+//! core attributes; PrusaSlicer's own `printable` is left out because
+//! lib3mf's strict reader refuses unknown attributes in the core namespace,
+//! and PrusaSlicer reads a missing `printable` as printable.
 //!
 //! The ZIP is written by [`crate::zip_writer`]: entries deflated (level 1)
 //! on every core with a fixed 1980-01-01 time stamp, so the bytes repeat run
@@ -37,6 +44,7 @@ const CONTENT_TYPES: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
 <Types xmlns="http://schemas.openxmlformats.org/package/2006/content-types">
  <Default Extension="rels" ContentType="application/vnd.openxmlformats-package.relationships+xml"/>
  <Default Extension="model" ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/>
+ <Default Extension="config" ContentType="text/xml"/>
 </Types>
 "#;
 
@@ -120,10 +128,7 @@ fn write_model(parts: &[Part<'_>], object_name: &str, m: &mut impl Write) -> io:
         m,
         "    </triangles>\n   </mesh>\n  </object>\n </resources>"
     )?;
-    writeln!(
-        m,
-        " <build>\n  <item objectid=\"1\" printable=\"1\"/>\n </build>\n</model>"
-    )?;
+    writeln!(m, " <build>\n  <item objectid=\"1\"/>\n </build>\n</model>")?;
     Ok(())
 }
 

@@ -17,8 +17,11 @@ mod prepare;
 pub mod sdf;
 mod shapes;
 mod strut_grid;
+mod thinnest;
 mod tpms;
 mod union_index;
+
+pub use thinnest::{Feature, Thinnest};
 
 #[cfg(test)]
 pub(crate) mod tests;

@@ -42,6 +42,11 @@ pub struct Tpms {
 }
 
 impl Tpms {
+    /// The wall thickness (mm) it was made with.
+    pub fn thickness(&self) -> f64 {
+        2.0 * self.half_t
+    }
+
     /// A sheet of `kind` with period `cell` (mm) and wall `thickness` (mm).
     pub fn new(kind: TpmsType, cell: DVec3, thickness: f64) -> Self {
         let k = DVec3::splat(std::f64::consts::TAU) / cell;
