@@ -36,7 +36,7 @@ struct Case {
     by: SegmentBy,
     segments: usize,
     /// pyvcad 2.3.4's slice-stack rate on the same design and voxel size,
-    /// measured on this kind of machine (OPENVCAD.md §9), M voxels/s.
+    /// measured on this kind of machine (pyvcad 2.3.4), M voxels/s.
     pyvcad_png: Option<f64>,
 }
 

@@ -2,7 +2,7 @@
 //!
 //! Coordinates are written for a unit cube `[-1/2, 1/2]³` and scaled by the
 //! cell size. BCC, FCC, Cubic and Kelvin match pyvcad 2.3.4's `LatticeType`
-//! (OPENVCAD.md section 2, Lattices); Octet is ours.
+//! (pyvcad 2.3.4's lattices); Octet is ours.
 
 use glam::DVec3;
 

@@ -1,8 +1,8 @@
 //! Material tables: named base materials with display colours and, for FEA
 //! export, elastic properties.
 //!
-//! The file format is pyvcad's (`{"materials":[{"name","r","g","b","a"}]}`,
-//! OPENVCAD.md section 4) with optional mechanical fields
+//! The file format is pyvcad 2.3.4's
+//! (`{"materials":[{"name","r","g","b","a"}]}`) with optional mechanical fields
 //! (`youngs_modulus_mpa`, `poisson_ratio`, `density_g_cm3`). Ids follow
 //! pyvcad: `void` is always id 0; the other entries get ids 1..N in file
 //! order (an entry named `void` is skipped). When two entries share a name the

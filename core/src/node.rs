@@ -4,7 +4,7 @@
 //! are shared, so a unit cell used by `Tile` or a strut used a thousand times
 //! exists once. Building is cheap and does no geometry; [`crate::Model::prepare`]
 //! turns the tree into an evaluator. Names and argument orders follow pyvcad
-//! 2.x (OPENVCAD.md section 2).
+//! 2.x (pyvcad 2.3.4).
 
 use std::sync::Arc;
 

@@ -49,7 +49,7 @@ fn every_example_is_tested() {
     }
 }
 
-/// pyvcad's lattice (OPENVCAD.md §12, d4; `d4_bcc_lattice_box` in the
+/// pyvcad's lattice (pyvcad 2.3.4's design d4; `d4_bcc_lattice_box` in the
 /// model's tests checks this file against pyvcad's distances). Here: the
 /// 10 mm box that makes pyvcad's 200³ grid 0.05 mm voxels, and the
 /// lattice's material at a node.

@@ -1,8 +1,8 @@
 //! The Abaqus/CalculiX `.inp` deck.
 //!
 //! Layout (flat, no `*PART`/`*ASSEMBLY`; CalculiX 2.20 ignores parts and
-//! pyvcad's Part/Assembly output with comma-led data lines hangs it, see
-//! OPENVCAD.md §5):
+//! pyvcad 2.3.4's Part/Assembly output with comma-led data lines hangs
+//! it):
 //!
 //! ```text
 //! *HEADING / title line / ** comments

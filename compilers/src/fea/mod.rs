@@ -1,6 +1,6 @@
 //! FEA meshes for Abaqus/CalculiX (`.inp`).
 //!
-//! Two element kinds (DESIGN.md, "Compilers"):
+//! Two element kinds (the paper's FEA export):
 //!
 //! * **C3D8R bricks** on the shared voxel grid ([`bricks`]): one brick per
 //!   voxel whose centre is inside, shared corner nodes.

@@ -230,7 +230,7 @@ pub(super) fn tri_set(m: &IndexedMesh) -> Vec<[[u32; 3]; 3]> {
 mod tests {
     use super::*;
 
-    /// The unit cube, outward oriented (12 triangles from 3MF.md).
+    /// The unit cube, outward oriented (12 triangles).
     pub(crate) fn cube() -> IndexedMesh {
         let v = [
             [0., 0., 0.],

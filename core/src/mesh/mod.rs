@@ -1,7 +1,7 @@
 //! Triangle meshes as exact signed distance fields.
 //!
 //! pyvcad's `Mesh` node converts a mesh into an OpenVDB narrow-band grid
-//! (OPENVCAD.md §2: distances clamped to the band, resolution-dependent).
+//! (pyvcad 2.3.4: distances clamped to the band, resolution-dependent).
 //! Volcad instead answers every query exactly from the triangles:
 //!
 //! * **distance**: nearest triangle through a binned-SAH BVH (`bvh.rs`)

@@ -3,7 +3,7 @@
 //! `frac(p, out)` writes the fractions at `p` into `out` (one entry per
 //! material the model uses, all zero on entry). Callers ask only where the
 //! node's distance is ≤ 0; the rules per node follow pyvcad 2.3.4
-//! (OPENVCAD.md section 2) except where `docs/PYVCAD.md` says otherwise.
+//! (pyvcad 2.3.4) except where `docs/PYVCAD.md` says otherwise.
 
 use crate::expr::ExprSet;
 use glam::DVec3;
@@ -270,7 +270,7 @@ impl NAry {
     /// `blend = false`: the first child (in order) containing `p` wins.
     /// `blend = true`: the average over the children containing `p`.
     /// Where no child contains `p` (the fillet of a smooth union) the nearest
-    /// child's fractions are used, as pyvcad does (d3 in OPENVCAD.md §12).
+    /// child's fractions are used, as pyvcad does (measured on pyvcad 2.3.4).
     fn union_frac(&self, p: DVec3, out: &mut [f64]) {
         if let Some(index) = &self.index
             && let Candidates::Cell {

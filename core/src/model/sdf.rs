@@ -57,7 +57,7 @@ pub fn segment_dist2(p: DVec3, a: DVec3, ab: DVec3, inv_ab2: f64) -> f64 {
     (ap - ab * t).length_squared()
 }
 
-/// pyvcad's quadratic smooth minimum with k' = 4k (OPENVCAD.md, Union):
+/// pyvcad's quadratic smooth minimum with k' = 4k (pyvcad 2.3.4's Union):
 /// `h = max(4k − |a − b|, 0) / 4k; min(a, b) − k·h²`.
 #[inline]
 pub fn smooth_min(a: f64, b: f64, k: f64) -> f64 {

@@ -1,5 +1,5 @@
 //! Node semantics: one test per node, pyvcad's cross-check designs
-//! (OPENVCAD.md §12), every deliberate fix (docs/PYVCAD.md), and the
+//! (measured on pyvcad 2.3.4), every deliberate fix (docs/PYVCAD.md), and the
 //! soundness of interval bounds and of the large-union index.
 
 use glam::DVec3;
@@ -29,7 +29,7 @@ fn close(a: f64, b: f64, tol: f64) {
     assert!((a - b).abs() <= tol, "{a} vs {b}");
 }
 
-// ---- OPENVCAD.md §12: pyvcad's own values ----
+// ---- pyvcad 2.3.4's own values ----
 
 #[test]
 fn d1_csg_priority() {

@@ -79,7 +79,7 @@ pub(super) fn register(engine: &mut Engine, ctx: &RunContext) {
 /// `Mesh(path)`, `Mesh(path, m)`, `Mesh(path, m, disable_validation)`,
 /// `Mesh(path, sample_size)`, `Mesh(path, sample_size, m)` and
 /// `Mesh(path, sample_size, m, disable_validation)`: pyvcad 2.3.4's two
-/// constructors (OPENVCAD.md §2). `sample_size` is checked and otherwise
+/// constructors (pyvcad 2.3.4). `sample_size` is checked and otherwise
 /// not needed: distances come from the triangles exactly, not from a grid.
 fn register_mesh(engine: &mut Engine, ctx: &RunContext) {
     let c = ctx.clone();

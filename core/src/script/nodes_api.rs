@@ -1,5 +1,5 @@
 //! The node constructors scripts call, with pyvcad 2.x names and argument
-//! orders (OPENVCAD.md section 2): transforms, booleans, material nodes and
+//! orders (pyvcad 2.3.4): transforms, booleans, material nodes and
 //! builder methods here, leaves in `leaves_api`. Every constructor checks its arguments
 //! and fails at the call's line and column; math strings are compiled here,
 //! so an expression's syntax error points at the `FGrade` call that holds it.

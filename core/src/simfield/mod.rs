@@ -7,7 +7,7 @@
 //! fallback (`tet_bvh.rs`).
 //! Displacements give the derived variable `len = |(dx, dy, dz)(p)|`: the
 //! vector is interpolated first and its magnitude taken afterwards, as in
-//! OpenVCAD (OPENVCAD.md §6). The mesh's outer surface (`boundary.rs`) is a
+//! OpenVCAD (pyvcad 2.3.4). The mesh's outer surface (`boundary.rs`) is a
 //! [`TriangleMesh`], which gives the field an exact signed distance.
 
 mod boundary;

@@ -1,5 +1,5 @@
 //! Legacy OpenVCAD `.vcad` text designs (pyvcad 2.3.4's
-//! `parse_vcad_text`, OPENVCAD.md section 7), read into the same
+//! `parse_vcad_text`), read into the same
 //! [`Design`] a Rhai script builds.
 //!
 //! The text is lexed ([`lexer`]), parsed into calls ([`parser`]) and

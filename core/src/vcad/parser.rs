@@ -1,4 +1,4 @@
-//! The `.vcad` grammar (OPENVCAD.md section 7), by recursive descent:
+//! The `.vcad` grammar, by recursive descent:
 //!
 //! ```text
 //! file := call EOF

@@ -1,5 +1,5 @@
 //! `.vcad` calls → the design tree. Each construct becomes the pyvcad node
-//! that `pv.parse_vcad_text` builds for it (OPENVCAD.md section 7), with the
+//! that `pv.parse_vcad_text` builds for it, with the
 //! node's origin set to the construct's line and column, so errors found
 //! later (at prepare) also point into the `.vcad` file.
 
