@@ -249,7 +249,14 @@ fn meshio_reads_eall_as_every_element() {
             .expect("a count")
     };
     let cells = count("cells");
-    assert!(count("E_VeroCyan") > 0 && count("E_Agilus30Clr") > 0, "{text}");
-    assert_eq!(count("E_VeroCyan") + count("E_Agilus30Clr"), cells, "{text}");
+    assert!(
+        count("E_VeroCyan") > 0 && count("E_Agilus30Clr") > 0,
+        "{text}"
+    );
+    assert_eq!(
+        count("E_VeroCyan") + count("E_Agilus30Clr"),
+        cells,
+        "{text}"
+    );
     assert_eq!(count("EALL"), cells, "{text}");
 }
