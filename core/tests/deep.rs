@@ -298,7 +298,7 @@ fn chains_that_do_not_flatten_are_refused_with_the_depth() {
         }
         for n in [smooth, blends, shells] {
             let e = refused(&n);
-            assert!(e.contains("nested 1001 levels deep"), "{e}");
+            assert!(e.contains("nested 501 levels deep"), "{e}");
             assert!(e.contains("Union(false, parts)"), "{e}");
         }
     });
@@ -317,7 +317,7 @@ fn the_deepest_design_allowed_evaluates_in_a_small_stack() {
         });
         let mut n = sphere(DVec3::ZERO, 2.0, RED);
         let mut levels = 1;
-        while levels < 1_000 {
+        while levels < 500 {
             n = Node::new(match levels % 4 {
                 0 => NodeKind::Union {
                     smooth: 0.0,
@@ -340,7 +340,7 @@ fn the_deepest_design_allowed_evaluates_in_a_small_stack() {
             });
             levels += 1;
         }
-        let m = Model::prepare(&n, table()).expect("1,000 levels are allowed");
+        let m = Model::prepare(&n, table()).expect("500 levels are allowed");
         let p = DVec3::new(0.5, 0.0, 0.0);
         let d = m.distance(p);
         assert!(d < 0.0, "{d}");
@@ -355,6 +355,6 @@ fn the_deepest_design_allowed_evaluates_in_a_small_stack() {
 
         // One more level is refused.
         let e = refused(&union(0.0, vec![n, s.clone()]));
-        assert!(e.contains("nested 1001 levels deep"), "{e}");
+        assert!(e.contains("nested 501 levels deep"), "{e}");
     });
 }

@@ -44,7 +44,7 @@ pub(super) struct Prepared {
 /// Deepest prepared tree: evaluation, intervals and fraction bounds recurse
 /// once a level, each level a few hundred bytes of a thread's stack (the
 /// fraction bounds' scratch arrays are 1 KiB), and a thread may have 2 MiB.
-pub(super) const MAX_DEPTH: u32 = 1_000;
+pub(super) const MAX_DEPTH: u32 = 500;
 
 /// Most nodes a prepared tree may expand to (see [`Prepared::size`]).
 pub(super) const MAX_EXPANDED: u64 = 1 << 24;
