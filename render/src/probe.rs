@@ -211,7 +211,7 @@ fn march(
                 (tt, fr, surface)
             }
             Some(lo) => {
-                let (tt, fr) = bisect(lo, tt, |t| {
+                let (tt, fr) = bisect(lo, tt, 20, |t| {
                     let p = at(t);
                     let (dm, fr) = model.eval_point(p);
                     (dm.max(cut_d(p)) <= 0.0 && drawn.contains(&fr)).then_some(fr)
@@ -231,10 +231,15 @@ fn march(
 }
 
 /// The first `t` in `(lo, hi]` where `drawn_at` answers (it does at `hi`,
-/// not at `lo`), to a millionth of the interval, with its answer.
-fn bisect<T>(mut lo: f64, mut hi: f64, drawn_at: impl Fn(f64) -> Option<T>) -> Option<(f64, T)> {
+/// not at `lo`), to 2^−`steps` of the interval, with its answer.
+fn bisect<T>(
+    mut lo: f64,
+    mut hi: f64,
+    steps: u32,
+    drawn_at: impl Fn(f64) -> Option<T>,
+) -> Option<(f64, T)> {
     let mut best = None;
-    for _ in 0..20 {
+    for _ in 0..steps {
         let mid = 0.5 * (lo + hi);
         match drawn_at(mid) {
             Some(v) => {
@@ -291,15 +296,7 @@ fn sign_march(
     while prev < tmax {
         let t = (prev + step).min(tmax);
         if sdf(o + d * t) <= 0.0 {
-            let (mut a, mut b) = (prev, t);
-            for _ in 0..48 {
-                let m = 0.5 * (a + b);
-                if sdf(o + d * m) <= 0.0 {
-                    b = m;
-                } else {
-                    a = m;
-                }
-            }
+            let (b, ()) = bisect(prev, t, 48, |m| (sdf(o + d * m) <= 0.0).then_some(()))?;
             return Some(hit_at(model, cut, o + d * b, b));
         }
         prev = t;

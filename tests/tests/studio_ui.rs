@@ -480,7 +480,7 @@ fn an_export_larger_than_the_disk_is_not_started() {
     assert!(h.state().jobs().list().is_empty(), "no job starts");
     let log = h.state().log_lines().join("\n");
     assert!(
-        log.contains("PNG stack export not started: --out: the output needs about"),
+        log.contains("PNG stack export not started: \"Output folder\": the output needs about"),
         "{log}"
     );
     assert!(!out.exists());

@@ -5,7 +5,8 @@ use std::path::PathBuf;
 
 use egui::{Key, KeyboardShortcut, Modifiers, ViewportCommand};
 
-use super::files::{self, DialogAnswer, DialogPurpose, Document, Recovered};
+use super::dialogs::{DialogAnswer, DialogPurpose};
+use super::files::{self, Document, Recovered};
 use super::settings::Theme;
 use super::{StudioApp, examples};
 

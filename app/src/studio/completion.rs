@@ -76,7 +76,8 @@ fn word_before(text: &str, cursor: usize) -> (Range<usize>, String, bool) {
     }
     let word: String = chars[start..].iter().collect();
     let before: String = chars[..start].iter().rev().take(4).collect();
-    let in_id = before.starts_with("\"(di") || before.starts_with("\"(");
+    // Material names only inside `id("…")`, not in any string literal.
+    let in_id = before.starts_with("\"(di");
     (start..chars.len(), word, in_id)
 }
 
@@ -254,6 +255,9 @@ mod tests {
         assert_eq!(r.end - r.start, 2);
         let (_, w, s) = word_before("Uni", 3);
         assert_eq!((w.as_str(), s), ("Uni", false));
+        let t = "Mesh(\"bu";
+        let (_, w, s) = word_before(t, t.chars().count());
+        assert_eq!((w.as_str(), s), ("bu", false), "a path is not a material");
     }
 
     #[test]

@@ -100,16 +100,6 @@ impl Dialogs {
         self.open > 0 || self.builtin.is_some()
     }
 
-    /// True when dialogs are the built-in browser (tests, the log).
-    pub fn is_builtin(&self) -> bool {
-        self.native == Native::Missing
-    }
-
-    /// Use the built-in browser from now on (tests; a setting could too).
-    pub fn use_builtin(&mut self) {
-        self.native = Native::Missing;
-    }
-
     /// A line for the log, once: why the built-in browser is used.
     pub fn take_notice(&mut self) -> Option<String> {
         self.notice.take()

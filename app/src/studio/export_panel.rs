@@ -23,7 +23,7 @@ use volcad_compilers::resources::{check_disk_for, human_bytes};
 use volcad_compilers::thin::thin_feature_notes;
 use volcad_core::Model;
 
-use super::jobs::{Jobs, fresh_destination};
+use super::jobs::{Jobs, fresh_destination, in_panel_words};
 
 /// What the panel asks the app to do.
 pub enum Action {
@@ -181,7 +181,7 @@ struct Estimated {
 }
 
 fn estimate(model: &Model, p: &Params) -> Result<Estimated, String> {
-    let e = |e: volcad_compilers::ExportError| e.to_string();
+    let e = |e: volcad_compilers::ExportError| in_panel_words(&e.to_string());
     let (size, option) = match p {
         Params::Png(p) => (p.voxel.max_element(), "--voxel"),
         Params::Mesh(p) => (p.voxel.max_element(), "--voxel"),
@@ -190,6 +190,7 @@ fn estimate(model: &Model, p: &Params) -> Result<Estimated, String> {
     let warnings: Vec<String> = thin_feature_notes(model, size, option)
         .into_iter()
         .filter(|n| n.starts_with("warning"))
+        .map(|n| in_panel_words(&n))
         .collect();
     Ok(match p {
         Params::Png(p) => {
@@ -377,7 +378,8 @@ impl ExportPanels {
         // `check_disk_for`); this estimate sampled layers at the voxel size.
         let room = |dest: &Path| {
             disk_bytes.map_or(Ok(()), |b| {
-                check_disk_for(b, dest, "a larger voxel size").map_err(|e| e.to_string())
+                check_disk_for(b, dest, "a larger voxel size")
+                    .map_err(|e| in_panel_words(&e.to_string()))
             })
         };
         if start.clicked()

@@ -12,8 +12,6 @@ use std::time::{Duration, Instant, SystemTime};
 
 use serde::{Deserialize, Serialize};
 
-pub use super::dialogs::{DialogAnswer, DialogPurpose, Dialogs};
-
 /// The document in the editor.
 #[derive(Clone, Debug, Default)]
 pub struct Document {

@@ -48,9 +48,10 @@ use std::time::{Duration, Instant};
 
 use egui_extras::syntax_highlighting::SyntectSettings;
 
+use dialogs::Dialogs;
 use editor::{Editor, LineMark};
 use export_panel::ExportPanels;
-use files::{Dialogs, Document, Recovery};
+use files::{Document, Recovery};
 use jobs::Jobs;
 use live::{LiveDesign, LiveError, LiveResult, LiveRunner, RunRequest};
 use params::ParamPanel;
@@ -579,7 +580,7 @@ impl StudioApp {
                     export_panel::Action::PickFolder(i) => {
                         let dir = self.exports.dir();
                         self.dialogs
-                            .show(&ctx, files::DialogPurpose::ExportFolder(i), dir, None);
+                            .show(&ctx, dialogs::DialogPurpose::ExportFolder(i), dir, None);
                     }
                     export_panel::Action::Log(l) => self.bottom.log(l),
                 }

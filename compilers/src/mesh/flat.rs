@@ -342,15 +342,6 @@ impl Regions {
         }
     }
 
-    fn find(&mut self, mut a: u32) -> u32 {
-        while self.parent[a as usize] != a {
-            let up = self.parent[self.parent[a as usize] as usize];
-            self.parent[a as usize] = up;
-            a = up;
-        }
-        a
-    }
-
     /// The key of cube `id` (the same for its whole region).
     pub fn key(&self, id: u32) -> FlatKey {
         self.table[self.keys[id as usize] as usize]
@@ -369,7 +360,10 @@ impl Regions {
         if self.parent[a as usize] == self.parent[b as usize] {
             return;
         }
-        let (ra, rb) = (self.find(a), self.find(b));
+        let (ra, rb) = (
+            crate::union_find::find(&mut self.parent, a),
+            crate::union_find::find(&mut self.parent, b),
+        );
         self.parent[ra.max(rb) as usize] = ra.min(rb);
     }
 
@@ -405,7 +399,7 @@ impl Regions {
             })
             .collect();
         for e in 0..self.edges.len() {
-            let r = self.find(self.edges[e].cube);
+            let r = crate::union_find::find(&mut self.parent, self.edges[e].cube);
             if let Ok(s) = roots.binary_search(&r) {
                 regions[s].edges.push(e as u32);
             }
@@ -431,7 +425,7 @@ impl Regions {
         };
         if tris.iter().any(Option::is_none) {
             for id in 0..n {
-                let r = self.find(id);
+                let r = crate::union_find::find(&mut self.parent, id);
                 if let Ok(s) = roots.binary_search(&r)
                     && tris[s].is_none()
                 {

@@ -168,6 +168,18 @@ pub(crate) struct RunContext {
 }
 
 impl RunContext {
+    /// The context of one run with `opts`: its folders, parameter
+    /// overrides and a fresh state.
+    pub fn from_options(opts: &ScriptOptions) -> Self {
+        RunContext {
+            base_dir: opts.base_dir.clone(),
+            allow_read: Arc::new(opts.allow_read.clone()),
+            home: opts.home.clone(),
+            overrides: Arc::new(opts.params.clone()),
+            state: Arc::new(Mutex::new(RunState::default())),
+        }
+    }
+
     /// Resolve `name` relative to the script's folder, refusing anything
     /// outside its project and the allowed folders.
     pub fn resolve(&self, name: &str, pos: Position) -> RResult<PathBuf> {
@@ -227,13 +239,7 @@ pub fn model_of_file(path: &Path) -> Result<crate::Model, String> {
 pub fn run_script(source: &str, name: &str, opts: &ScriptOptions) -> Result<Design, ScriptError> {
     // Some editors start UTF-8 files with a byte-order mark; it is not code.
     let source = source.strip_prefix('\u{feff}').unwrap_or(source);
-    let ctx = RunContext {
-        base_dir: opts.base_dir.clone(),
-        allow_read: Arc::new(opts.allow_read.clone()),
-        home: opts.home.clone(),
-        overrides: Arc::new(opts.params.clone()),
-        state: Arc::new(Mutex::new(RunState::default())),
-    };
+    let ctx = RunContext::from_options(opts);
     if let Err(message) = crate::heap::budget_from_env() {
         return Err(ScriptError {
             file: name.to_owned(),
@@ -293,13 +299,7 @@ pub fn run_script(source: &str, name: &str, opts: &ScriptOptions) -> Result<Desi
 /// once each): the language reference is checked against them.
 pub fn registered_functions() -> Vec<String> {
     let opts = ScriptOptions::default();
-    let ctx = RunContext {
-        base_dir: None,
-        allow_read: Arc::new(opts.allow_read.clone()),
-        home: opts.home.clone(),
-        overrides: Arc::new(HashMap::new()),
-        state: Arc::new(Mutex::new(RunState::default())),
-    };
+    let ctx = RunContext::from_options(&opts);
     let engine = build_engine(&ctx, &opts);
     let mut names: Vec<String> = engine
         .gen_fn_signatures(false)

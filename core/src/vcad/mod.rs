@@ -18,7 +18,7 @@ mod tests;
 mod translate;
 
 use std::path::Path;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 pub use translate::CONSTRUCTS;
 
@@ -63,13 +63,11 @@ pub fn run_vcad(source: &str, name: &str, opts: &ScriptOptions) -> Result<Design
     let toks = lexer::tokenize(source).map_err(to_err)?;
     let call = parser::parse(&toks, end_of(source)).map_err(to_err)?;
     let table = Arc::new(MaterialTable::default_table());
-    let files = opts.base_dir.clone().map(|base_dir| RunContext {
-        base_dir: Some(base_dir),
-        allow_read: Arc::new(opts.allow_read.clone()),
-        home: opts.home.clone(),
-        overrides: Arc::default(),
-        state: Arc::new(Mutex::default()),
-    });
+    // Files resolve as a script's do (`.vcad` has no parameters).
+    let files = opts
+        .base_dir
+        .is_some()
+        .then(|| RunContext::from_options(opts));
     let mut t = translate::Translator {
         table: &table,
         files,
