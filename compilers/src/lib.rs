@@ -8,6 +8,7 @@
 //! * [`png_stack`]: inkjet slice stacks, one PNG per layer.
 //! * [`mesh`]: segmented meshes (STL, OBJ, one 3MF with per-part settings).
 //! * [`fea`]: Abaqus/CalculiX `.inp` meshes (C3D8R bricks, adaptive C3D4 tets).
+//! * [`shard`]: layer stacks split into N layer ranges and merged back.
 #![warn(missing_docs)]
 
 pub mod fea;
@@ -23,6 +24,7 @@ pub mod png_stack;
 mod presets;
 mod probe;
 pub mod resources;
+pub mod shard;
 pub mod thin;
 mod union_find;
 pub mod zip_writer;

@@ -15,6 +15,7 @@ use volcad_compilers::job::{self, design_hash};
 use volcad_compilers::mesh::{MeshFormats, MeshParams, SegmentBy};
 use volcad_compilers::png_stack::{self, Dither, PngParams};
 use volcad_compilers::resources::check_disk_for;
+use volcad_compilers::shard;
 use volcad_compilers::thin::thin_feature_notes;
 
 use super::DesignArgs;
@@ -59,6 +60,11 @@ pub struct ExportArgs {
     /// included); file names keep the global layer indices.
     #[arg(long)]
     pub layers: Option<String>,
+    /// png: only the K-th of N equal layer ranges (K counts from 1: 1/4 is
+    /// the lowest quarter, 4/4 the top); file names keep the global layer
+    /// indices, and `volcad merge` joins the N folders into the single export.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<String>,
     /// png: random (default) or diffusion.
     #[arg(long)]
     pub dither: Option<String>,
@@ -278,6 +284,9 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
             if foreign.len() == 1 { "does" } else { "do" }
         );
     }
+    if a.shard.is_some() && a.kind != Kind::Png {
+        bail!(shard::not_shardable(&format!("{:?}", a.kind).to_lowercase()));
+    }
     if a.kind == Kind::Fea {
         refuse_tet_options(a, parse_element(a.element.as_deref())?)?;
     }
@@ -297,10 +306,16 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
         ),
         (None, None) => None,
     };
-    let hash = design_hash(&[
-        l.source.as_bytes(),
-        format!("{:?}", a.design.params).as_bytes(),
-    ]);
+    // The values the script ran with (from --param and --params/--set
+    // alike, in declaration order): two runs with the same values share a
+    // hash, which `volcad merge` relies on to join their shards.
+    let values: Vec<String> = l
+        .design
+        .params
+        .iter()
+        .map(|p| format!("{}={:?}", p.name, p.value))
+        .collect();
+    let hash = design_hash(&[l.source.as_bytes(), values.join("\n").as_bytes()]);
     if let Some(t) = a.threads {
         volcad_compilers::resources::check_threads(t)?;
     }
@@ -324,6 +339,7 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
                 seed: a.seed,
                 dither,
                 layers: a.layers.as_deref().map(parse_layers).transpose()?,
+                shard: a.shard.as_deref().map(str::parse).transpose()?,
                 per_material_bitmaps: a.bitmaps,
                 threads,
             };
@@ -480,7 +496,7 @@ fn fea_estimate(model: &volcad_core::Model, p: &FeaParams) -> anyhow::Result<()>
 
 /// A flag that Ctrl-C, SIGTERM and SIGHUP set, for [`follow`] to cancel the
 /// export with.
-fn interrupt_flag() -> Arc<AtomicBool> {
+pub(super) fn interrupt_flag() -> Arc<AtomicBool> {
     let interrupted = Arc::new(AtomicBool::new(false));
     let flag = interrupted.clone();
     // A second handler cannot be installed (e.g. in tests running several
@@ -498,7 +514,7 @@ fn interrupt_flag() -> Arc<AtomicBool> {
 }
 
 /// Show progress until the job ends; a signal (`interrupted`) cancels it.
-fn follow(handle: job::JobHandle, interrupted: &AtomicBool) -> anyhow::Result<()> {
+pub(super) fn follow(handle: job::JobHandle, interrupted: &AtomicBool) -> anyhow::Result<()> {
     let bar = indicatif::ProgressBar::new(1000);
     bar.set_style(
         indicatif::ProgressStyle::with_template(

@@ -23,6 +23,7 @@ macro_rules! note {
 mod design;
 mod export;
 mod info;
+mod merge;
 mod output;
 mod render;
 mod sample;
@@ -111,6 +112,8 @@ pub enum Command {
     Render(render::RenderArgs),
     /// Export for printers, slicers and solvers.
     Export(export::ExportArgs),
+    /// Join the folders of `volcad export png --shard K/N` into the single export.
+    Merge(merge::MergeArgs),
     /// Convert a CalculiX .frd result to CSV (`node_id,x,y,z,dx,dy,dz`).
     FeaResult {
         /// The .frd file.
@@ -138,6 +141,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         } => sample::sample(&design, &points, &out),
         Command::Render(a) => render::render(&a),
         Command::Export(a) => export::export(&a),
+        Command::Merge(a) => merge::merge(&a),
         Command::FeaResult { frd, inp, out } => export::fea_result(&frd, &inp, &out),
         Command::Bench(a) => info::bench(&a),
     }
