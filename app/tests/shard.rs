@@ -58,9 +58,13 @@ fn tree(dir: &Path) -> BTreeMap<String, Vec<u8>> {
 
 /// `volcad export png` of the design with `OPTS` and `extra` into `out`.
 fn export(out: &Path, extra: &[&str]) -> std::process::Output {
+    export_with(out, OPTS, extra)
+}
+
+fn export_with(out: &Path, opts: &[&str], extra: &[&str]) -> std::process::Output {
     let d = design();
     let mut args = vec!["export", "png", d.as_str(), "--out", s(out)];
-    args.extend_from_slice(OPTS);
+    args.extend_from_slice(opts);
     args.extend_from_slice(extra);
     volcad(&args)
 }
@@ -156,18 +160,20 @@ fn merge_fails(out: &Path, dirs: &[&Path]) -> String {
 fn merge_refuses_shards_that_do_not_belong_together() {
     let dir = tmp("shard-refuse");
     let d = dir.path();
-    let shard = |k: usize, extra: &[&str]| {
+    let shard = |k: usize, opts: &[&str], extra: &[&str]| {
         let p = d.join(format!("s{k}{}", extra.join("").replace(['-', ' '], "")));
         let spec = format!("{k}/4");
         let mut a = vec!["--shard", spec.as_str()];
         a.extend_from_slice(extra);
-        ok(&export(&p, &a));
+        ok(&export_with(&p, opts, &a));
         p
     };
-    let [s1, s2, s3, s4] = [1, 2, 3, 4].map(|k| shard(k, &[]));
+    let [s1, s2, s3, s4] = [1, 2, 3, 4].map(|k| shard(k, OPTS, &[]));
     let out = d.join("out");
-    // Another seed for shard 2.
-    let s2_seed = shard(2, &["--seed", "8"]);
+    // Another seed for shard 2 (7 is OPTS' seed).
+    let seed_8: Vec<&str> = OPTS.iter().map(|a| if *a == "7" { "8" } else { a }).collect();
+    let s2_seed = d.join("s2seed");
+    ok(&export_with(&s2_seed, &seed_8, &["--shard", "2/4"]));
     let e = merge_fails(&out, &[&s1, &s2_seed, &s3, &s4]);
     assert!(
         e.contains("are not shards of one export: seed is 8 in")
@@ -177,7 +183,7 @@ fn merge_refuses_shards_that_do_not_belong_together() {
     // Shard 3 missing: its layers are named, and which shard holds them.
     let e = merge_fails(&out, &[&s1, &s2, &s4]);
     assert!(
-        e.contains("layers 10..=14 missing (shard 3/4: not given, or not finished)"),
+        e.contains("layers 10..=14 are missing (shard 3/4: not given, or not finished)"),
         "{e}"
     );
     // Shard 2 twice: the overlap is named with both folders.
@@ -187,10 +193,10 @@ fn merge_refuses_shards_that_do_not_belong_together() {
         .output()
         .unwrap());
     let e = merge_fails(&out, &[&s1, &s2, &copy, &s3, &s4]);
-    assert!(e.contains("layers 5..=9 in both"), "{e}");
+    assert!(e.contains("layers 5..=9 are in both"), "{e}");
     assert!(e.contains("s2copy"), "{e}");
     // Another design parameter: another design hash.
-    let d2 = shard(2, &["--param", "length=16"]);
+    let d2 = shard(2, OPTS, &["--param", "length=16"]);
     let e = merge_fails(&out, &[&s1, &d2, &s3, &s4]);
     assert!(e.contains("design hash"), "{e}");
     // A listed file gone from a shard.

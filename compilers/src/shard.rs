@@ -201,12 +201,12 @@ struct ShardParams {
     count: usize,
 }
 
-/// `layer 5` or `layers 5..=9`, as `--layers` spells ranges.
-fn span(r: &Range<usize>) -> String {
+/// `layer 5 is` or `layers 5..=9 are`, as `--layers` spells ranges.
+fn span_is(r: &Range<usize>) -> String {
     if r.len() == 1 {
-        format!("layer {}", r.start)
+        format!("layer {} is", r.start)
     } else {
-        format!("layers {}..={}", r.start, r.end - 1)
+        format!("layers {}..={} are", r.start, r.end - 1)
     }
 }
 
@@ -359,7 +359,7 @@ fn check_tiling(parts: &[Part]) -> Result<(), ExportError> {
         } else {
             format!(" ({}: not given, or not finished)", which.join(", "))
         };
-        problems.push(format!("{} missing{hint}", span(&gap)));
+        problems.push(format!("{} missing{hint}", span_is(&gap)));
     };
     let mut end = 0;
     let mut owner: Option<&Part> = None;
@@ -371,7 +371,7 @@ fn check_tiling(parts: &[Part]) -> Result<(), ExportError> {
         {
             problems.push(format!(
                 "{} in both {} and {}",
-                span(&(p.layers.start..end.min(p.layers.end))),
+                span_is(&(p.layers.start..end.min(p.layers.end))),
                 o.dir.display(),
                 p.dir.display()
             ));
@@ -481,8 +481,16 @@ fn merged_summary(parts: &[Part]) -> Result<Summary, ExportError> {
             t.1 = t.1.saturating_add(*c);
         }
     }
-    let mut parameters = serde_json::Value::Object(shared_params(first));
-    parameters["layers"] = json!([0, nz]);
+    // Rebuilt key by key, so the order is the shard's whatever map serde_json uses.
+    let mut parameters = serde_json::Map::new();
+    for (k, v) in first.summary.parameters.as_object().into_iter().flatten() {
+        let v = match k.as_str() {
+            "shard" => continue,
+            "layers" => json!([0, nz]),
+            _ => v.clone(),
+        };
+        parameters.insert(k.clone(), v);
+    }
     let kind = kind_of(&first.summary.kind).map(|k| k.notes);
     let notes = kind.and_then(|f| f(first, &(0..nz), &counts)).ok_or_else(|| {
         ExportError::Other(format!(
@@ -497,7 +505,7 @@ fn merged_summary(parts: &[Part]) -> Result<Summary, ExportError> {
         counts,
         units: parts.iter().map(|p| p.summary.units).sum(),
         unit: first.summary.unit.clone(),
-        parameters,
+        parameters: serde_json::Value::Object(parameters),
         notes,
         seconds: 0.0,
     })
