@@ -79,7 +79,11 @@ fn assert_same_tree(merged: &Path, single: &Path) {
     for (name, bytes) in &s {
         assert!(m[name] == *bytes, "{name} differs from the single export");
     }
-    assert_eq!(s.len(), 20 * 3 + 1, "20 layers × (RGBA + 2 bitmaps) + manifest");
+    assert_eq!(
+        s.len(),
+        20 * 3 + 1,
+        "20 layers × (RGBA + 2 bitmaps) + manifest"
+    );
 }
 
 fn run_script(cmd: &mut Command) -> String {
@@ -171,13 +175,15 @@ fn merge_refuses_shards_that_do_not_belong_together() {
     let [s1, s2, s3, s4] = [1, 2, 3, 4].map(|k| shard(k, OPTS, &[]));
     let out = d.join("out");
     // Another seed for shard 2 (7 is OPTS' seed).
-    let seed_8: Vec<&str> = OPTS.iter().map(|a| if *a == "7" { "8" } else { a }).collect();
+    let seed_8: Vec<&str> = OPTS
+        .iter()
+        .map(|a| if *a == "7" { "8" } else { a })
+        .collect();
     let s2_seed = d.join("s2seed");
     ok(&export_with(&s2_seed, &seed_8, &["--shard", "2/4"]));
     let e = merge_fails(&out, &[&s1, &s2_seed, &s3, &s4]);
     assert!(
-        e.contains("are not shards of one export: seed is 8 in")
-            && e.contains("but 7 in"),
+        e.contains("are not shards of one export: seed is 8 in") && e.contains("but 7 in"),
         "{e}"
     );
     // Shard 3 missing: its layers are named, and which shard holds them.
@@ -236,7 +242,15 @@ fn bad_shard_options_are_refused_before_any_work() {
     assert!(e.contains("give one of them"), "{e}");
     let d = design();
     let e = fails(&volcad(&[
-        "export", "mesh", &d, "--voxel", "1", "--out", s(&out), "--shard", "1/2",
+        "export",
+        "mesh",
+        &d,
+        "--voxel",
+        "1",
+        "--out",
+        s(&out),
+        "--shard",
+        "1/2",
     ]));
     assert!(
         e.contains("--shard does not apply to `volcad export mesh`"),
@@ -246,7 +260,15 @@ fn bad_shard_options_are_refused_before_any_work() {
     // A folder that is not a layer stack is not merged.
     let mesh = dir.path().join("mesh");
     ok(&volcad(&[
-        "export", "mesh", &d, "--voxel", "1", "--formats", "stl", "--out", s(&mesh),
+        "export",
+        "mesh",
+        &d,
+        "--voxel",
+        "1",
+        "--formats",
+        "stl",
+        "--out",
+        s(&mesh),
     ]));
     let e = merge_fails(&out, &[&mesh]);
     assert!(e.contains("a mesh export; only layer stacks (png)"), "{e}");

@@ -567,7 +567,8 @@ fn summary(
         .zip(counts)
         .map(|(id, c)| (table.name(*id).to_owned(), c))
         .collect();
-    let design_notes = crate::thin::thin_feature_notes(model, est.grid.voxel.max_element(), "--voxel");
+    let design_notes =
+        crate::thin::thin_feature_notes(model, est.grid.voxel.max_element(), "--voxel");
     let g = est.grid;
     let notes = stack_notes(g.dims, g.voxel, &est.layers, &counts, design_notes);
     let o = est.grid.origin;

@@ -138,12 +138,14 @@ pub fn not_shardable(kind: &str) -> String {
     }
 }
 
-/// A layer-stack kind that merges: its manifest `kind`, and how its notes
-/// are rebuilt for a range and counts from one shard's (`None` when the
-/// shard's notes are not the ones this version writes).
+/// Rebuilds a stack's notes for a range and counts from one shard's
+/// (`None` when the shard's notes are not the ones this version writes).
+type MergedNotes = fn(&Part, &Range<usize>, &[(String, u64)]) -> Option<Vec<String>>;
+
+/// A layer-stack kind that merges: its manifest `kind` and its notes.
 struct StackKind {
     kind: &'static str,
-    notes: fn(&Part, &Range<usize>, &[(String, u64)]) -> Option<Vec<String>>,
+    notes: MergedNotes,
 }
 
 const KINDS: &[StackKind] = &[StackKind {
@@ -229,8 +231,9 @@ fn read_part(dir: &Path) -> Result<Part, ExportError> {
              that failed or was interrupted leaves no folder: run that shard again)"
         ))
     })?;
-    let m: ManifestIn = serde_json::from_str(&text)
-        .map_err(|e| ExportError::Other(format!("{}: not a volcad manifest: {e}", path.display())))?;
+    let m: ManifestIn = serde_json::from_str(&text).map_err(|e| {
+        ExportError::Other(format!("{}: not a volcad manifest: {e}", path.display()))
+    })?;
     if m.tool != "volcad" {
         return Err(ExportError::Other(format!(
             "{}: written by {:?}, not volcad",
@@ -259,7 +262,7 @@ fn read_part(dir: &Path) -> Result<Part, ExportError> {
         count: s.count,
     });
     let shard_ok = shard.is_none_or(|s| s.layers(nz).ok() == Some(a..b));
-    if !(a < b && b <= nz) || !shard_ok {
+    if !(a < b && b <= nz && shard_ok) {
         return Err(ExportError::Other(format!(
             "{}: layers {a}..{b} are not a range of the grid's {nz} layers{}",
             path.display(),
@@ -280,7 +283,12 @@ fn read_part(dir: &Path) -> Result<Part, ExportError> {
 
 /// The parameters without what differs between the shards of one export.
 fn shared_params(p: &Part) -> serde_json::Map<String, serde_json::Value> {
-    let mut m = p.summary.parameters.as_object().cloned().unwrap_or_default();
+    let mut m = p
+        .summary
+        .parameters
+        .as_object()
+        .cloned()
+        .unwrap_or_default();
     m.remove("layers");
     m.remove("shard");
     m
@@ -297,10 +305,16 @@ fn check_same_export(a: &Part, b: &Part) -> Result<(), ExportError> {
         )))
     };
     if a.version != b.version {
-        return differ(format!("volcad {} wrote {db}, {} wrote {da}", b.version, a.version));
+        return differ(format!(
+            "volcad {} wrote {db}, {} wrote {da}",
+            b.version, a.version
+        ));
     }
     if a.summary.kind != b.summary.kind {
-        return differ(format!("{db} is a {} export, {da} a {}", b.summary.kind, a.summary.kind));
+        return differ(format!(
+            "{db} is a {} export, {da} a {}",
+            b.summary.kind, a.summary.kind
+        ));
     }
     if a.design_hash != b.design_hash {
         return differ(format!(
@@ -316,10 +330,15 @@ fn check_same_export(a: &Part, b: &Part) -> Result<(), ExportError> {
         let (va, vb) = (pa.get(k), pb.get(k));
         if va != vb {
             let show = |v: Option<&serde_json::Value>| v.map_or("absent".into(), |v| v.to_string());
-            return differ(format!("{k} is {} in {db} but {} in {da}", show(vb), show(va)));
+            return differ(format!(
+                "{k} is {} in {db} but {} in {da}",
+                show(vb),
+                show(va)
+            ));
         }
     }
-    let names = |p: &Part| -> Vec<String> { p.summary.counts.iter().map(|c| c.0.clone()).collect() };
+    let names =
+        |p: &Part| -> Vec<String> { p.summary.counts.iter().map(|c| c.0.clone()).collect() };
     if names(a) != names(b) || a.summary.unit != b.summary.unit {
         return differ(format!(
             "their materials differ ({} against {})",
@@ -349,7 +368,10 @@ fn check_tiling(parts: &[Part]) -> Result<(), ExportError> {
             .map(|n| {
                 (1..=n)
                     .map(|index| Shard { index, count: n })
-                    .filter(|s| s.layers(nz).is_ok_and(|r| r.start < gap.end && gap.start < r.end))
+                    .filter(|s| {
+                        s.layers(nz)
+                            .is_ok_and(|r| r.start < gap.end && gap.start < r.end)
+                    })
                     .map(|s| format!("shard {s}"))
                     .collect()
             })
@@ -423,7 +445,10 @@ pub fn plan_merge(dirs: &[PathBuf]) -> Result<MergePlan, ExportError> {
     if dirs.is_empty() {
         return Err(ExportError::Other("give at least one shard folder".into()));
     }
-    let mut parts = dirs.iter().map(|d| read_part(d)).collect::<Result<Vec<_>, _>>()?;
+    let mut parts = dirs
+        .iter()
+        .map(|d| read_part(d))
+        .collect::<Result<Vec<_>, _>>()?;
     let this = env!("CARGO_PKG_VERSION");
     if parts[0].version != this {
         return Err(ExportError::Other(format!(
@@ -501,7 +526,10 @@ fn merged_summary(parts: &[Part]) -> Result<Summary, ExportError> {
     })?;
     Ok(Summary {
         kind: first.summary.kind.clone(),
-        files: parts.iter().flat_map(|p| p.summary.files.iter().cloned()).collect(),
+        files: parts
+            .iter()
+            .flat_map(|p| p.summary.files.iter().cloned())
+            .collect(),
         counts,
         units: parts.iter().map(|p| p.summary.units).sum(),
         unit: first.summary.unit.clone(),
@@ -604,13 +632,19 @@ mod tests {
                 assert_eq!(next, nz);
             }
         }
-        let e = Shard { index: 1, count: 8 }.layers(5).unwrap_err().to_string();
+        let e = Shard { index: 1, count: 8 }
+            .layers(5)
+            .unwrap_err()
+            .to_string();
         assert_eq!(
             e,
             "--shard: 1/8: the grid has 5 layer(s), fewer than 8 shards; use at most 5 shards"
         );
         for (s, msg) in [
-            ("0/3", "K counts from 1 to N: the first shard is 1/3, the last 3/3"),
+            (
+                "0/3",
+                "K counts from 1 to N: the first shard is 1/3, the last 3/3",
+            ),
             ("4/3", "K counts from 1 to N"),
             ("3", "expected K/N"),
             ("1/x", "N \"x\" is not a whole number"),
@@ -626,7 +660,10 @@ mod tests {
     #[test]
     fn only_plain_relative_names_are_copied() {
         let d = Path::new("/x");
-        assert_eq!(inside(d, "a/slice_0.png"), Some(PathBuf::from("/x/a/slice_0.png")));
+        assert_eq!(
+            inside(d, "a/slice_0.png"),
+            Some(PathBuf::from("/x/a/slice_0.png"))
+        );
         assert_eq!(inside(d, "../y"), None);
         assert_eq!(inside(d, "/etc/passwd"), None);
         assert_eq!(inside(d, "a/./b"), Some(PathBuf::from("/x/a/b")));

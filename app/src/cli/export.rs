@@ -285,7 +285,9 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
         );
     }
     if a.shard.is_some() && a.kind != Kind::Png {
-        bail!(shard::not_shardable(&format!("{:?}", a.kind).to_lowercase()));
+        bail!(shard::not_shardable(
+            &format!("{:?}", a.kind).to_lowercase()
+        ));
     }
     if a.kind == Kind::Fea {
         refuse_tet_options(a, parse_element(a.element.as_deref())?)?;

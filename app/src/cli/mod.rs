@@ -110,8 +110,9 @@ pub enum Command {
     },
     /// Render a view to a PNG (offscreen GPU, lavapipe where there is no GPU).
     Render(render::RenderArgs),
-    /// Export for printers, slicers and solvers.
-    Export(export::ExportArgs),
+    /// Export for printers, slicers and solvers (boxed: its options
+    /// outweigh every other command's).
+    Export(Box<export::ExportArgs>),
     /// Join the folders of `volcad export png --shard K/N` into the single export.
     Merge(merge::MergeArgs),
     /// Convert a CalculiX .frd result to CSV (`node_id,x,y,z,dx,dy,dz`).
