@@ -38,8 +38,8 @@ impl ANode {
     }
 
     /// First child containing `q` that defines `idx`, or all of them folded
-    /// by the node's resolver; where none contains it (a point on a seam
-    /// within rounding), the nearest.
+    /// by the node's resolver; where `q` is outside this node (in a smooth
+    /// parent's fillet, or on a seam within rounding), the nearest child.
     fn pick_children(
         &self,
         children: &[std::sync::Arc<ANode>],
@@ -66,8 +66,9 @@ impl ANode {
                 r.fold(out, tmp);
             }
         }
-        if found {
-            return Ok(true);
+        // Inside this node, a child without the attribute holds the point.
+        if found || self.dist.contains(q) {
+            return Ok(found);
         }
         let nearest = children
             .iter()
@@ -110,8 +111,13 @@ impl ANode {
                 return Err(AttributeError {
                     node: self.describe.clone(),
                     message: format!(
-                        "{} (\"{}\") gives {v} at ({}, {}, {}), outside {lo}..{hi} {unit}; keep the value in that range (clamp(...) in a math string)",
-                        own.call, own.name, pw.x, pw.y, pw.z
+                        "{} (\"{}\") gives {v} at ({}, {}, {}); it must be {}: keep the value in that range (clamp(...) in a math string)",
+                        own.call,
+                        own.name,
+                        pw.x,
+                        pw.y,
+                        pw.z,
+                        super::range_text(lo, hi, unit)
                     ),
                 });
             }

@@ -22,7 +22,7 @@ mod resolve;
 
 use std::sync::Arc;
 
-pub use names::{COMMON, Common, check_kind, range};
+pub use names::{COMMON, Common, check_kind, range, range_text};
 pub use prepared::Evaluator;
 pub use resolve::Resolver;
 
