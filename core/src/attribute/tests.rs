@@ -316,3 +316,58 @@ fn data_from_a_simulation_field_column() {
     let e = model_of(&src.replace("\"e\"", "\"E2\""), "t.rhai", &opts).unwrap_err();
     assert!(e.contains("no column \"E2\""), "{e}");
 }
+
+#[test]
+fn convert_by_table_and_by_math_string() {
+    let part = "let s = RectPrism(Vec3(0, 0, 0), Vec3(40, 4, 4), m.id(\"red\"));
+                s.set_attribute(\"shore_hardness\", \"60 + x\");";
+    let m = model(&format!(
+        "{part} Convert(s, \"shore_hardness\", \"modulus\", [[30, 1.0], [50, 3.0], [70, 13.0]])"
+    ));
+    // x = −5: hardness 55, halfway from 50 to 70 is a quarter: 3 + 10/4.
+    assert!((at(&m, "modulus", [-5.0, 0.0, 0.0]) - 5.5).abs() < 1e-12);
+    assert!(m.attribute_warnings().is_empty());
+    // x = 15: hardness 75, past the table's end: clamped, counted.
+    assert_eq!(at(&m, "modulus", [15.0, 0.0, 0.0]), 13.0);
+    assert_eq!(at(&m, "shore_hardness", [15.0, 0.0, 0.0]), 75.0);
+    let w = m.attribute_warnings();
+    assert!(
+        w.len() == 1 && w[0].contains("1 samples") && w[0].contains("30..70"),
+        "{w:?}"
+    );
+    let m = model(&format!(
+        "{part} Convert(s, \"shore_hardness\", \"modulus\", \"exp(0.0235*shore_hardness - 0.6403)\")"
+    ));
+    let want = (0.0235f64 * 62.0 - 0.6403).exp();
+    assert!((at(&m, "modulus", [2.0, 0.0, 0.0]) - want).abs() < 1e-12);
+    // Its interval holds every sample.
+    let i = m.attribute_index("modulus").unwrap();
+    let iv = m
+        .attribute_interval(i, &Aabb::new(DVec3::splat(-3.0), DVec3::splat(3.0)))
+        .unwrap();
+    assert!(iv.contains(at(&m, "modulus", [2.0, 0.0, 0.0])));
+}
+
+#[test]
+fn convert_refusals() {
+    let part = "let s = Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\")); s.set_attribute(\"shore_hardness\", 60);";
+    let e = try_model(&format!(
+        "{part} Convert(s, \"shore_hardness\", \"modulus\", [[30, 1.0], [20, 3.0]])"
+    ))
+    .unwrap_err();
+    assert!(e.contains("must rise") && e.contains("t.rhai:2:"), "{e}");
+    let e = try_model(&format!(
+        "{part} Convert(s, \"hardness\", \"modulus\", [[30, 1.0], [50, 3.0]])"
+    ))
+    .unwrap_err();
+    assert!(
+        e.contains("no node sets") && e.contains("shore_hardness"),
+        "{e}"
+    );
+    // A conversion reading an attribute its own node computes from it.
+    let e = try_model(&format!(
+        "{part} let c = Convert(s, \"shore_hardness\", \"k\", \"shore_hardness*2\"); c.set_attribute(\"shore_hardness\", \"k/2\"); c"
+    ))
+    .unwrap_err();
+    assert!(e.contains("cycle"), "{e}");
+}
