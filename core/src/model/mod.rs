@@ -106,6 +106,12 @@ impl SubDistance {
     pub(crate) fn interval(&self, b: &Aabb) -> Interval {
         self.node.interval(b)
     }
+
+    /// Fractions at `p` into `out` (the design's materials, dense).
+    pub(crate) fn fractions(&self, p: DVec3, out: &mut [f64]) {
+        out.fill(0.0);
+        self.node.eval(p, out);
+    }
 }
 
 /// Prepares the distances of script subtrees, sharing one cache.
