@@ -23,6 +23,7 @@ pub mod frd;
 pub mod inp_writer;
 pub mod lattice;
 pub mod materials;
+pub mod property_bins;
 pub mod quality;
 pub mod refine;
 pub mod sizing;
