@@ -24,6 +24,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod attribute;
 pub mod bench;
 pub mod bounds;
 pub mod cells;

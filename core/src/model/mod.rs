@@ -74,6 +74,54 @@ pub struct Model {
     prepare_time: Duration,
     varying: bool,
     averaging: bool,
+    /// The attribute evaluator, only when some node carries an attribute
+    /// (kept apart from `root` so distances and fractions never look at it).
+    pub(crate) attrs: Option<Arc<crate::attribute::Evaluator>>,
+}
+
+/// The distance of one script subtree in its own frame (the attribute
+/// evaluator asks which children contain a point, and its math strings'
+/// `d`).
+#[derive(Debug, Clone)]
+pub(crate) struct SubDistance {
+    node: Arc<PNode>,
+    /// The subtree's box.
+    pub(crate) bbox: Aabb,
+}
+
+impl SubDistance {
+    /// Signed distance at `p`.
+    #[inline]
+    pub(crate) fn dist(&self, p: DVec3) -> f64 {
+        self.node.dist(p)
+    }
+
+    /// True when `p` is inside.
+    #[inline]
+    pub(crate) fn contains(&self, p: DVec3) -> bool {
+        self.node.contains(p)
+    }
+
+    /// Bounds of the distance over `b`.
+    pub(crate) fn interval(&self, b: &Aabb) -> Interval {
+        self.node.interval(b)
+    }
+}
+
+/// Prepares the distances of script subtrees, sharing one cache.
+pub(crate) struct SubPreparer(prepare::Preparer);
+
+impl SubPreparer {
+    /// A preparer for a design using `materials`.
+    pub(crate) fn new(materials: &[MaterialId]) -> Result<Self, PrepareError> {
+        Ok(Self(prepare::Preparer::new(materials)?))
+    }
+
+    /// The distance of the subtree `n`.
+    pub(crate) fn distance(&mut self, n: &Node) -> Result<SubDistance, PrepareError> {
+        let (node, bbox) = self.0.prepare(n)?;
+        Ok(SubDistance { node, bbox })
+    }
 }
 
 /// Points as structure of arrays (mm).
@@ -120,7 +168,9 @@ impl Model {
                 message: "the design has no material".into(),
             });
         }
+        let attrs = crate::attribute::Evaluator::build(root, &materials)?.map(Arc::new);
         Ok(Model {
+            attrs,
             varying: root_p.varying_fractions(),
             averaging: root_p.averages_fractions(),
             root: root_p,
