@@ -15,7 +15,13 @@
 
 use std::collections::BTreeMap;
 
+use glam::DVec3;
+use rayon::prelude::*;
+use volcad_core::{Model, Points};
+
+use super::FeaMesh;
 use super::inp_writer::MatOut;
+use crate::job::ExportError;
 
 /// Default number of bins per property (`--property-bins`).
 pub const DEFAULT_BINS: usize = 16;
@@ -106,6 +112,151 @@ pub fn bin_elements(p: &ElementProps, n: usize) -> Sets {
         .collect();
     let set_of = (0..p.modulus.len()).map(|i| index[&key(i)]).collect();
     Sets { set_of, materials }
+}
+
+/// Points per batch of attribute evaluation.
+const CHUNK: usize = 4096;
+
+/// Attribute `index` (a scalar) at every point, in parallel batches; the
+/// first failing batch (lowest index) reports, so the message does not
+/// depend on the thread count.
+fn scalar_at(model: &Model, index: usize, pts: &[DVec3]) -> Result<Vec<f64>, ExportError> {
+    let mut out = vec![f64::NAN; pts.len()];
+    let failed = out
+        .par_chunks_mut(CHUNK)
+        .zip(pts.par_chunks(CHUNK))
+        .enumerate()
+        .filter_map(|(c, (o, p))| {
+            let x: Vec<f64> = p.iter().map(|q| q.x).collect();
+            let y: Vec<f64> = p.iter().map(|q| q.y).collect();
+            let z: Vec<f64> = p.iter().map(|q| q.z).collect();
+            let pts = Points {
+                x: &x,
+                y: &y,
+                z: &z,
+            };
+            model.attribute_batch(index, pts, o).err().map(|e| (c, e))
+        })
+        .min_by_key(|(c, _)| *c);
+    match failed {
+        Some((_, e)) => Err(ExportError::Other(e.to_string())),
+        None => Ok(out),
+    }
+}
+
+/// Attribute `name` at every element: at its centroid, or where the
+/// centroid has no value (a boundary element whose centre lies just
+/// outside), the mean of its corners' values; an element with neither is
+/// an error naming it.
+fn per_element(
+    model: &Model,
+    name: &str,
+    mesh: &FeaMesh,
+    centroids: &[DVec3],
+) -> Result<Vec<f64>, ExportError> {
+    let index = model
+        .require_attribute(name)
+        .map_err(|e| ExportError::Other(e.to_string()))?;
+    let mut v = scalar_at(model, index, centroids)?;
+    for (e, x) in v.iter_mut().enumerate() {
+        if x.is_nan() {
+            let corners: Vec<DVec3> = mesh
+                .element_nodes(e)
+                .iter()
+                .map(|n| mesh.nodes[*n as usize])
+                .collect();
+            let at = scalar_at(model, index, &corners)?;
+            let set: Vec<f64> = at.into_iter().filter(|a| !a.is_nan()).collect();
+            if set.is_empty() {
+                let c = centroids[e];
+                return Err(ExportError::Other(format!(
+                    "element {} at ({:.4}, {:.4}, {:.4}) mm: no node sets \"{name}\" there; set it on every part that has elements (or on the root, which its children inherit)",
+                    e + 1,
+                    c.x,
+                    c.y,
+                    c.z
+                )));
+            }
+            *x = set.iter().sum::<f64>() / set.len() as f64;
+        }
+    }
+    Ok(v)
+}
+
+/// The properties of every element of `mesh` from the design's `modulus`,
+/// `poissons_ratio` and `density`; `None` when the design has no
+/// `modulus`. Without `poissons_ratio` each element takes the Poisson ratio
+/// of its drawn material from the material table.
+pub fn element_props(model: &Model, mesh: &FeaMesh) -> Result<Option<ElementProps>, ExportError> {
+    if model.attribute_index("modulus").is_none() {
+        return Ok(None);
+    }
+    let centroids: Vec<DVec3> = (0..mesh.len())
+        .map(|e| {
+            let n = mesh.element_nodes(e);
+            n.iter().map(|i| mesh.nodes[*i as usize]).sum::<DVec3>() / n.len() as f64
+        })
+        .collect();
+    let modulus = per_element(model, "modulus", mesh, &centroids)?;
+    if let Some((e, m)) = modulus.iter().enumerate().find(|(_, m)| **m <= 0.0) {
+        let c = centroids[e];
+        return Err(ExportError::Other(format!(
+            "element {} at ({:.4}, {:.4}, {:.4}) mm: modulus {m} MPa; the FEA export needs a modulus > 0",
+            e + 1,
+            c.x,
+            c.y,
+            c.z
+        )));
+    }
+    let poisson = if model.attribute_index("poissons_ratio").is_some() {
+        per_element(model, "poissons_ratio", mesh, &centroids)?
+    } else {
+        table_poisson(model, mesh)?
+    };
+    let density = match model.attribute_index("density") {
+        Some(_) => Some(per_element(model, "density", mesh, &centroids)?),
+        None => None,
+    };
+    Ok(Some(ElementProps {
+        modulus,
+        poisson,
+        density,
+    }))
+}
+
+/// The Poisson ratio of each element's drawn material, from the table.
+fn table_poisson(model: &Model, mesh: &FeaMesh) -> Result<Vec<f64>, ExportError> {
+    let table = model.table();
+    let per_slot: Vec<Option<f64>> = model
+        .materials()
+        .iter()
+        .map(|id| table.get(*id).and_then(|m| m.poisson_ratio))
+        .collect();
+    mesh.mat
+        .iter()
+        .map(|s| {
+            per_slot[*s as usize].ok_or_else(|| {
+                let id = model.materials()[*s as usize];
+                ExportError::Other(format!(
+                    "the design sets \"modulus\" but not \"poissons_ratio\", and material \"{}\" (id {id}) in material table {} has no Poisson ratio; set node.set_attribute(\"poissons_ratio\", 0.3) (or the material's value) beside the modulus",
+                    table.name(id),
+                    table.origin()
+                ))
+            })
+        })
+        .collect()
+}
+
+/// Poisson ratios at 0.5 (incompressible) written as 0.49, as for
+/// materials (λ = Eν/((1+ν)(1−2ν)) is infinite at 0.5); the note, if any.
+pub fn cap_poisson(sets: &mut Sets) -> Option<String> {
+    let n = sets
+        .materials
+        .iter_mut()
+        .filter(|m| m.nu >= 0.5 - 1e-9)
+        .map(|m| m.nu = 0.49)
+        .count();
+    (n > 0).then(|| format!("{n} property sets with Poisson ratio 0.5 (incompressible) written as 0.49; linear elements lock near 0.5"))
 }
 
 #[cfg(test)]
