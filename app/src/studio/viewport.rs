@@ -4,7 +4,7 @@
 //! ```text
 //! Arc<Model> ──ProgressiveBaker (thread)──► try_recv each frame ──► Arc<VolumeBake> (generation n)
 //! UploadOnce callback: uploads bake n once (tracks the last uploaded generation), then draws
-//! hover/click ──ProbeWorker (thread, newest request wins)──► ProbeHit ──► read-out
+//! hover/click ──ProbeWorker (thread, newest request wins)──► PickHit ──► read-out
 //! ```
 
 use std::sync::Arc;
@@ -315,6 +315,19 @@ impl Viewport {
                     material_index: 0,
                     level: 0.5,
                 };
+            }
+            if *mode == ViewMode::Volume {
+                ui.add(
+                    egui::Slider::new(
+                        &mut self.settings.volume_density,
+                        volcad_render::MIN_DENSITY..=volcad_render::MAX_DENSITY,
+                    )
+                    .logarithmic(true)
+                    .text("density"),
+                )
+                .on_hover_text(
+                    "How opaque the volume is: more shows the outer layers, less sees deeper",
+                );
             }
             ui.separator();
             if self.shading.picker_ui(ui, self.model.as_deref()) {

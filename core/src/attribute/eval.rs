@@ -5,7 +5,7 @@ use glam::DVec3;
 
 use super::prepared::{ANode, COORD_SLOTS, Op, OwnSrc, PComp};
 use super::{AttributeError, AttributeInfo, AttributeKind};
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 use crate::interval::Interval;
 use crate::model::{Model, Points, sdf};
 

@@ -4,7 +4,7 @@
 
 use glam::{DMat3, DVec3};
 
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 
 /// How a node maps a point of its frame into its child's.
 pub(super) enum Move {

@@ -3,7 +3,7 @@
 use glam::DVec3;
 
 use crate::Model;
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 use crate::model::Points;
 use crate::script::{ScriptOptions, model_of};
 
