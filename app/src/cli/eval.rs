@@ -18,8 +18,22 @@ pub fn eval(args: &DesignArgs, x: f64, y: f64, z: f64) -> anyhow::Result<()> {
     if fracs.is_empty() {
         outln!("outside: no material");
     }
-    for (id, f) in fracs {
-        outln!("{}: {f}", l.model.table().name(id));
+    for (id, f) in &fracs {
+        outln!("{}: {f}", l.model.table().name(*id));
+    }
+    // Attributes have values only inside (NaN, printed "none", outside).
+    if !fracs.is_empty() {
+        let p = DVec3::new(x, y, z);
+        for (i, a) in l.model.attributes().iter().enumerate() {
+            let mut v = [0.0; 4];
+            let v = &mut v[..a.kind.width()];
+            l.model.attribute_at(i, p, v)?;
+            outln!(
+                "attribute {}: {}",
+                a.name,
+                volcad_core::attribute::value_text(v)
+            );
+        }
     }
     Ok(())
 }

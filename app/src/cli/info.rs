@@ -39,6 +39,9 @@ pub fn info(args: &DesignArgs) -> anyhow::Result<()> {
             p.max
         );
     }
+    for line in volcad_core::attribute::describe_tree(&l.design.root) {
+        outln!("attribute:   {line}");
+    }
     outln!("script time: {:.3} s", l.script_time.as_secs_f64());
     outln!("prepare:     {:.3} s", m.prepare_time().as_secs_f64());
     Ok(())

@@ -109,6 +109,10 @@ pub enum Command {
         /// Output CSV (`-` for standard output).
         #[arg(long)]
         out: PathBuf,
+        /// Attribute columns to add, comma-separated (`modulus,color`; a
+        /// Vec3 gives `name.x name.y name.z`, a Vec4 `name.r` .. `name.a`).
+        #[arg(long, value_delimiter = ',')]
+        attributes: Vec<String>,
     },
     /// Render a view to a PNG (offscreen GPU, lavapipe where there is no GPU).
     Render(render::RenderArgs),
@@ -138,7 +142,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
             design,
             points,
             out,
-        } => sample::sample(&design, &points, &out),
+            attributes,
+        } => sample::sample(&design, &points, &out, &attributes),
         Command::Render(a) => render::render(&a),
         Command::Export(a) => export::export(&a),
         Command::FeaResult { frd, inp, out } => fea_result::fea_result(&frd, &inp, &out),

@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 
-use super::prepared::{ANode, COORD_SLOTS, Op, OwnSrc, PComp};
+use super::prepared::{ANode, COORD_SLOTS, Op, OwnSrc, PComp, PConv};
 use super::{AttributeError, AttributeInfo, AttributeKind};
 use crate::aabb::Aabb;
 use crate::interval::Interval;
@@ -27,6 +27,17 @@ impl ANode {
             self.own_value(pos as usize, q, pw, out)?;
             return Ok(true);
         }
+        self.eval_below(idx, q, pw, out)
+    }
+
+    /// Attribute `idx` as the children below this node give it.
+    fn eval_below(
+        &self,
+        idx: usize,
+        q: DVec3,
+        pw: DVec3,
+        out: &mut [f64],
+    ) -> Result<bool, AttributeError> {
         match &self.op {
             Op::Leaf => Ok(false),
             Op::Map(m, c) => c.eval(idx, m.apply(q), pw, out),
@@ -38,8 +49,8 @@ impl ANode {
     }
 
     /// First child containing `q` that defines `idx`, or all of them folded
-    /// by the node's resolver; where none contains it (a point on a seam
-    /// within rounding), the nearest.
+    /// by the node's resolver; where `q` is outside this node (in a smooth
+    /// parent's fillet, or on a seam within rounding), the nearest child.
     fn pick_children(
         &self,
         children: &[std::sync::Arc<ANode>],
@@ -66,8 +77,9 @@ impl ANode {
                 r.fold(out, tmp);
             }
         }
-        if found {
-            return Ok(true);
+        // Inside this node, a child without the attribute holds the point.
+        if found || self.dist.contains(q) {
+            return Ok(found);
         }
         let nearest = children
             .iter()
@@ -100,18 +112,23 @@ impl ANode {
             }
             for &dep in &own.order {
                 let mut v = [0.0];
-                self.source_value(dep, q, &slots, &mut v);
+                self.source_value(dep, q, pw, &slots, &mut v)?;
                 slots[COORD_SLOTS + dep] = v[0];
             }
         }
-        self.source_value(pos, q, &slots, out);
+        self.source_value(pos, q, pw, &slots, out)?;
         if let Some((lo, hi, unit)) = own.range {
             if let Some(v) = out.iter().find(|v| **v < lo || **v > hi) {
                 return Err(AttributeError {
                     node: self.describe.clone(),
                     message: format!(
-                        "{} (\"{}\") gives {v} at ({}, {}, {}), outside {lo}..{hi} {unit}; keep the value in that range (clamp(...) in a math string)",
-                        own.call, own.name, pw.x, pw.y, pw.z
+                        "{} (\"{}\") gives {v} at ({}, {}, {}); it must be {}: keep the value in that range (clamp(...) in a math string)",
+                        own.call,
+                        own.name,
+                        pw.x,
+                        pw.y,
+                        pw.z,
+                        super::range_text(lo, hi, unit)
                     ),
                 });
             }
@@ -121,7 +138,14 @@ impl ANode {
 
     /// The values of own attribute `pos` with the variables in `slots`.
     #[inline]
-    fn source_value(&self, pos: usize, q: DVec3, slots: &[f64], out: &mut [f64]) {
+    fn source_value(
+        &self,
+        pos: usize,
+        q: DVec3,
+        pw: DVec3,
+        slots: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), AttributeError> {
         match &self.own[pos].src {
             OwnSrc::Comps(cs) => {
                 for (o, c) in out.iter_mut().zip(cs) {
@@ -140,15 +164,50 @@ impl ANode {
                     f64::NAN
                 };
             }
+            OwnSrc::Convert {
+                from,
+                from_own,
+                map,
+                clamped,
+            } => {
+                let mut x = [f64::NAN];
+                match from_own {
+                    Some(j) => x[0] = slots[COORD_SLOTS + j],
+                    None => {
+                        self.eval_below(*from, q, pw, &mut x)?;
+                    }
+                }
+                out[0] = match map {
+                    PConv::Table(t) if !x[0].is_nan() => {
+                        let (y, outside) = t.lookup(x[0]);
+                        if outside {
+                            clamped.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        }
+                        y
+                    }
+                    PConv::Table(_) => f64::NAN,
+                    PConv::Expr(e) => {
+                        let mut s = [0.0; COORD_SLOTS + 1];
+                        s[..COORD_SLOTS].copy_from_slice(&slots[..COORD_SLOTS]);
+                        s[COORD_SLOTS] = x[0];
+                        e.eval(&s)
+                    }
+                };
+            }
         }
+        Ok(())
     }
 
     /// Bounds of scalar attribute `idx` over `b` (this node's frame):
     /// `None` when no value can occur there.
     pub(super) fn interval(&self, idx: usize, b: &Aabb) -> Option<Interval> {
         if let Some(pos) = self.own_of[idx] {
-            return Some(self.own_interval(pos as usize, b));
+            return self.own_interval(pos as usize, b);
         }
+        self.interval_below(idx, b)
+    }
+
+    fn interval_below(&self, idx: usize, b: &Aabb) -> Option<Interval> {
         match &self.op {
             Op::Leaf => None,
             Op::Map(m, c) => c.interval(idx, &m.apply_box(b)),
@@ -178,7 +237,7 @@ impl ANode {
         }
     }
 
-    fn own_interval(&self, pos: usize, b: &Aabb) -> Interval {
+    fn own_interval(&self, pos: usize, b: &Aabb) -> Option<Interval> {
         let own = &self.own[pos];
         let mut slots = [Interval::EVERYTHING; 64];
         slots[0] = Interval::new(b.min.x, b.max.x);
@@ -189,13 +248,36 @@ impl ANode {
             slots[8] = self.dist.interval(b);
         }
         for &dep in &own.order {
-            slots[COORD_SLOTS + dep] = self.source_interval(dep, &slots);
+            slots[COORD_SLOTS + dep] = self.source_interval(dep, b, &slots)?;
         }
-        self.source_interval(pos, &slots)
+        self.source_interval(pos, b, &slots)
     }
 
-    fn source_interval(&self, pos: usize, slots: &[Interval]) -> Interval {
-        match &self.own[pos].src {
+    fn source_interval(&self, pos: usize, b: &Aabb, slots: &[Interval]) -> Option<Interval> {
+        Some(match &self.own[pos].src {
+            OwnSrc::Convert {
+                from,
+                from_own,
+                map,
+                ..
+            } => {
+                let x = match from_own {
+                    Some(j) => slots[COORD_SLOTS + j],
+                    None => self.interval_below(*from, b)?,
+                };
+                match map {
+                    PConv::Table(t) => {
+                        let (lo, hi) = t.output_range();
+                        Interval::new(lo, hi)
+                    }
+                    PConv::Expr(e) => {
+                        let mut s = [Interval::EVERYTHING; COORD_SLOTS + 1];
+                        s[..COORD_SLOTS].copy_from_slice(&slots[..COORD_SLOTS]);
+                        s[COORD_SLOTS] = x;
+                        e.eval_interval(&s)
+                    }
+                }
+            }
             OwnSrc::Comps(cs) => match cs.first() {
                 Some(PComp::Const(v)) => Interval::point(*v),
                 Some(PComp::Expr(e)) => e.eval_interval(slots),
@@ -207,7 +289,7 @@ impl ANode {
                 Some((lo, hi)) => Interval::new(lo, hi),
                 None => Interval::EVERYTHING,
             },
-        }
+        })
     }
 }
 
@@ -361,5 +443,49 @@ impl Model {
             return None;
         }
         a.root.interval(index, b)
+    }
+}
+
+impl Model {
+    /// One line per conversion whose table clamped samples so far ("Convert
+    /// to \"modulus\" (set_attribute at line 4:9): 12 samples of ... outside
+    /// the table were clamped to its ends"), for the caller to warn with
+    /// after sampling.
+    pub fn attribute_warnings(&self) -> Vec<String> {
+        let Some(a) = &self.attrs else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        let mut seen = std::collections::HashSet::new();
+        let mut stack = vec![&a.root];
+        while let Some(n) = stack.pop() {
+            if !seen.insert(std::sync::Arc::as_ptr(n)) {
+                continue;
+            }
+            for o in &n.own {
+                if let OwnSrc::Convert {
+                    from,
+                    map: PConv::Table(t),
+                    clamped,
+                    ..
+                } = &o.src
+                {
+                    let k = clamped.load(std::sync::atomic::Ordering::Relaxed);
+                    if k > 0 {
+                        let (lo, hi) = t.input_range();
+                        out.push(format!(
+                            "{}: Convert to \"{}\": {k} samples of \"{}\" outside the table's {lo}..{hi} were clamped to its ends",
+                            n.describe, o.name, a.infos[*from].name
+                        ));
+                    }
+                }
+            }
+            match &n.op {
+                Op::Leaf => {}
+                Op::Map(_, c) => stack.push(c),
+                Op::Pick { children, .. } => stack.extend(children.iter()),
+            }
+        }
+        out
     }
 }

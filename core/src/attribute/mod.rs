@@ -13,6 +13,8 @@
 //! unless the node names a resolver ([`Resolver`]); a smooth union blends by
 //! its distance blend weight.
 
+mod convert;
+mod describe;
 mod eval;
 mod moves;
 mod names;
@@ -22,7 +24,9 @@ mod resolve;
 
 use std::sync::Arc;
 
-pub use names::{COMMON, Common, check_kind, range};
+pub use convert::{ConvMap, Table};
+pub use describe::{column_names, describe_tree, value_text};
+pub use names::{COMMON, Common, check_kind, range, range_text};
 pub use prepared::Evaluator;
 pub use resolve::Resolver;
 
@@ -103,6 +107,14 @@ pub enum AttrSource {
         column: usize,
         /// The column's name, for messages.
         column_name: String,
+    },
+    /// Another scalar attribute mapped by a table or a math string
+    /// (`Convert`): the node's own value of `from`, else the one below it.
+    Convert {
+        /// The input attribute.
+        from: String,
+        /// The mapping.
+        map: ConvMap,
     },
 }
 

@@ -105,3 +105,12 @@ pub fn check_kind(name: &str, kind: AttributeKind, what: &str) -> Result<(), Att
 pub fn range(name: &str) -> Option<(f64, f64, &'static str)> {
     common(name).map(|c| (c.min, c.max, c.unit))
 }
+
+/// "0..100 %" or "at least 0 MPa", for messages.
+pub fn range_text(lo: f64, hi: f64, unit: &str) -> String {
+    if hi.is_infinite() {
+        format!("at least {lo} {unit}")
+    } else {
+        format!("{lo}..{hi} {unit}")
+    }
+}

@@ -1,7 +1,7 @@
 //! The order in which a node's attributes that read each other by name are
 //! evaluated, and the refusal of cycles (`a = "b+1"`, `b = "a*2"`).
 
-use super::prepared::{COORD_SLOTS, Own, OwnSrc, PComp};
+use super::prepared::{COORD_SLOTS, Own, OwnSrc, PComp, PConv};
 use crate::model::PrepareError;
 use crate::node::Node;
 
@@ -13,6 +13,14 @@ fn direct_used(o: &Own) -> u64 {
             PComp::Expr(e) => m | e.used_vars(),
         }),
         OwnSrc::Data { .. } => 0,
+        // The math string's slot 9 is its input, not an own attribute.
+        OwnSrc::Convert { from_own, map, .. } => {
+            let coords = match map {
+                PConv::Table(_) => 0,
+                PConv::Expr(e) => e.used_vars() & ((1 << COORD_SLOTS) - 1),
+            };
+            coords | from_own.map_or(0, |j| 1u64 << (COORD_SLOTS + j))
+        }
     }
 }
 

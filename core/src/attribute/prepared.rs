@@ -49,6 +49,22 @@ pub(super) enum OwnSrc {
         field: Arc<crate::simfield::SimField>,
         column: usize,
     },
+    Convert {
+        /// Design index of the input attribute.
+        from: usize,
+        /// Its position in `ANode::own` when this node sets it.
+        from_own: Option<usize>,
+        map: PConv,
+        /// Samples whose input was outside the table (clamped).
+        clamped: std::sync::atomic::AtomicU64,
+    },
+}
+
+/// A prepared conversion.
+pub(super) enum PConv {
+    Table(Arc<super::Table>),
+    /// Slots: the coordinates, then the input value.
+    Expr(Arc<Expr>),
 }
 
 /// One attribute a node sets.
@@ -420,6 +436,7 @@ impl Builder<'_> {
                     field: field.clone(),
                     column: *column,
                 },
+                AttrSource::Convert { from, map } => self.convert(n, a, d, from, map)?,
             };
             own.push(Own {
                 name: d.name.clone(),
@@ -432,6 +449,61 @@ impl Builder<'_> {
         }
         super::order::order_dependencies(n, &mut own)?;
         Ok((own, own_of))
+    }
+}
+
+impl Builder<'_> {
+    /// A `Convert` of `from`: a scalar of the design.
+    fn convert(
+        &self,
+        n: &Node,
+        a: &super::NodeAttributes,
+        d: &super::AttrDef,
+        from: &str,
+        map: &super::ConvMap,
+    ) -> Result<OwnSrc, PrepareError> {
+        let Some(&idx) = self.index.get(from) else {
+            let have: Vec<&str> = self.infos.iter().map(|i| i.name.as_str()).collect();
+            return Err(err(
+                n,
+                format!(
+                    "converts \"{from}\", which no node sets; the design has: {}",
+                    have.join(", ")
+                ),
+            ));
+        };
+        if self.infos[idx].kind != AttributeKind::Scalar {
+            return Err(err(
+                n,
+                format!(
+                    "converts \"{from}\", a {}; Convert reads a number attribute",
+                    self.infos[idx].kind.name()
+                ),
+            ));
+        }
+        let map = match map {
+            super::ConvMap::Table(t) => PConv::Table(t.clone()),
+            super::ConvMap::Expr(s) => {
+                let mut vars: Vec<&str> = COORD_VARS.to_vec();
+                vars.push(from);
+                let e = Expr::compile(s, &vars).map_err(|e| {
+                    err(
+                        n,
+                        format!(
+                            "Convert to \"{}\": {e}; the math string reads x y z rho phic r theta phis d and \"{from}\"",
+                            d.name
+                        ),
+                    )
+                })?;
+                PConv::Expr(Arc::new(e))
+            }
+        };
+        Ok(OwnSrc::Convert {
+            from: idx,
+            from_own: a.defs.iter().position(|o| o.name == from),
+            map,
+            clamped: Default::default(),
+        })
     }
 }
 

@@ -7,7 +7,9 @@ use glam::DVec4;
 use rhai::{Dynamic, Engine, NativeCallContext as Ctx, Position};
 
 use super::values::*;
-use crate::attribute::{AttrDef, AttrSource, AttributeKind, Component, Resolver, check_kind};
+use crate::attribute::{
+    AttrDef, AttrSource, AttributeKind, Component, ConvMap, Resolver, Table, check_kind,
+};
 use crate::expr::COORD_VARS;
 use crate::node::{Node, NodeKind};
 
@@ -15,7 +17,8 @@ use crate::node::{Node, NodeKind};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Vec4(pub DVec4);
 
-pub(super) fn register(engine: &mut Engine) {
+pub(super) fn register(engine: &mut Engine, ctx: &super::RunContext) {
+    register_convert(engine, ctx);
     engine.register_type_with_name::<Vec4>("Vec4");
     engine.register_fn(
         "Vec4",
@@ -201,4 +204,58 @@ fn data_def(name: &str, field: &Node, column: &str, p: Position) -> RResult<Attr
         },
         origin: origin(p),
     })
+}
+
+/// `Convert(child, from, to, table)`: `to` from `from` through a table
+/// (an array of `[input, output]` pairs or a `.csv` file of two columns)
+/// or a math string of the coordinates and `from`.
+fn register_convert(engine: &mut Engine, ctx: &super::RunContext) {
+    let c = ctx.clone();
+    engine.register_fn(
+        "Convert",
+        move |cc: Ctx, child: Node, from: &str, to: &str, map: Dynamic| -> RResult<Node> {
+            let p = cc.call_position();
+            check_name(from, p)?;
+            check_name(to, p)?;
+            let what = format!("Convert(\"{from}\" -> \"{to}\")");
+            if from == to {
+                return fail(p, format!("{what}: converts an attribute to itself; name another target"));
+            }
+            check_kind(to, AttributeKind::Scalar, &what).or_else(|e| fail(p, e.to_string()))?;
+            let map = if let Some(rows) = map.clone().try_cast::<rhai::Array>() {
+                let pairs = rows
+                    .iter()
+                    .enumerate()
+                    .map(|(i, r)| {
+                        let row = format!("{what}: table row {}", i + 1);
+                        match r.clone().try_cast::<rhai::Array>() {
+                            Some(v) if v.len() == 2 => Ok((finite(&v[0], &row, p)?, finite(&v[1], &row, p)?)),
+                            _ => fail(p, format!("{row} must be a pair [input, output], got {}", described(r))),
+                        }
+                    })
+                    .collect::<RResult<Vec<_>>>()?;
+                ConvMap::Table(std::sync::Arc::new(Table::new(&pairs, &what).or_else(|m| fail(p, m))?))
+            } else if let Ok(s) = map.clone().into_string() {
+                if s.to_ascii_lowercase().ends_with(".csv") {
+                    let full = c.resolve(&s, p)?;
+                    let text = std::fs::read_to_string(&full)
+                        .or_else(|e| fail(p, format!("{what}: {}: {e}", full.display())))?;
+                    let t = Table::parse_csv(&text, &full.display().to_string()).or_else(|m| fail(p, format!("{what}: {m}")))?;
+                    ConvMap::Table(std::sync::Arc::new(t))
+                } else {
+                    ConvMap::Expr(s)
+                }
+            } else {
+                return fail(p, format!("{what}: the conversion is an array of [input, output] pairs, a .csv table or a math string of \"{from}\"; got {}", described(&map)));
+            };
+            let mut n = Node::with_origin(NodeKind::Identity { child: Some(child) }, origin(p));
+            n.attributes_mut().set(AttrDef {
+                name: to.to_owned(),
+                kind: AttributeKind::Scalar,
+                source: AttrSource::Convert { from: from.to_owned(), map },
+                origin: origin(p),
+            });
+            Ok(n)
+        },
+    );
 }

@@ -558,7 +558,7 @@ fn build_engine(ctx: &RunContext, opts: &ScriptOptions) -> Engine {
     nodes_api::register_composites(&mut engine);
     shapes_api::register_shapes(&mut engine);
     nodes_api::register_methods(&mut engine);
-    attribute_api::register(&mut engine);
+    attribute_api::register(&mut engine, ctx);
     files_api::register(&mut engine, ctx);
     query_api::register(&mut engine, ctx);
     text_api::register(&mut engine, ctx);
