@@ -48,7 +48,9 @@
 //! cores; set [`ViewSettings::render_scale`] to 0.5 there (about 4× faster).
 #![warn(missing_docs)]
 
+pub mod attribute_bake;
 mod bake;
+pub mod colormap;
 mod camera;
 mod gpu;
 mod offscreen;
@@ -59,7 +61,9 @@ mod settings;
 mod upscale;
 pub mod viewport;
 
-pub use bake::{BakeError, MAX_CHANNELS, VolumeBake, bake};
+pub use attribute_bake::AttributeShading;
+pub use bake::{BakeError, MAX_CHANNELS, VolumeBake, bake, bake_shaded};
+pub use colormap::ColorMap;
 pub use camera::{Camera, StandardView};
 pub use gpu::{MAX_DENSITY, MIN_DENSITY, RENDER_SHADER, Renderer, THIN_BIAS_VOXELS};
 pub use offscreen::{Offscreen, render_offscreen};
