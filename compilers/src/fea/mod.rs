@@ -197,6 +197,9 @@ pub struct FeaMesh {
     pub quality: Option<QualityReport>,
     /// Free-form figures for the summary.
     pub notes: Vec<String>,
+    /// Boundary faces and pieces, when the mesher found them on the way
+    /// (bricks); otherwise [`topology::topology`] finds them.
+    pub topology: Option<topology::Topology>,
 }
 
 impl FeaMesh {
@@ -208,6 +211,7 @@ impl FeaMesh {
             mat: Vec::new(),
             quality: None,
             notes: Vec::new(),
+            topology: None,
         }
     }
 
@@ -526,7 +530,7 @@ pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summ
     let progress = |stage: &str, done: u64, total: u64, frac: f64| {
         ctx.progress(stage, done, total, "elements", frac * 0.9)
     };
-    let mesh = match p.threads {
+    let mut mesh = match p.threads {
         Some(0) => return Err(ExportError::param("--threads", "must be at least 1")),
         Some(n) => rayon::ThreadPoolBuilder::new()
             .num_threads(n)
@@ -536,6 +540,7 @@ pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summ
         None => build_mesh(model, p, ctx.cancel_flag(), &progress)?,
     };
     ctx.check_cancel()?;
+    let known = mesh.topology.take();
     if mesh.is_empty() {
         return Err(ExportError::Other("the mesh has no elements: the design is empty at this element size (try a smaller --voxel or --max-cell)".into()));
     }
@@ -624,7 +629,7 @@ pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summ
             .map_err(|e| ExportError::io(&path, e))
     };
     let faces = || {
-        let topo = topology::topology(&mesh);
+        let topo = known.unwrap_or_else(|| topology::topology(&mesh));
         let footprint = boundary::footprint(&mesh.nodes, &topo.boundary);
         (topo, footprint)
     };
