@@ -1,7 +1,7 @@
-//! `volcad export png|mesh|fea` and `volcad fea-result`: run an export job
+//! `volcad export png|mesh|fea`: run an export job
 //! with a progress bar; Ctrl-C cancels cleanly (nothing is left behind).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::RecvTimeoutError;
@@ -98,6 +98,9 @@ pub struct ExportArgs {
     /// fea: append a static step: bottom fixed, top displaced by this many mm in z.
     #[arg(long, allow_negative_numbers = true)]
     pub step: Option<f64>,
+    /// fea: with a `modulus` attribute, elastic sets per property (default 16).
+    #[arg(long, allow_negative_numbers = true)]
+    pub property_bins: Option<usize>,
     /// fea: end sets, pieces and solver memory.
     #[command(flatten)]
     pub fea_checks: Box<FeaChecks>,
@@ -222,6 +225,7 @@ fn foreign_options(a: &ExportArgs) -> Vec<&'static str> {
         ("--max-cell", a.max_cell.is_some(), Kind::Fea),
         ("--sizing", a.sizing.is_some(), Kind::Fea),
         ("--step", a.step.is_some(), Kind::Fea),
+        ("--property-bins", a.property_bins.is_some(), Kind::Fea),
         ("--fix-band", a.fea_checks.fix_band.is_some(), Kind::Fea),
         ("--fix", a.fea_checks.fix.is_some(), Kind::Fea),
         ("--load", a.fea_checks.load.is_some(), Kind::Fea),
@@ -451,6 +455,7 @@ fn fea_params(
         max_cell: a.max_cell.unwrap_or(min_cell * 4.0),
         sizing: a.sizing.clone().map_or(Sizing::Heterogeneity, Sizing::Expr),
         seed: a.seed,
+        property_bins: a.property_bins,
         step: a.step.map(|d| StepParams {
             top_displacement: d,
         }),
@@ -566,19 +571,5 @@ pub(super) fn follow(handle: job::JobHandle, interrupted: &AtomicBool) -> anyhow
     for n in &summary.notes {
         outln!("  {n}");
     }
-    Ok(())
-}
-
-/// `volcad fea-result JOB.frd --inp JOB.inp --out result.csv` (`--out -`
-/// for standard output). The CSV is made in memory first: a deck that does
-/// not match the result leaves no file.
-pub fn fea_result(frd: &Path, inp: &Path, out: &Path) -> anyhow::Result<()> {
-    super::output::check_regular(frd, "CalculiX result (.frd)")?;
-    super::output::check_regular(inp, "deck (.inp)")?;
-    super::output::target(out, "--out")?;
-    let r = volcad_compilers::fea::read_frd(frd)?;
-    let (text, _) = volcad_compilers::fea::result_csv(&r, Some(inp))?;
-    super::output::write_output(out, "--out", |w| w.write_all(text.as_bytes()))?;
-    note!("{} nodes -> {}", r.displacements.len(), out.display());
     Ok(())
 }

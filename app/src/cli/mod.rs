@@ -20,8 +20,11 @@ macro_rules! note {
     }};
 }
 
+mod bench;
 mod design;
+mod eval;
 mod export;
+mod fea_result;
 mod info;
 mod merge;
 mod output;
@@ -107,6 +110,10 @@ pub enum Command {
         /// Output CSV (`-` for standard output).
         #[arg(long)]
         out: PathBuf,
+        /// Attribute columns to add, comma-separated (`modulus,color`; a
+        /// Vec3 gives `name.x name.y name.z`, a Vec4 `name.r` .. `name.a`).
+        #[arg(long, value_delimiter = ',')]
+        attributes: Vec<String>,
     },
     /// Render a view to a PNG (offscreen GPU, lavapipe where there is no GPU).
     Render(render::RenderArgs),
@@ -127,24 +134,25 @@ pub enum Command {
         out: PathBuf,
     },
     /// Measure evaluation and export throughput on designs (points/s, voxels/s).
-    Bench(info::BenchArgs),
+    Bench(bench::BenchArgs),
 }
 
 /// Run a parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Info(d) => info::info(&d),
-        Command::Eval { design, x, y, z } => info::eval(&design, x, y, z),
+        Command::Eval { design, x, y, z } => eval::eval(&design, x, y, z),
         Command::Sample {
             design,
             points,
             out,
-        } => sample::sample(&design, &points, &out),
+            attributes,
+        } => sample::sample(&design, &points, &out, &attributes),
         Command::Render(a) => render::render(&a),
         Command::Export(a) => export::export(&a),
         Command::Merge(a) => merge::merge(&a),
-        Command::FeaResult { frd, inp, out } => export::fea_result(&frd, &inp, &out),
-        Command::Bench(a) => info::bench(&a),
+        Command::FeaResult { frd, inp, out } => fea_result::fea_result(&frd, &inp, &out),
+        Command::Bench(a) => bench::bench(&a),
     }
 }
 
