@@ -563,6 +563,7 @@ fn summary(
             est.layers.end
         ),
         "orientation: column 0 = min X, row 0 = max Y (top view), layer 0 = lowest Z".to_owned(),
+        grid_span_note(&est.grid, &model.bbox()),
         // No working-memory figure: it grows with the thread count, and
         // the notes go into the manifest, which must not (the command line
         // prints the estimate before it starts).
@@ -603,4 +604,21 @@ fn summary(
         notes,
         seconds: 0.0,
     }
+}
+
+/// How the slices' extent relates to the part's: each count is
+/// `ceil(extent / voxel)`, as pyvcad 2.3.4's (its J750 stack of a
+/// 15 × 10 × 5 mm bar is 355 × 119 px and 186 layers), centred on the
+/// part, so the stack is up to one voxel larger than the part per axis.
+pub fn grid_span_note(grid: &Grid, part: &volcad_core::Aabb) -> String {
+    let span = DVec3::new(
+        grid.dims[0] as f64,
+        grid.dims[1] as f64,
+        grid.dims[2] as f64,
+    ) * grid.voxel;
+    let size = part.size();
+    format!(
+        "slices span {:.4} × {:.4} × {:.4} mm for a part of {:.4} × {:.4} × {:.4} mm: each count is ceil(extent / voxel), as in pyvcad, centred on the part (up to one voxel more per axis)",
+        span.x, span.y, span.z, size.x, size.y, size.z
+    )
 }
