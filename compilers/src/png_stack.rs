@@ -567,8 +567,14 @@ fn summary(
         .zip(counts)
         .map(|(id, c)| (table.name(*id).to_owned(), c))
         .collect();
-    let design_notes =
-        crate::thin::thin_feature_notes(model, est.grid.voxel.max_element(), "--voxel");
+    // What the design and grid alone decide (the same in every shard):
+    // the slices' span against the part's, then thin features.
+    let mut design_notes = vec![grid_span_note(&est.grid, &model.bbox())];
+    design_notes.extend(crate::thin::thin_feature_notes(
+        model,
+        est.grid.voxel.max_element(),
+        "--voxel",
+    ));
     let g = est.grid;
     let notes = stack_notes(g.dims, g.voxel, &est.layers, &counts, design_notes);
     let o = est.grid.origin;
@@ -661,4 +667,21 @@ pub(crate) fn merged_notes(
     }
     let design = notes[head..design_end].to_vec();
     Some(stack_notes(part.dims, part.voxel, layers, counts, design))
+}
+
+/// How the slices' extent relates to the part's: each count is
+/// `ceil(extent / voxel)`, as pyvcad 2.3.4's (its J750 stack of a
+/// 15 × 10 × 5 mm bar is 355 × 119 px and 186 layers), centred on the
+/// part, so the stack is up to one voxel larger than the part per axis.
+pub fn grid_span_note(grid: &Grid, part: &volcad_core::Aabb) -> String {
+    let span = DVec3::new(
+        grid.dims[0] as f64,
+        grid.dims[1] as f64,
+        grid.dims[2] as f64,
+    ) * grid.voxel;
+    let size = part.size();
+    format!(
+        "slices span {:.4} × {:.4} × {:.4} mm for a part of {:.4} × {:.4} × {:.4} mm: each count is ceil(extent / voxel), as in pyvcad, centred on the part (up to one voxel more per axis)",
+        span.x, span.y, span.z, size.x, size.y, size.z
+    )
 }

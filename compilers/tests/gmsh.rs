@@ -171,7 +171,7 @@ fn gmsh_meshes_every_graded_bar_segment() {
 #[test]
 fn gmsh_meshes_every_seat_segment() {
     let m = example("bicycle_seat.rhai");
-    let segs = meshes(&m, 1.0, SegmentBy::Dominant, 4);
+    let segs = meshes(&m, 2.0, SegmentBy::Dominant, 4);
     assert!(segs.iter().filter(|s| !s.mesh.is_empty()).count() >= 2);
     assert!(check_shared(&segs) > 0, "segments share no interface");
     check("seat", &segs);

@@ -9,7 +9,9 @@ use std::sync::Arc;
 use common::{colour_counts, decode, manifest, model, read_tree, run, tmp};
 use glam::DVec3;
 use volcad_compilers::ExportError;
-use volcad_compilers::png_stack::{Dither, PngParams, estimate, export_png_stack, preset};
+use volcad_compilers::png_stack::{
+    Dither, PngParams, estimate, export_png_stack, grid_span_note, preset,
+};
 use volcad_core::Model;
 
 const RED: [u8; 4] = [255, 0, 0, 255];
@@ -369,6 +371,27 @@ fn j750_preset_estimate() {
     assert_eq!(e.layers, 0..186);
     assert_eq!(e.files, 186);
     assert!(e.memory_bytes > 0 && e.disk_bytes > 0);
+}
+
+/// Counts are `ceil(extent / voxel)` as in pyvcad, and the summary (and so
+/// the manifest) says how far the stack reaches past the part.
+#[test]
+fn slice_counts_match_pyvcad_and_the_summary_gives_the_span() {
+    // pyvcad 2.3.4's DirectMaterialCompiler, this bar at the J750 voxel:
+    // 186 PNGs of 355 × 119 px.
+    let m = model(r#"RectPrism(Vec3(0,0,0), Vec3(15,10,5), default_materials().id("gray"))"#);
+    let p = PngParams {
+        voxel: preset("j750").unwrap().voxel,
+        ..PngParams::default()
+    };
+    let e = estimate(&m, &p).unwrap();
+    assert_eq!(e.grid.dims, [355, 119, 186]);
+    let note = grid_span_note(&e.grid, &m.bbox());
+    // 119 × 25.4/300 = 10.0753 mm in Y for the 10 mm part.
+    assert!(
+        note.contains("× 10.0753 ×") && note.contains("15.0000 × 10.0000 × 5.0000 mm"),
+        "{note}"
+    );
 }
 
 /// The disk estimate codes and encodes a few layers as the export does:

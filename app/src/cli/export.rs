@@ -45,6 +45,10 @@ pub struct ExportArgs {
     #[arg(long)]
     pub out: PathBuf,
     /// Voxel size in mm (each within 1e-6..=1e6): one value, or X,Y,Z.
+    ///
+    /// The grid has ceil(extent / voxel) voxels per axis, as pyvcad's,
+    /// centred on the part: a slice stack reaches up to one voxel past the
+    /// part per axis (its summary and manifest give both sizes).
     #[arg(long, allow_hyphen_values = true)]
     pub voxel: Option<String>,
     /// Printer preset for the voxel size (png): j750.

@@ -1,10 +1,11 @@
 //! Triangulation of a flat region's outline (see [`super::flat`]).
 //!
-//! The outline is projected along the normal's largest axis. An outline
-//! that is one convex loop (a box's face, a slab's interface) with evenly
-//! spaced points is cut into a strip of triangles with exact orientation
-//! tests alone ([`convex_strip`]); any other is triangulated by a
-//! constrained Delaunay triangulation (spade, exact predicates). Both keep every outline point
+//! The outline is projected along the normal's largest axis. A small
+//! outline that is one convex loop (a flat cube's cut) is cut into a strip
+//! of triangles with exact orientation tests alone ([`convex_strip`]); any
+//! other is triangulated by a constrained Delaunay triangulation (spade,
+//! exact predicates), with a point added inside beside each clustered pair
+//! of outline points. Both keep every outline point
 //! (collinear ones included; dropping one would leave a T-junction). In
 //! the Delaunay path faces inside the outline are found by flood fill from
 //! the hull, flipping at each outline edge. Triangles are oriented like
@@ -30,7 +31,7 @@ pub(super) fn triangulate(
     normal: [i32; 3],
     outline: impl ExactSizeIterator<Item = [u32; 2]>,
     verts: &[[f32; 3]],
-) -> Option<Vec<[u32; 3]>> {
+) -> Option<Triangulated> {
     // Project along the normal's largest component (quantised is enough).
     let n = normal.map(i32::abs);
     let drop = if n[0] >= n[1] && n[0] >= n[2] {
@@ -68,10 +69,26 @@ pub(super) fn triangulate(
         .iter()
         .map(|[a, b]| pts[*a].x * pts[*b].y - pts[*b].x * pts[*a].y)
         .sum();
-    if evenly_spaced(&pts, &edges)
-        && let Some(strip) = convex_strip(&pts, &edges, area2)
-    {
-        return oriented(strip, &pts, &global, area2);
+    // A small outline's triangles stay within a few voxels whatever its
+    // spacing (single flat cubes of curved surfaces are most regions). A
+    // larger one takes the Delaunay path: a strip's zig-zag spans the
+    // region with every triangle (needles of tenths of a degree across a
+    // face, which gmsh's boundary recovery does not get through).
+    let small = pts.len() <= SMALL_OUTLINE;
+    let even = small || evenly_spaced(&pts, &edges);
+    if small && let Some(strip) = convex_strip(&pts, &edges, area2) {
+        return oriented(strip, &pts, &global, area2).map(|tris| Triangulated {
+            tris,
+            added: Vec::new(),
+        });
+    }
+    let mut added = Vec::new();
+    if !even {
+        let plane = Plane {
+            normal: normal.map(f64::from),
+            axes: [drop, u, v],
+        };
+        added = inner_points(&mut pts, &mut global, &edges, area2, verts, &plane);
     }
     let count = pts.len();
     let mut conflict = false;
@@ -125,9 +142,98 @@ pub(super) fn triangulate(
             _ => Some(None),
         });
     let faces: Option<Vec<[usize; 3]>> = inside.collect();
-    oriented(faces?, &pts, &global, area2)
+    let tris = oriented(faces?, &pts, &global, area2)?;
+    Some(keep_used(tris, added))
 }
 
+/// A region's triangles: indices into the label's vertices, or
+/// [`ADDED`]` + k` for `added[k]`, a point inside the region.
+pub(super) struct Triangulated {
+    pub tris: Vec<[u32; 3]>,
+    pub added: Vec<[f32; 3]>,
+}
+
+/// Marks an index into [`Triangulated::added`].
+pub(super) const ADDED: u32 = 1 << 31;
+
+/// The region's plane: its normal (any scale) and the dropped axis, then
+/// the two projected ones.
+struct Plane {
+    normal: [f64; 3],
+    axes: [usize; 3],
+}
+
+/// One point inside the region beside each outline edge shorter than
+/// [`STRIP_EDGE_RATIO`] of the longest, half the longest edge in from its
+/// middle (on the region's side), added to `pts` and `global` (as
+/// [`ADDED`]` + k`); their 3D positions, on the plane. Such short edges
+/// are the contourer's point clusters around samples the face passes
+/// through; without inner points the Delaunay triangulation joins each to
+/// a point across the region (needles of hundredths of a degree, which
+/// stop gmsh's boundary recovery). A point that lands outside the region
+/// leaves an outside face or fails the area check (then the region falls
+/// back to marching tetrahedra).
+fn inner_points(
+    pts: &mut Vec<Point2<f64>>,
+    global: &mut Vec<u32>,
+    edges: &[[usize; 2]],
+    area2: f64,
+    verts: &[[f32; 3]],
+    plane: &Plane,
+) -> Vec<[f32; 3]> {
+    let len2 = |pts: &[Point2<f64>], [a, b]: [usize; 2]| {
+        let (dx, dy) = (pts[b].x - pts[a].x, pts[b].y - pts[a].y);
+        dx * dx + dy * dy
+    };
+    let longest = edges.iter().map(|e| len2(pts, *e)).fold(0.0, f64::max);
+    let short = STRIP_EDGE_RATIO * STRIP_EDGE_RATIO * longest;
+    let step = 0.5 * longest.sqrt();
+    let [drop, u, v] = plane.axes;
+    let n = plane.normal;
+    let mut added = Vec::new();
+    for &[a, b] in edges {
+        let l2 = len2(pts, [a, b]);
+        if l2 >= short || l2 <= 0.0 {
+            continue;
+        }
+        // The region is on the left of its outline when it turns
+        // counter-clockwise (area2 > 0).
+        let (dx, dy) = (pts[b].x - pts[a].x, pts[b].y - pts[a].y);
+        let side = area2.signum() * step / l2.sqrt();
+        let (du, dv) = (-dy * side, dx * side);
+        let [pa, pb] = [a, b].map(|i| verts[global[i] as usize].map(f64::from));
+        let mut p: [f64; 3] = std::array::from_fn(|k| 0.5 * (pa[k] + pb[k]));
+        p[u] += du;
+        p[v] += dv;
+        // Along the plane: n · Δ = 0.
+        p[drop] -= (n[u] * du + n[v] * dv) / n[drop];
+        pts.push(Point2::new(p[u], p[v]));
+        global.push(ADDED + added.len() as u32);
+        added.push(p.map(|c| c as f32));
+    }
+    added
+}
+
+/// `tris` with only the added points they use, renumbered in order.
+fn keep_used(mut tris: Vec<[u32; 3]>, added: Vec<[f32; 3]>) -> Triangulated {
+    let mut new = vec![u32::MAX; added.len()];
+    let mut kept = Vec::new();
+    for t in &mut tris {
+        for i in t.iter_mut().filter(|i| **i >= ADDED) {
+            let k = (*i - ADDED) as usize;
+            if new[k] == u32::MAX {
+                new[k] = kept.len() as u32;
+                kept.push(added[k]);
+            }
+            *i = ADDED + new[k];
+        }
+    }
+    Triangulated { tris, added: kept }
+}
+
+/// Outlines of at most this many points are triangulated without inner
+/// points.
+const SMALL_OUTLINE: usize = 16;
 /// Outline edges shorter than this fraction of the longest send the
 /// region to the Delaunay path.
 const STRIP_EDGE_RATIO: f64 = 0.25;
@@ -345,7 +451,9 @@ mod tests {
             let n = r.len();
             assert_eq!(strip_of(&r).map(|t| t.len()), Some(n - 2), "a convex loop");
             let (verts, edges) = outline(&r);
-            let tris = triangulate([0, 0, 1], edges.into_iter(), &verts).expect("triangulated");
+            let tris = triangulate([0, 0, 1], edges.into_iter(), &verts)
+                .expect("triangulated")
+                .tris;
             assert_eq!(tris.len(), n - 2);
             // Every point kept, every triangle turning like the outline
             // (strictly: no sliver of zero area), areas adding up.
@@ -392,10 +500,14 @@ mod tests {
         }
         assert!(strip_of(&wobbly).is_none());
         let (verts, edges) = outline(&wobbly);
-        let tris = triangulate([0, 0, 1], edges.into_iter(), &verts).expect("the wobbly one");
+        let tris = triangulate([0, 0, 1], edges.into_iter(), &verts)
+            .expect("the wobbly one")
+            .tris;
         assert_eq!(tris.len(), wobbly.len() - 2);
         let (verts, edges) = outline(&l);
-        let tris = triangulate([0, 0, 1], edges.into_iter(), &verts).expect("the L");
+        let tris = triangulate([0, 0, 1], edges.into_iter(), &verts)
+            .expect("the L")
+            .tris;
         assert_eq!(tris.len(), 4);
         let sum: f64 = tris.iter().map(|t| area2(&verts, *t)).sum();
         assert!((sum - 6.0).abs() < 1e-12, "{sum}");
@@ -421,8 +533,53 @@ mod tests {
             .collect();
         let local: Vec<[usize; 2]> = edges.iter().map(|e| e.map(|i| i as usize)).collect();
         assert!(convex_strip(&pts, &local, 1.0).is_none(), "two loops");
-        let tris = triangulate([0, 0, 1], edges.into_iter(), &verts).expect("the holed square");
+        let tris = triangulate([0, 0, 1], edges.into_iter(), &verts)
+            .expect("the holed square")
+            .tris;
         let sum: f64 = tris.iter().map(|t| area2(&verts, *t)).sum();
         assert!((sum - (64.0 - 4.0) * 2.0).abs() < 1e-9, "{sum}");
+    }
+
+    #[test]
+    fn clustered_points_get_inner_points_instead_of_needles() {
+        // A 20 × 6 rectangle whose top and bottom sides carry a second
+        // point 0.05 beside each of their points, as where a face passes
+        // through samples.
+        let mut loop_pts = Vec::new();
+        for i in 0..20 {
+            loop_pts.extend([[i as f32, 0.0], [i as f32 + 0.05, 0.0]]);
+        }
+        loop_pts.extend((0..6).map(|j| [20.0, j as f32]));
+        for i in (1..=20).rev() {
+            loop_pts.extend([[i as f32, 6.0], [i as f32 - 0.05, 6.0]]);
+        }
+        loop_pts.push([0.0, 6.0]);
+        loop_pts.extend((1..6).rev().map(|j| [0.0, j as f32]));
+        let (verts, edges) = outline(&loop_pts);
+        let t = triangulate([0, 0, 1], edges.into_iter(), &verts).expect("triangulated");
+        assert!(!t.added.is_empty());
+        let mut all = verts.clone();
+        all.extend(&t.added);
+        let at = |i: u32| {
+            let i = if i >= ADDED {
+                verts.len() + (i - ADDED) as usize
+            } else {
+                i as usize
+            };
+            glam::DVec2::new(f64::from(all[i][0]), f64::from(all[i][1]))
+        };
+        let mut sum = 0.0;
+        let mut smallest = 180.0f64;
+        for tri in &t.tris {
+            let p = tri.map(at);
+            sum += (p[1] - p[0]).perp_dot(p[2] - p[0]);
+            for k in 0..3 {
+                let (u, w) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
+                smallest = smallest.min(u.angle_to(w).abs().to_degrees());
+            }
+        }
+        assert!((sum - 240.0).abs() < 1e-6, "{sum}");
+        // Without inner points a short side meets a point 6 across: 0.5°.
+        assert!(smallest > 2.0, "{smallest}°");
     }
 }
