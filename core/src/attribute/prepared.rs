@@ -163,6 +163,7 @@ impl Evaluator {
     pub(crate) fn build(
         root: &Node,
         materials: &[MaterialId],
+        sub: SubPreparer,
     ) -> Result<Option<Evaluator>, PrepareError> {
         let nodes = distinct_nodes(root);
         if nodes.iter().all(|n| n.attributes().is_none()) {
@@ -178,7 +179,7 @@ impl Evaluator {
             materials,
             infos: &infos,
             index,
-            sub: SubPreparer::new(materials)?,
+            sub,
             done: HashMap::new(),
         };
         let root = b.tree(root)?;
