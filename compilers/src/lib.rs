@@ -18,6 +18,7 @@ pub mod design;
 pub mod dither;
 pub mod mesh;
 pub mod par_deflate;
+pub mod plan;
 pub mod png_io;
 pub mod png_stack;
 mod presets;
