@@ -16,13 +16,13 @@ pub mod lazy_random;
 
 pub mod design;
 pub mod dither;
+mod estimate;
 pub mod mesh;
 pub mod par_deflate;
 pub mod plan;
 pub mod png_io;
 pub mod png_stack;
 mod presets;
-mod probe;
 pub mod resources;
 pub mod thin;
 mod union_find;
