@@ -1,7 +1,7 @@
 //! `volcad export png|mesh|fea`: run an export job
 //! with a progress bar; Ctrl-C cancels cleanly (nothing is left behind).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::RecvTimeoutError;
