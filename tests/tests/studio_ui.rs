@@ -499,7 +499,7 @@ fn studio_with_file(
     (path, harness(opts))
 }
 
-const SPHERE: &str = "let m = default_materials();\nSphere(Vec3(0, 0, 0), 4, m.id(\"red\"))\n";
+const SPHERE: &str = "let m = default_materials();\nSphere(Vec3(0, 0, 0), 5, m.id(\"red\"))\n";
 
 #[test]
 fn export_folders_default_to_the_design_and_kind() {
@@ -544,7 +544,9 @@ fn the_spheres_fea_deck_does_not_land_in_the_bars_folder() {
     std::fs::write(&sphere, SPHERE).unwrap();
     let ctx = h.ctx.clone();
     h.state_mut().open_path(&ctx, sphere);
-    wait_for(&mut h, "the sphere", |a| bbox_x(a) == Some(8.0));
+    wait_for(&mut h, "the sphere", |a| {
+        bbox_x(a).is_some_and(|x| (x - 10.0).abs() < 0.01)
+    });
     wait_idle(&mut h);
     assert_eq!(h.state().export_dir(), Some(dir.join("sphere_fea")));
     wait_label(&mut h, "elements");
@@ -604,7 +606,12 @@ fn replacing_a_finished_export_asks_and_names_what_is_in_it() {
     h.run_steps(2);
     assert!(h.state().modal().is_none());
     assert_eq!(h.state().jobs().list().len(), 2, "no job starts");
-    h.get_by_label_contains("holds other files (notes.txt) and no export manifest");
+    let log = h.state().log_lines().join("\n");
+    assert!(
+        log.contains("PNG stack export not started: \"Output folder\" ")
+            && log.contains("holds other files (notes.txt) and no export manifest"),
+        "{log}"
+    );
 }
 
 fn percentile(v: &[f64], p: f64) -> f64 {
