@@ -538,7 +538,7 @@ fn the_spheres_fea_deck_does_not_land_in_the_bars_folder() {
     wait_idle(&mut h);
     h.get_by_label("FEA (.inp)").click();
     h.run_steps(2);
-    wait_label(&mut h, "elements");
+    wait_label(&mut h, "Estimate: about");
     export_to_the_end(&mut h, "Export FEA (.inp)");
     let sphere = dir.join("sphere.rhai");
     std::fs::write(&sphere, SPHERE).unwrap();
@@ -549,7 +549,7 @@ fn the_spheres_fea_deck_does_not_land_in_the_bars_folder() {
     });
     wait_idle(&mut h);
     assert_eq!(h.state().export_dir(), Some(dir.join("sphere_fea")));
-    wait_label(&mut h, "elements");
+    wait_label(&mut h, "Estimate: about");
     export_to_the_end(&mut h, "Export FEA (.inp)");
     let design = |folder: &str| -> serde_json::Value {
         let m = std::fs::read_to_string(dir.join(folder).join("manifest.json")).unwrap();

@@ -156,6 +156,9 @@ pub fn verdict(dest: &Path) -> Option<Verdict> {
                 ),
             )
         }
+        // A device, pipe or dangling link: the job refuses it, in its own
+        // words, before it writes anything.
+        Folder::NotAFolder if !dest.is_file() => return None,
         Folder::NotAFolder => {
             return Some(Verdict::refuse(&ExportError::DestinationExists(
                 dest.to_owned(),

@@ -77,8 +77,8 @@ pub enum Opt {
 }
 
 impl Opt {
-    /// Every key, longest flag first where one flag starts another
-    /// (`--format` and `--formats`), so rewriting text flag by flag is safe.
+    /// Every key. No flag starts another, so a message can be rewritten
+    /// flag by flag.
     pub const ALL: [Opt; 14] = [
         Opt::MinCell,
         Opt::MaxCell,

@@ -13,10 +13,11 @@ pub(super) fn estimate(model: &Model, p: &PngParams) -> Result<Assessment, Expor
     let [nx, ny, nz] = est.grid.dims;
     Ok(Assessment {
         text: format!(
-            "{nx} × {ny} × {nz} voxels ({:.3e}), layers {} to {} ({} files), about {} on disk, {} memory",
+            "{nx} × {ny} × {nz} voxels ({:.3e}), layers {} to {} included ({} of {nz}; {} files), about {} on disk, {} memory",
             est.voxels as f64,
             est.layers.start,
             est.layers.end.saturating_sub(1),
+            est.layers.len(),
             est.files,
             human_bytes(est.disk_bytes),
             human_bytes(est.memory_bytes)
