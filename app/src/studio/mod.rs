@@ -41,7 +41,7 @@ pub mod settings;
 pub mod textops;
 pub mod viewport;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::AtomicI32;
 use std::time::{Duration, Instant};
@@ -449,28 +449,6 @@ impl StudioApp {
         self.exports.dir()
     }
 
-    /// Where the document's export folders go: beside its script, or in
-    /// the documents folder when it has none.
-    fn export_place(&self) -> export_panel::Place {
-        let name = self.doc.name();
-        match &self.doc.path {
-            Some(p) => export_panel::Place {
-                key: p.display().to_string(),
-                folder: p.parent().map_or_else(PathBuf::new, Path::to_path_buf),
-                name,
-            },
-            None => export_panel::Place {
-                key: format!("untitled:{name}"),
-                folder: self
-                    .opts
-                    .documents_dir
-                    .clone()
-                    .unwrap_or_else(|| PathBuf::from(".")),
-                name,
-            },
-        }
-    }
-
     fn poll_workers(&mut self, ctx: &egui::Context) {
         if let Some(r) = self.live.poll(ctx) {
             self.apply_result(ctx, r);
@@ -605,7 +583,7 @@ impl StudioApp {
                     .as_ref()
                     .map(|g| (g.model.clone(), g.source.clone()));
                 let ctx = ui.ctx().clone();
-                let place = self.export_place();
+                let place = export_panel::Place::of(&self.doc, self.opts.documents_dir.as_deref());
                 let action = self.exports.ui(
                     ui,
                     &place,

@@ -28,6 +28,7 @@ use volcad_compilers::plan::{self, ExportParams, Opt, Severity, Verdict};
 use volcad_compilers::png_stack::PngParams;
 use volcad_core::Model;
 
+use super::files::Document;
 use super::jobs::{Jobs, in_panel_words};
 use worker::EstimateWorker;
 
@@ -97,6 +98,24 @@ pub struct Place {
 }
 
 impl Place {
+    /// Where `doc`'s export folders go: beside its script, or in
+    /// `documents` (else the current folder) when it has none.
+    pub fn of(doc: &Document, documents: Option<&Path>) -> Place {
+        let name = doc.name();
+        match &doc.path {
+            Some(p) => Place {
+                key: p.display().to_string(),
+                folder: p.parent().map_or_else(PathBuf::new, Path::to_path_buf),
+                name,
+            },
+            None => Place {
+                key: format!("untitled:{name}"),
+                folder: documents.map_or_else(|| PathBuf::from("."), Path::to_path_buf),
+                name,
+            },
+        }
+    }
+
     /// `<folder>/<design>_<kind>`.
     fn default_dir(&self, kind: Kind) -> PathBuf {
         let stem = Path::new(&self.name)
