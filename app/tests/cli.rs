@@ -601,3 +601,52 @@ fn parameter_sets_apply_on_the_command_line() {
         "{err}"
     );
 }
+
+#[test]
+fn a_finished_export_is_replaced_only_with_force_and_other_folders_never() {
+    let scratch = tmp("replace");
+    let d = scratch.path();
+    let bar = example("graded_bar.rhai");
+    let out = d.join("bar_png");
+    let export = |voxel: &str, extra: &[&str]| {
+        let mut args = vec!["export", "png", &bar, "--out", out.to_str().unwrap()];
+        args.extend(["--voxel", voxel]);
+        args.extend(extra);
+        volcad(&args)
+    };
+    ok(&export("1", &[]));
+    let manifest = std::fs::read_to_string(out.join("manifest.json")).unwrap();
+    assert!(
+        manifest.contains("\"design\": \"graded_bar.rhai\""),
+        "{manifest}"
+    );
+    // Five 1 mm layers; a second export at 0.5 mm would replace them.
+    assert_eq!(files_in(&out).len(), 6);
+    let err = fails(&export("0.5", &[]));
+    assert!(
+        err.contains("holds a finished export, a png export of graded_bar.rhai (6 files")
+            && err.contains("add --force to replace it"),
+        "{err}"
+    );
+    assert_eq!(files_in(&out).len(), 6, "the finished export is kept");
+    ok(&export("0.5", &["--force"]));
+    assert_eq!(files_in(&out).len(), 11, "replaced: ten layers");
+    // A folder of other files is never replaced, --force or not, and the
+    // refusal names what is in it.
+    let mine = d.join("mine");
+    std::fs::create_dir(&mine).unwrap();
+    for n in ["notes.txt", "photo.jpg"] {
+        std::fs::write(mine.join(n), "x").unwrap();
+    }
+    for force in [&[][..], &["--force"]] {
+        let mut args = vec!["export", "png", &bar, "--out", mine.to_str().unwrap()];
+        args.extend(["--voxel", "1"]);
+        args.extend(force);
+        let err = fails(&volcad(&args));
+        assert!(
+            err.contains("holds other files (notes.txt, photo.jpg) and no export manifest"),
+            "{err}"
+        );
+        assert_eq!(files_in(&mine), ["notes.txt", "photo.jpg"]);
+    }
+}

@@ -122,6 +122,8 @@ pub struct JobContext {
     start: Instant,
     /// The design's hash, for the manifest.
     pub design_hash: String,
+    /// The design's name (its script's file name), for the manifest.
+    pub design: Option<String>,
 }
 
 impl JobContext {
@@ -230,6 +232,8 @@ struct Manifest<'a> {
     tool: &'static str,
     version: &'static str,
     design_hash: &'a str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    design: Option<&'a str>,
     #[serde(flatten)]
     summary: &'a Summary,
 }
@@ -254,13 +258,27 @@ pub fn spawn<F>(dest: PathBuf, design_hash: String, work: F) -> JobHandle
 where
     F: FnOnce(&JobContext) -> Result<Summary, ExportError> + Send + 'static,
 {
+    spawn_design(dest, design_hash, None, work)
+}
+
+/// [`spawn`], with the design's name recorded in the manifest (what the
+/// question before replacing a finished export names).
+pub fn spawn_design<F>(
+    dest: PathBuf,
+    design_hash: String,
+    design: Option<String>,
+    work: F,
+) -> JobHandle
+where
+    F: FnOnce(&JobContext) -> Result<Summary, ExportError> + Send + 'static,
+{
     let (tx, rx) = sync_channel(64);
     let cancel = Arc::new(AtomicBool::new(false));
     let c2 = cancel.clone();
     let d2 = dest.clone();
     let thread = std::thread::Builder::new()
         .name("volcad-export".into())
-        .spawn(move || run_job(d2, design_hash, c2, tx, work))
+        .spawn(move || run_job(d2, (design_hash, design), c2, tx, work))
         .expect("spawning a thread");
     JobHandle {
         progress: rx,
@@ -310,11 +328,11 @@ fn process_gone(_pid: u32) -> bool {
     false
 }
 
-/// Run `work` on this thread (the CLI uses this through `spawn` too; tests
-/// may call it directly).
+/// Run `work` on this thread with the design's hash and name (what [`spawn`]
+/// and [`spawn_design`] run on their thread; tests may call it directly).
 pub fn run_job<F>(
     dest: PathBuf,
-    design_hash: String,
+    (design_hash, design): (String, Option<String>),
     cancel: Arc<AtomicBool>,
     tx: SyncSender<Progress>,
     work: F,
@@ -355,7 +373,8 @@ where
         .take_while(|a| Some(*a) != existing)
         .map(Path::to_path_buf)
         .collect();
-    let out = stage_and_run(&dest, parent, cancel, tx, design_hash, work);
+    let design = (design_hash, design);
+    let out = stage_and_run(&dest, parent, cancel, tx, design, work);
     if out.is_err() {
         for folder in &made {
             if std::fs::remove_dir(folder).is_err() {
@@ -407,7 +426,7 @@ fn stage_and_run<F>(
     parent: &Path,
     cancel: Arc<AtomicBool>,
     tx: SyncSender<Progress>,
-    design_hash: String,
+    (design_hash, design): (String, Option<String>),
     work: F,
 ) -> Result<Summary, ExportError>
 where
@@ -437,6 +456,7 @@ where
         tx,
         start: Instant::now(),
         design_hash,
+        design,
     };
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| work(&ctx)));
     let result = match result {
@@ -450,6 +470,7 @@ where
             tool: "volcad",
             version: env!("CARGO_PKG_VERSION"),
             design_hash: &ctx.design_hash,
+            design: ctx.design.as_deref(),
             summary: &summary,
         };
         let path = staging.join("manifest.json");

@@ -20,6 +20,7 @@ pub mod dither;
 mod estimate;
 pub mod mesh;
 pub mod par_deflate;
+pub mod plan;
 pub mod png_io;
 pub mod png_stack;
 mod presets;

@@ -486,6 +486,134 @@ fn an_export_larger_than_the_disk_is_not_started() {
     assert!(!out.exists());
 }
 
+/// A studio with `text` saved as `dir/name` and opened from there.
+fn studio_with_file(
+    dir: &Path,
+    name: &str,
+    text: &str,
+) -> (std::path::PathBuf, Harness<'static, StudioApp>) {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    let mut opts = StudioOptions::for_tests(dir.join("data"), text);
+    opts.script = Some(path.clone());
+    (path, harness(opts))
+}
+
+const SPHERE: &str = "let m = default_materials();\nSphere(Vec3(0, 0, 0), 5, m.id(\"red\"))\n";
+
+#[test]
+fn export_folders_default_to_the_design_and_kind() {
+    let scratch = temp_dir("folders");
+    let dir = scratch.path();
+    let (_, mut h) = studio_with_file(dir, "bar.rhai", BAR);
+    wait_idle(&mut h);
+    assert_eq!(h.state().export_dir(), Some(dir.join("bar_png")));
+    h.get_by_label("Meshes / 3MF").click();
+    h.run_steps(2);
+    assert_eq!(h.state().export_dir(), Some(dir.join("bar_mesh")));
+    h.get_by_label("FEA (.inp)").click();
+    h.run_steps(2);
+    assert_eq!(h.state().export_dir(), Some(dir.join("bar_fea")));
+    // A folder typed for one kind stays with it.
+    set_output_folder(&mut h, &dir.join("deck"));
+    h.get_by_label("PNG stack").click();
+    h.run_steps(2);
+    assert_eq!(h.state().export_dir(), Some(dir.join("bar_png")));
+    h.get_by_label("FEA (.inp)").click();
+    h.run_steps(2);
+    assert_eq!(h.state().export_dir(), Some(dir.join("deck")));
+    drop(h);
+    // An untitled design's go to the documents folder.
+    let (data, mut h) = studio(BAR, "untitled-folders");
+    wait_idle(&mut h);
+    let docs = data.path().join("data/documents");
+    assert_eq!(h.state().export_dir(), Some(docs.join("untitled_png")));
+}
+
+#[test]
+fn the_spheres_fea_deck_does_not_land_in_the_bars_folder() {
+    let scratch = temp_dir("two-decks");
+    let dir = scratch.path();
+    let (_, mut h) = studio_with_file(dir, "bar.rhai", BAR);
+    wait_idle(&mut h);
+    h.get_by_label("FEA (.inp)").click();
+    h.run_steps(2);
+    wait_label(&mut h, "Estimate: about");
+    export_to_the_end(&mut h, "Export FEA (.inp)");
+    let sphere = dir.join("sphere.rhai");
+    std::fs::write(&sphere, SPHERE).unwrap();
+    let ctx = h.ctx.clone();
+    h.state_mut().open_path(&ctx, sphere);
+    wait_for(&mut h, "the sphere", |a| {
+        bbox_x(a).is_some_and(|x| (x - 10.0).abs() < 0.01)
+    });
+    wait_idle(&mut h);
+    assert_eq!(h.state().export_dir(), Some(dir.join("sphere_fea")));
+    wait_label(&mut h, "Estimate: about");
+    export_to_the_end(&mut h, "Export FEA (.inp)");
+    let design = |folder: &str| -> serde_json::Value {
+        let m = std::fs::read_to_string(dir.join(folder).join("manifest.json")).unwrap();
+        serde_json::from_str::<serde_json::Value>(&m).unwrap()["design"].clone()
+    };
+    assert_eq!(design("bar_fea"), "bar.rhai");
+    assert_eq!(design("sphere_fea"), "sphere.rhai");
+    assert!(dir.join("bar_fea/model.inp").is_file());
+}
+
+#[test]
+fn replacing_a_finished_export_asks_and_names_what_is_in_it() {
+    let scratch = temp_dir("replace");
+    let dir = scratch.path();
+    let (_, mut h) = studio_with_file(dir, "bar.rhai", BAR);
+    wait_idle(&mut h);
+    set_png_voxel(&mut h, 0.5);
+    wait_label(&mut h, "Estimate: 30 ×");
+    export_to_the_end(&mut h, "Export PNG stack");
+    let out = dir.join("bar_png");
+    let files = || std::fs::read_dir(&out).unwrap().count();
+    assert_eq!(files(), 11, "ten layers and the manifest");
+    // Escape and Enter both keep the folder; replacing takes a click.
+    for key in [egui::Key::Escape, egui::Key::Enter] {
+        h.get_by_label("Export PNG stack").click();
+        h.run_steps(2);
+        assert!(
+            matches!(h.state().modal(), Some(Modal::ConfirmExport(_))),
+            "{:?}",
+            h.state().modal()
+        );
+        h.get_by_label_contains("holds a finished export: a png export of bar.rhai (11 files,");
+        h.get_by_label_contains("written 20");
+        h.key_press(key);
+        h.run_steps(2);
+        assert!(h.state().modal().is_none(), "{key:?}");
+        assert_eq!(h.state().jobs().list().len(), 1, "{key:?}: no new job");
+        assert_eq!(files(), 11);
+    }
+    h.get_by_label("Export PNG stack").click();
+    h.run_steps(2);
+    h.get_by_label("Replace").click();
+    wait_for(&mut h, "the second export", |a| {
+        a.jobs().list().len() == 2 && !a.jobs().any_running()
+    });
+    assert_eq!(job_state(h.state()), Some("done"));
+    assert_eq!(files(), 11);
+    // A folder of other files is refused, naming them.
+    let mine = dir.join("mine");
+    std::fs::create_dir(&mine).unwrap();
+    std::fs::write(mine.join("notes.txt"), "x").unwrap();
+    set_output_folder(&mut h, &mine);
+    h.get_by_label("Export PNG stack").click();
+    h.run_steps(2);
+    assert!(h.state().modal().is_none());
+    assert_eq!(h.state().jobs().list().len(), 2, "no job starts");
+    let log = h.state().log_lines().join("\n");
+    assert!(
+        log.contains("PNG stack export not started: \"Output folder\" ")
+            && log.contains("holds other files (notes.txt) and no export manifest"),
+        "{log}"
+    );
+}
+
 fn percentile(v: &[f64], p: f64) -> f64 {
     let mut s = v.to_vec();
     s.sort_by(f64::total_cmp);

@@ -1,7 +1,7 @@
 //! `volcad export png|mesh|fea`: run an export job
 //! with a progress bar; Ctrl-C cancels cleanly (nothing is left behind).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::RecvTimeoutError;
@@ -9,14 +9,12 @@ use std::time::Duration;
 
 use anyhow::{Context, bail};
 use glam::DVec3;
-use volcad_compilers::fea::solver::{check_solver_memory, machine_memory, solver_bytes};
 use volcad_compilers::fea::{Element, EndSets, FeaParams, Sizing, StepParams};
 use volcad_compilers::job::{self, design_hash};
 use volcad_compilers::mesh::{MeshFormats, MeshParams, SegmentBy};
+use volcad_compilers::plan::{self, ExportParams, Severity, Verdict, blocking};
 use volcad_compilers::png_stack::{self, Dither, PngParams};
-use volcad_compilers::resources::check_disk_for;
 use volcad_compilers::shard;
-use volcad_compilers::thin::thin_feature_notes;
 
 use super::DesignArgs;
 use super::design::load_design;
@@ -105,13 +103,19 @@ pub struct ExportArgs {
     /// fea: with a `modulus` attribute, elastic sets per property (default 16).
     #[arg(long, allow_negative_numbers = true)]
     pub property_bins: Option<usize>,
-    /// fea: end sets, pieces and solver memory.
+    /// fea: end sets and pieces.
     #[command(flatten)]
     pub fea_checks: Box<FeaChecks>,
+    /// Override the refusals that protect your work and machine: replace a
+    /// finished export in --out (a folder holding our manifest.json), and
+    /// (fea) write a deck even when CalculiX would need more memory than
+    /// this machine has. A folder of other files is never replaced.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// `volcad export fea` options that choose the end node sets and let a
-/// deck through its checks (boxed: they would make every command's
+/// deck in pieces through (boxed: they would make every command's
 /// arguments larger).
 #[derive(clap::Args, Debug)]
 pub struct FeaChecks {
@@ -127,9 +131,6 @@ pub struct FeaChecks {
     /// fea: write a deck whose elements fall into several pieces (refused otherwise).
     #[arg(long)]
     pub allow_pieces: bool,
-    /// fea: write a deck even when CalculiX would need more memory than this machine has.
-    #[arg(long)]
-    pub force: bool,
 }
 
 /// The voxel sizes accepted, in mm: a nanometre to a kilometre.
@@ -234,7 +235,6 @@ fn foreign_options(a: &ExportArgs) -> Vec<&'static str> {
         ("--fix", a.fea_checks.fix.is_some(), Kind::Fea),
         ("--load", a.fea_checks.load.is_some(), Kind::Fea),
         ("--allow-pieces", a.fea_checks.allow_pieces, Kind::Fea),
-        ("--force", a.fea_checks.force, Kind::Fea),
     ];
     given
         .iter()
@@ -329,79 +329,70 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
     if let Some(t) = a.threads {
         volcad_compilers::resources::check_threads(t)?;
     }
-    let threads = a.threads;
-    let dest = a.out.clone();
+    let params = match a.kind {
+        Kind::Png => ExportParams::Png(png_params(a, voxel)?),
+        Kind::Mesh => ExportParams::Mesh(mesh_params(a, voxel, &model)?),
+        Kind::Fea => ExportParams::Fea(fea_params(a, voxel, &model)?),
+    };
+    let verdicts = preflight(&params, &model, &a.out)?;
+    for v in verdicts.iter().filter(|v| v.severity == Severity::Warn) {
+        eprintln!("{}", v.message);
+    }
+    if let Some(v) = blocking(&verdicts, a.force) {
+        bail!("{}", v.message);
+    }
+    let mut params = params;
+    params.set_force(a.force);
     // Before the job starts: a signal that came between the job creating
     // its staging folder and the handler being installed ended the process
     // with the folder left behind (seen once in CI).
     let interrupted = interrupt_flag();
-    let handle = match a.kind {
-        Kind::Png => {
-            let dither = match a.dither.as_deref().unwrap_or("random") {
-                "random" => Dither::Random,
-                "diffusion" => Dither::Diffusion,
-                d => bail!("--dither {d}: expected random or diffusion"),
-            };
-            let p = PngParams {
-                voxel: voxel.context(
-                    "--voxel or --preset is required for png (e.g. --voxel 0.1 or --preset j750)",
-                )?,
-                seed: a.seed,
-                dither,
-                layers: a.layers.as_deref().map(parse_layers).transpose()?,
-                shard: a.shard.as_deref().map(str::parse).transpose()?,
-                per_material_bitmaps: a.bitmaps,
-                threads,
-            };
-            let est = png_stack::estimate(&model, &p)?;
-            let [nx, ny, nz] = est.grid.dims;
-            note!(
-                "grid {nx} x {ny} x {nz}; layers {} to {} included ({} of {nz}; {} voxels); about {:.1} MB on disk, {:.1} MB working memory",
-                est.layers.start,
-                est.layers.end.saturating_sub(1),
-                est.layers.len(),
-                est.voxels,
-                est.disk_bytes as f64 / 1e6,
-                est.memory_bytes as f64 / 1e6
-            );
-            check_disk_for(est.disk_bytes, &dest, "a larger voxel size")?;
-            warn_thin(&model, p.voxel.max_element(), "--voxel");
-            job::spawn(dest, hash, move |ctx| {
-                png_stack::export_png_stack(&model, &p, ctx)
-            })
-        }
-        Kind::Mesh => {
-            let p = mesh_params(a, voxel, &model)?;
-            let est = volcad_compilers::mesh::estimate_mesh(&model, &p)?;
-            let [nx, ny, nz] = est.grid.dims;
-            note!(
-                "grid {nx} x {ny} x {nz} ({} voxels), {} segments; about {:.1e} triangles and {:.1} MB on disk, {:.1} MB working memory",
-                est.voxels,
-                est.segments,
-                est.triangles as f64,
-                est.disk_bytes as f64 / 1e6,
-                est.memory_bytes as f64 / 1e6
-            );
-            check_disk_for(est.disk_bytes, &dest, "a larger voxel size")?;
-            warn_thin(&model, p.voxel.max_element(), "--voxel");
-            job::spawn(dest, hash, move |ctx| {
-                volcad_compilers::mesh::export_meshes(&model, &p, ctx)
-            })
-        }
-        Kind::Fea => {
-            let p = fea_params(a, voxel, &model)?;
-            if p.element == Element::C3D8R {
-                fea_estimate(&model, &p)?;
-            } else {
-                let (size, option) = p.cell();
-                warn_thin(&model, size, option);
-            }
-            job::spawn(dest, hash, move |ctx| {
-                volcad_compilers::fea::export_fea(&model, &p, ctx)
-            })
-        }
-    };
+    let design = a
+        .design
+        .design
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned());
+    let handle = params.run(model, a.out.clone(), hash, design);
     follow(handle, &interrupted)
+}
+
+/// The plan's estimate (printed) and every pre-flight verdict for an
+/// export into `dest`. Adaptive tetrahedra skip the estimate: it grades a
+/// coarse lattice, as long as meshing itself.
+fn preflight(
+    params: &ExportParams,
+    model: &volcad_core::Model,
+    dest: &Path,
+) -> anyhow::Result<Vec<Verdict>> {
+    let (mut verdicts, disk) = if params.estimate_is_slow() {
+        (params.design_verdicts(model), None)
+    } else {
+        let a = params.assess(model)?;
+        note!("estimate: {}", a.text);
+        (a.verdicts, a.disk_bytes)
+    };
+    verdicts.extend(plan::preflight(disk, dest));
+    Ok(verdicts)
+}
+
+/// The slice stack's parameters from the options (`voxel` as parsed).
+fn png_params(a: &ExportArgs, voxel: Option<DVec3>) -> anyhow::Result<PngParams> {
+    let dither = match a.dither.as_deref().unwrap_or("random") {
+        "random" => Dither::Random,
+        "diffusion" => Dither::Diffusion,
+        d => bail!("--dither {d}: expected random or diffusion"),
+    };
+    Ok(PngParams {
+        voxel: voxel.context(
+            "--voxel or --preset is required for png (e.g. --voxel 0.1 or --preset j750)",
+        )?,
+        seed: a.seed,
+        dither,
+        layers: a.layers.as_deref().map(parse_layers).transpose()?,
+        shard: a.shard.as_deref().map(str::parse).transpose()?,
+        per_material_bitmaps: a.bitmaps,
+        threads: a.threads,
+    })
 }
 
 /// The mesh export's parameters from the options (`voxel` as parsed).
@@ -469,40 +460,11 @@ fn fea_params(
             load: a.fea_checks.load.clone(),
         },
         allow_pieces: a.fea_checks.allow_pieces,
-        force: a.fea_checks.force,
+        // Set by the plan once the user agreed (`--force`).
+        force: false,
         solver_memory: None,
         threads: a.threads,
     })
-}
-
-/// Print the warnings about features thinner than `size` can resolve
-/// before the export starts (the summary repeats them).
-fn warn_thin(model: &volcad_core::Model, size: f64, option: &str) {
-    for n in thin_feature_notes(model, size, option) {
-        if n.starts_with("warning") {
-            eprintln!("{n}");
-        }
-    }
-}
-
-/// Print the brick deck's estimated size and solver memory, and refuse
-/// before meshing when even half the estimated nodes would not fit the
-/// solving machine (the estimate is within a factor of about two; the
-/// export checks the exact count before writing). Tetrahedra skip it: their
-/// estimate grades a coarse lattice, as long as meshing itself.
-fn fea_estimate(model: &volcad_core::Model, p: &FeaParams) -> anyhow::Result<()> {
-    let est = volcad_compilers::fea::estimate_fea(model, p)?;
-    eprintln!(
-        "about {} elements, {} nodes, {:.1} MB .inp; CalculiX's direct solver about {:.1} GB",
-        est.elements,
-        est.nodes,
-        est.file_bytes as f64 / 1e6,
-        solver_bytes(est.nodes) as f64 / 1e9
-    );
-    let (size, option) = p.cell();
-    warn_thin(model, size, option);
-    check_solver_memory(est.nodes / 2, machine_memory()?, p.force, &p.size_options())?;
-    Ok(())
 }
 
 /// A flag that Ctrl-C, SIGTERM and SIGHUP set, for [`follow`] to cancel the

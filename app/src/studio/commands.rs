@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use egui::{Key, KeyboardShortcut, Modifiers, ViewportCommand};
 
 use super::dialogs::{DialogAnswer, DialogPurpose};
+use super::export_panel::Question;
 use super::files::{self, Document, Recovered};
 use super::settings::Theme;
 use super::{StudioApp, examples};
@@ -55,6 +56,9 @@ pub enum Modal {
     QuitWithJobs,
     /// A message to acknowledge (an error saving, for example).
     Message(String),
+    /// An export waits: it would replace a finished export or outgrow the
+    /// solving machine.
+    ConfirmExport(Question),
 }
 
 /// Apply the theme preference.
@@ -467,6 +471,26 @@ impl StudioApp {
                     if ui.button("OK").clicked() || enter || esc {
                         close = true;
                     }
+                }
+                Modal::ConfirmExport(q) => {
+                    ui.heading(&q.heading);
+                    ui.label(&q.text);
+                    ui.horizontal(|ui| {
+                        if ui.button(&q.confirm).clicked() {
+                            close = true;
+                            if let Some(line) = self.exports.confirm(&mut self.jobs) {
+                                self.bottom.log(line);
+                            }
+                        }
+                        // Enter, like Escape, keeps the folder: replacing
+                        // work takes a click.
+                        if ui.button("Cancel").clicked() || enter || esc {
+                            close = true;
+                            if let Some(line) = self.exports.cancel_pending() {
+                                self.bottom.log(line);
+                            }
+                        }
+                    });
                 }
             }
         });

@@ -251,6 +251,14 @@ pub fn default_data_dir() -> Option<PathBuf> {
         .map(|d| d.join("volcad"))
 }
 
+/// The user's documents folder (`$HOME/Documents` when it exists, else
+/// `$HOME`), where an untitled design's exports go by default.
+pub fn documents_dir() -> Option<PathBuf> {
+    let home = PathBuf::from(std::env::var_os("HOME").filter(|h| !h.is_empty())?);
+    let docs = home.join("Documents");
+    Some(if docs.is_dir() { docs } else { home })
+}
+
 /// Open a folder in the desktop's file manager (`xdg-open`), without waiting.
 pub fn open_folder(path: &Path) -> Result<(), String> {
     let program = if cfg!(target_os = "macos") {

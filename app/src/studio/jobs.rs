@@ -3,10 +3,11 @@
 //! drained every frame with `try_recv`; a finished job is joined only once
 //! `is_finished()` says it will not wait.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Duration;
 
 use volcad_compilers::job::{JobHandle, Progress, Summary};
+use volcad_compilers::plan::Opt;
 
 use super::files;
 
@@ -232,29 +233,38 @@ pub fn duration_text(d: Duration) -> String {
     }
 }
 
+/// The export panel's name for the option `o` (its field, in quotes).
+pub fn field(o: Opt) -> &'static str {
+    match o {
+        Opt::MinCell => "\"Cell min\"",
+        Opt::MaxCell => "\"Cell max\"",
+        Opt::Sizing => "\"Size of h\"",
+        Opt::Voxel => "\"Voxel (mm)\"",
+        Opt::Out => "\"Output folder\"",
+        Opt::Infill => "\"3MF infill\"",
+        Opt::Segments => "\"Segments\"",
+        Opt::By => "\"Split by\"",
+        Opt::Formats => "\"Formats\"",
+        Opt::Threads => "the thread count",
+        Opt::Layers => "the layer range",
+        Opt::Step => "\"Static step\"",
+        Opt::PropertyBins => "\"Property bins\"",
+        Opt::Shard => "the shard",
+        Opt::Force => "\"Export anyway\"",
+        Opt::Design => "design",
+    }
+}
+
 /// A compiler's message in the panel's words: its command-line option
 /// names become the fields that set them (`--voxel` → "Voxel (mm)").
 pub fn in_panel_words(message: &str) -> String {
-    const FIELDS: [(&str, &str); 13] = [
-        ("--min-cell", "\"Cell min\""),
-        ("--max-cell", "\"Cell max\""),
-        ("--sizing", "\"Size of h\""),
-        ("--voxel", "\"Voxel (mm)\""),
-        ("--out", "\"Output folder\""),
-        ("--infill", "\"3MF infill\""),
-        ("--segments", "\"Segments\""),
-        ("--material", "\"Split by\""),
-        ("--format", "\"Formats\""),
-        ("--threads", "the thread count"),
-        ("--layers", "the layer range"),
-        ("--step", "\"Static step\""),
-        ("--property-bins", "\"Property bins\""),
-    ];
     let mut m = message.to_owned();
-    for (flag, field) in FIELDS {
-        m = m.replace(flag, field);
+    for o in Opt::ALL.into_iter().filter(|o| *o != Opt::Design) {
+        m = m.replace(o.flag(), field(o));
     }
-    m
+    // Older spellings some messages still use.
+    m.replace("--material", field(Opt::By))
+        .replace("--format", field(Opt::Formats))
 }
 
 /// "1 file", "2 files".
@@ -280,18 +290,6 @@ fn summary_text(s: &Summary) -> String {
         t += &format!("\n{}", counts.join(", "));
     }
     t
-}
-
-/// A destination that does not exist yet: `base/name`, or `base/name-2`, ...
-pub fn fresh_destination(base: &Path, name: &str) -> PathBuf {
-    let first = base.join(name);
-    if !first.exists() {
-        return first;
-    }
-    (2..)
-        .map(|i| base.join(format!("{name}-{i}")))
-        .find(|p| !p.exists())
-        .unwrap_or(first)
 }
 
 #[cfg(test)]

@@ -85,6 +85,8 @@ pub struct StudioOptions {
     pub persistence: bool,
     /// Folder for the recovery file (`None`: no autosave).
     pub data_dir: Option<PathBuf>,
+    /// Where an untitled design's export folders go by default.
+    pub documents_dir: Option<PathBuf>,
     /// Wait this long after the last edit before running the script.
     pub debounce: Duration,
     /// Autosave unsaved text this often.
@@ -106,6 +108,7 @@ impl Default for StudioOptions {
             quit_after_frames: None,
             persistence: true,
             data_dir: files::default_data_dir(),
+            documents_dir: files::documents_dir(),
             debounce: Duration::from_millis(300),
             autosave_interval: Duration::from_secs(5),
             bake_levels: volcad_render_levels(),
@@ -125,6 +128,7 @@ impl StudioOptions {
         Self {
             initial_text: Some(initial_text.to_owned()),
             persistence: false,
+            documents_dir: Some(data_dir.join("documents")),
             data_dir: Some(data_dir),
             debounce: Duration::ZERO,
             autosave_interval: Duration::from_millis(200),
@@ -255,7 +259,7 @@ impl StudioApp {
             shot: screenshot::Screenshot::new(opts.screenshot.clone()),
             live: LiveRunner::new(opts.debounce),
             viewport: Viewport::new(has_gpu, opts.bake_levels.clone()),
-            exports: ExportPanels::new(settings.last_export_dir.clone()),
+            exports: ExportPanels::new(settings.export_dirs.clone()),
             opts,
             settings,
             syntect: highlight::settings(),
@@ -441,6 +445,11 @@ impl StudioApp {
         self.exports.set_dir(dir);
     }
 
+    /// The export panels' output folder shown (tests).
+    pub fn export_dir(&self) -> Option<PathBuf> {
+        self.exports.dir()
+    }
+
     fn poll_workers(&mut self, ctx: &egui::Context) {
         if let Some(r) = self.live.poll(ctx) {
             self.apply_result(ctx, r);
@@ -575,8 +584,10 @@ impl StudioApp {
                     .as_ref()
                     .map(|g| (g.model.clone(), g.source.clone()));
                 let ctx = ui.ctx().clone();
+                let place = export_panel::Place::of(&self.doc, self.opts.documents_dir.as_deref());
                 let action = self.exports.ui(
                     ui,
+                    &place,
                     model.as_ref().map(|(m, s)| (m, s.as_str())),
                     &mut self.jobs,
                 );
@@ -588,6 +599,7 @@ impl StudioApp {
                             .show(&ctx, dialogs::DialogPurpose::ExportFolder(i), dir, None);
                     }
                     export_panel::Action::Log(l) => self.bottom.log(l),
+                    export_panel::Action::Ask(q) => self.modal = Some(Modal::ConfirmExport(q)),
                 }
                 for note in self.jobs.ui(ui) {
                     self.bottom.log(note);
@@ -664,7 +676,7 @@ impl eframe::App for StudioApp {
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
         if self.opts.persistence {
             self.settings.last_file = self.doc.path.clone();
-            self.settings.last_export_dir = self.exports.dir();
+            self.settings.export_dirs = self.exports.dirs().clone();
             self.settings.store(storage);
         }
     }

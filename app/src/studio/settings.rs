@@ -2,6 +2,7 @@
 //! theme and the editor font size (panel sizes persist through egui's own
 //! memory). Stored as one JSON value in eframe's storage.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -42,8 +43,9 @@ pub struct Settings {
     pub show_side: bool,
     /// Bottom panel (problems, log) shown.
     pub show_bottom: bool,
-    /// Output folder last used by an export panel.
-    pub last_export_dir: Option<PathBuf>,
+    /// Export folders typed or picked, per design and kind (see
+    /// `export_panel::Place`).
+    pub export_dirs: BTreeMap<String, PathBuf>,
     /// Folders scripts may read besides their project (the command line's
     /// `--allow-read DIR`).
     pub read_folders: Vec<PathBuf>,
@@ -59,7 +61,7 @@ impl Default for Settings {
             show_editor: true,
             show_side: true,
             show_bottom: true,
-            last_export_dir: None,
+            export_dirs: BTreeMap::new(),
             read_folders: Vec::new(),
         }
     }
