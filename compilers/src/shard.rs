@@ -161,6 +161,8 @@ pub struct Part {
     pub version: String,
     /// The design's hash.
     pub design_hash: String,
+    /// The design's name, when the manifest records it.
+    pub design: Option<String>,
     /// The manifest's summary.
     pub summary: Summary,
     /// Its layers.
@@ -179,6 +181,8 @@ struct ManifestIn {
     tool: String,
     version: String,
     design_hash: String,
+    #[serde(default)]
+    design: Option<String>,
     #[serde(flatten)]
     summary: Summary,
 }
@@ -273,6 +277,7 @@ fn read_part(dir: &Path) -> Result<Part, ExportError> {
         dir: dir.to_owned(),
         version: m.version,
         design_hash: m.design_hash,
+        design: m.design,
         summary: m.summary,
         layers: a..b,
         dims: p.grid.dims,
@@ -320,6 +325,14 @@ fn check_same_export(a: &Part, b: &Part) -> Result<(), ExportError> {
         return differ(format!(
             "design hash {} differs from {} (another design or other --param values)",
             b.design_hash, a.design_hash
+        ));
+    }
+    if a.design != b.design {
+        let name = |d: &Option<String>| d.clone().unwrap_or_else(|| "no name".into());
+        return differ(format!(
+            "the design is {} in {db} and {} in {da}",
+            name(&b.design),
+            name(&a.design)
         ));
     }
     let (pa, pb) = (shared_params(a), shared_params(b));
@@ -429,6 +442,8 @@ fn inside(dir: &Path, rel: &str) -> Option<PathBuf> {
 pub struct MergePlan {
     /// The shards' design hash (the merged manifest's).
     pub design_hash: String,
+    /// The shards' design name (the merged manifest's).
+    pub design: Option<String>,
     /// The merged manifest's summary.
     pub summary: Summary,
     /// Number of shard folders.
@@ -488,6 +503,7 @@ pub fn plan_merge(dirs: &[PathBuf]) -> Result<MergePlan, ExportError> {
     let summary = merged_summary(&parts)?;
     Ok(MergePlan {
         design_hash: parts[0].design_hash.clone(),
+        design: parts[0].design.clone(),
         summary,
         shards: parts.len(),
         bytes,

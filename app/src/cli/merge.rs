@@ -39,6 +39,7 @@ pub fn merge(a: &MergeArgs) -> anyhow::Result<()> {
     );
     let interrupted = interrupt_flag();
     let hash = plan.design_hash.clone();
-    let handle = job::spawn(a.out.clone(), hash, move |ctx| plan.run(ctx));
+    let design = plan.design.clone();
+    let handle = job::spawn_design(a.out.clone(), hash, design, move |ctx| plan.run(ctx));
     follow(handle, &interrupted)
 }
