@@ -103,7 +103,10 @@ fn property_bins_refuse_a_design_without_modulus() {
     let e = run(&dir, move |ctx| export_fea(&m, &p, ctx))
         .unwrap_err()
         .to_string();
-    assert!(e.contains("--property-bins") && e.contains("modulus") && e.contains("density"), "{e}");
+    assert!(
+        e.contains("--property-bins") && e.contains("modulus") && e.contains("density"),
+        "{e}"
+    );
     assert!(!dir.join("model.inp").exists());
 }
 

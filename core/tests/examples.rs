@@ -196,7 +196,9 @@ fn text_label() {
 
 /// Scalar attribute `name` of `m` at `p` (NaN where it is not set).
 fn attr(m: &Model, name: &str, p: DVec3) -> f64 {
-    let i = m.attribute_index(name).unwrap_or_else(|| panic!("no {name}"));
+    let i = m
+        .attribute_index(name)
+        .unwrap_or_else(|| panic!("no {name}"));
     let mut out = [f64::NAN];
     m.attribute_at(i, p, &mut out).unwrap();
     out[0]
@@ -217,7 +219,10 @@ fn shore_grip() {
     assert!((attr(&m, "shore_hardness", end) - s_end).abs() < 1e-9);
     // Between the table's rows 80 (9.351) and 90 (20.844) MPa.
     let e_mid = attr(&m, "modulus", mid);
-    assert!((e_mid - (9.351 + 0.5 * (20.844 - 9.351))).abs() < 1e-9, "{e_mid}");
+    assert!(
+        (e_mid - (9.351 + 0.5 * (20.844 - 9.351))).abs() < 1e-9,
+        "{e_mid}"
+    );
     assert!(attr(&m, "modulus", end) < 2.0);
     assert!((frac(&m, mid, "VeroClear") - 55.0 / 65.0).abs() < 1e-6);
     assert!(frac(&m, end, "Agilus30Clr") > 0.8);
@@ -242,8 +247,10 @@ fn color_gradient() {
     let i = m.attribute_index("color").unwrap();
     let mut c = [0.0; 4];
     let near = |a: [f64; 4], b: [f64; 4]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-12);
-    m.attribute_at(i, DVec3::new(-19.0, 0.0, 0.0), &mut c).unwrap();
+    m.attribute_at(i, DVec3::new(-19.0, 0.0, 0.0), &mut c)
+        .unwrap();
     assert!(near(c, [0.975, 0.5, 0.025, 1.0]), "{c:?}");
-    m.attribute_at(i, DVec3::new(0.0, 0.0, 19.0), &mut c).unwrap();
+    m.attribute_at(i, DVec3::new(0.0, 0.0, 19.0), &mut c)
+        .unwrap();
     assert!(near(c, [0.5, 0.975, 0.5, 1.0]), "{c:?}");
 }

@@ -41,7 +41,11 @@ impl ColorMap {
     /// The colour of `value` on the range `[lo, hi]`; a range of zero width
     /// maps everything to its middle.
     pub fn color_in(self, value: f64, lo: f64, hi: f64) -> [u8; 4] {
-        let t = if hi > lo { (value - lo) / (hi - lo) } else { 0.5 };
+        let t = if hi > lo {
+            (value - lo) / (hi - lo)
+        } else {
+            0.5
+        };
         self.color(t)
     }
 }
@@ -321,7 +325,11 @@ mod tests {
     fn luminance(c: [u8; 4]) -> f64 {
         let lin = |v: u8| {
             let v = v as f64 / 255.0;
-            if v <= 0.04045 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) }
+            if v <= 0.04045 {
+                v / 12.92
+            } else {
+                ((v + 0.055) / 1.055).powf(2.4)
+            }
         };
         0.2126 * lin(c[0]) + 0.7152 * lin(c[1]) + 0.0722 * lin(c[2])
     }
@@ -335,7 +343,9 @@ mod tests {
         assert_eq!(m.color(f64::NAN), m.color(0.0));
         assert_eq!(m.color(7.0), m.color(1.0));
         // Lightness never falls along the map.
-        let l: Vec<f64> = (0..256).map(|i| luminance(m.color(i as f64 / 255.0))).collect();
+        let l: Vec<f64> = (0..256)
+            .map(|i| luminance(m.color(i as f64 / 255.0)))
+            .collect();
         assert!(l.windows(2).all(|w| w[1] >= w[0] - 1e-3), "{l:?}");
         assert_eq!(m.color_in(5.0, 0.0, 10.0), m.color(0.5));
         assert_eq!(m.color_in(3.0, 3.0, 3.0), m.color(0.5));

@@ -50,8 +50,8 @@
 
 pub mod attribute_bake;
 mod bake;
-pub mod colormap;
 mod camera;
+pub mod colormap;
 mod gpu;
 mod offscreen;
 mod pick;
@@ -63,8 +63,8 @@ pub mod viewport;
 
 pub use attribute_bake::AttributeShading;
 pub use bake::{BakeError, MAX_CHANNELS, VolumeBake, bake, bake_shaded};
-pub use colormap::ColorMap;
 pub use camera::{Camera, StandardView};
+pub use colormap::ColorMap;
 pub use gpu::{MAX_DENSITY, MIN_DENSITY, RENDER_SHADER, Renderer, THIN_BIAS_VOXELS};
 pub use offscreen::{Offscreen, render_offscreen};
 pub use pick::{HitSurface, PickHit, pick, pick_drawn};

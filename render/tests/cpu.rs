@@ -225,15 +225,24 @@ fn attribute_bake_maps_values_through_viridis() {
     let x_of = |i: u32| b.origin.x + (i as f32 + 0.5) * b.voxel.x;
     let i0 = (0..nx).find(|i| x_of(*i) > -7.0).unwrap();
     let i1 = (0..nx).find(|i| x_of(*i) > 0.0).unwrap();
-    assert_eq!(centre(i1), ColorMap::Viridis.color_in(x_of(i1) as f64, lo, hi));
-    assert_eq!(centre(i0), ColorMap::Viridis.color_in(x_of(i0) as f64, lo, hi));
+    assert_eq!(
+        centre(i1),
+        ColorMap::Viridis.color_in(x_of(i1) as f64, lo, hi)
+    );
+    assert_eq!(
+        centre(i0),
+        ColorMap::Viridis.color_in(x_of(i0) as f64, lo, hi)
+    );
     let i2 = (0..nx).find(|i| x_of(*i) > 6.0).unwrap();
     assert_eq!(centre(i2), UNDEFINED);
     // A fixed range: x = 0 is its top, so the top colour.
     s.range = Some([-10.0, 0.0]);
     let f = bake_shaded(&model, 32, Some((&s, eval)), &no).unwrap();
     assert_eq!(f.attribute_range, Some([-10.0, 0.0]));
-    assert_eq!(f.color[f.index(i1, ny / 2, nz / 2)], ColorMap::Viridis.color(1.0));
+    assert_eq!(
+        f.color[f.index(i1, ny / 2, nz / 2)],
+        ColorMap::Viridis.color(1.0)
+    );
     // Colours as they are.
     let red = |_p: volcad_core::Points<'_>, out: &mut [f64]| {
         for c in out.chunks_mut(4) {

@@ -614,7 +614,10 @@ impl ExportPanels {
                 .labelled_by(label);
             ui.end_row();
             let label = ui.label("Property bins").id;
-            let mut bins = self.fea.property_bins.unwrap_or(property_bins::DEFAULT_BINS);
+            let mut bins = self
+                .fea
+                .property_bins
+                .unwrap_or(property_bins::DEFAULT_BINS);
             let changed = ui
                 .add(egui::DragValue::new(&mut bins).range(1..=property_bins::MAX_BINS))
                 .labelled_by(label)

@@ -60,8 +60,16 @@ impl AttributeReading {
             Ok(v) => {
                 let parts: Vec<String> = v.iter().map(|x| super::attribute_view::fmt(*x)).collect();
                 let joined = parts.join(", ");
-                let shown = if v.len() > 1 { format!("({joined})") } else { joined };
-                if unit.is_empty() { shown } else { format!("{shown} {unit}") }
+                let shown = if v.len() > 1 {
+                    format!("({joined})")
+                } else {
+                    joined
+                };
+                if unit.is_empty() {
+                    shown
+                } else {
+                    format!("{shown} {unit}")
+                }
             }
             Err(e) => format!("error: {e}"),
         };
@@ -108,7 +116,10 @@ pub fn attributes_at(model: &Model, p: glam::DVec3) -> Vec<AttributeReading> {
 pub fn run(req: &ProbeRequest) -> Option<Probe> {
     let hit = volcad_render::pick_drawn(&req.model, &req.view, req.ndc, req.aspect)?;
     let surface_distance = req.model.distance(hit.point);
-    let attributes = attributes_at(&req.model, just_inside(&req.model, hit.point, surface_distance));
+    let attributes = attributes_at(
+        &req.model,
+        just_inside(&req.model, hit.point, surface_distance),
+    );
     Some(Probe {
         pos: req.pos,
         hit,

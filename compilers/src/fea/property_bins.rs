@@ -276,7 +276,11 @@ mod tests {
         assert_eq!(s.set_of, vec![0, 0, 0, 1, 1, 2, 2, 2, 3, 3, 3]);
         let e: Vec<f64> = s.materials.iter().map(|m| m.e).collect();
         assert_eq!(e, vec![110.0, 135.0, 160.0, 190.0]);
-        assert!(s.materials.iter().all(|m| m.nu == 0.3 && m.density.is_none()));
+        assert!(
+            s.materials
+                .iter()
+                .all(|m| m.nu == 0.3 && m.density.is_none())
+        );
         // One value everywhere: one set; more bins than values: one set per value.
         let one = ElementProps {
             modulus: vec![5.0; 3],
