@@ -107,6 +107,36 @@ pub enum ConvMap {
     Table(std::sync::Arc<Table>),
     /// A math string of the coordinates and the input attribute's name.
     Expr(String),
+    /// From the material fractions (`from` is `"fractions"`): a mixing
+    /// rule over one value per material.
+    Mix {
+        /// Voigt (`Σ fᵢvᵢ`, parallel) or Reuss (`1 / Σ fᵢ/vᵢ`, series).
+        reuss: bool,
+        /// `(material id, value)`.
+        values: Vec<(crate::material::MaterialId, f64)>,
+    },
+}
+
+/// The input name of a conversion from material fractions.
+pub const FRACTIONS: &str = "fractions";
+
+/// Voigt's or Reuss's mix of `values` (one per fraction), over the
+/// fractions given (normalised by their sum, so materials without a value
+/// do not count); NaN where none has a value.
+#[inline]
+pub fn mix(reuss: bool, fractions: &[f64], values: &[f64]) -> f64 {
+    let (mut total, mut acc) = (0.0, 0.0);
+    for (f, v) in fractions.iter().zip(values) {
+        total += f;
+        acc += if reuss { f / v } else { f * v };
+    }
+    if total <= 0.0 {
+        f64::NAN
+    } else if reuss {
+        total / acc
+    } else {
+        acc / total
+    }
 }
 
 #[cfg(test)]

@@ -59,6 +59,11 @@ fn source_text(s: &AttrSource) -> String {
                 format!("\"{from}\" through a table over {lo}..{hi}")
             }
             super::ConvMap::Expr(e) => format!("\"{e}\" of \"{from}\""),
+            super::ConvMap::Mix { reuss, values } => format!(
+                "{} mix of {} material values",
+                if *reuss { "Reuss" } else { "Voigt" },
+                values.len()
+            ),
         },
         AttrSource::Data {
             field, column_name, ..

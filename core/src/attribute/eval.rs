@@ -117,8 +117,10 @@ impl ANode {
             }
         }
         self.source_value(pos, q, pw, &slots, out)?;
-        if let Some((lo, hi, unit)) = own.range {
-            if let Some(v) = out.iter().find(|v| **v < lo || **v > hi) {
+        if let Some((lo, hi, unit)) = own.range
+            && let Some(v) = out.iter().find(|v| **v < lo || **v > hi)
+        {
+            {
                 return Err(AttributeError {
                     node: self.describe.clone(),
                     message: format!(
@@ -170,6 +172,22 @@ impl ANode {
                 map,
                 clamped,
             } => {
+                if let PConv::Mix {
+                    reuss,
+                    slots,
+                    values,
+                    materials,
+                } = map
+                {
+                    let mut f = [0.0; crate::model::MAX_MATERIALS];
+                    self.dist.fractions(q, &mut f[..*materials]);
+                    let mut picked = [0.0; crate::model::MAX_MATERIALS];
+                    for (p, s) in picked.iter_mut().zip(slots) {
+                        *p = f[*s];
+                    }
+                    out[0] = super::convert::mix(*reuss, &picked[..slots.len()], values);
+                    return Ok(());
+                }
                 let mut x = [f64::NAN];
                 match from_own {
                     Some(j) => x[0] = slots[COORD_SLOTS + j],
@@ -185,7 +203,7 @@ impl ANode {
                         }
                         y
                     }
-                    PConv::Table(_) => f64::NAN,
+                    PConv::Table(_) | PConv::Mix { .. } => f64::NAN,
                     PConv::Expr(e) => {
                         let mut s = [0.0; COORD_SLOTS + 1];
                         s[..COORD_SLOTS].copy_from_slice(&slots[..COORD_SLOTS]);
@@ -270,6 +288,7 @@ impl ANode {
                         let (lo, hi) = t.output_range();
                         Interval::new(lo, hi)
                     }
+                    PConv::Mix { .. } => Interval::EVERYTHING,
                     PConv::Expr(e) => {
                         let mut s = [Interval::EVERYTHING; COORD_SLOTS + 1];
                         s[..COORD_SLOTS].copy_from_slice(&slots[..COORD_SLOTS]);

@@ -24,7 +24,7 @@ mod resolve;
 
 use std::sync::Arc;
 
-pub use convert::{ConvMap, Table};
+pub use convert::{ConvMap, FRACTIONS, Table};
 pub use describe::{column_names, describe_tree, value_text};
 pub use names::{COMMON, Common, check_kind, range, range_text};
 pub use prepared::Evaluator;

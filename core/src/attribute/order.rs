@@ -16,7 +16,7 @@ fn direct_used(o: &Own) -> u64 {
         // The math string's slot 9 is its input, not an own attribute.
         OwnSrc::Convert { from_own, map, .. } => {
             let coords = match map {
-                PConv::Table(_) => 0,
+                PConv::Table(_) | PConv::Mix { .. } => 0,
                 PConv::Expr(e) => e.used_vars() & ((1 << COORD_SLOTS) - 1),
             };
             coords | from_own.map_or(0, |j| 1u64 << (COORD_SLOTS + j))

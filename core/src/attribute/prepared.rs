@@ -65,6 +65,13 @@ pub(super) enum PConv {
     Table(Arc<super::Table>),
     /// Slots: the coordinates, then the input value.
     Expr(Arc<Expr>),
+    /// A mix of the fractions: `slots[i]`'s material has `values[i]`.
+    Mix {
+        reuss: bool,
+        slots: Vec<usize>,
+        values: Vec<f64>,
+        materials: usize,
+    },
 }
 
 /// One attribute a node sets.
@@ -156,6 +163,7 @@ impl Evaluator {
     pub(crate) fn build(
         root: &Node,
         materials: &[MaterialId],
+        sub: SubPreparer,
     ) -> Result<Option<Evaluator>, PrepareError> {
         let nodes = distinct_nodes(root);
         if nodes.iter().all(|n| n.attributes().is_none()) {
@@ -168,9 +176,10 @@ impl Evaluator {
             .map(|(i, a)| (a.name.as_str(), i))
             .collect();
         let mut b = Builder {
+            materials,
             infos: &infos,
             index,
-            sub: SubPreparer::new(materials)?,
+            sub,
             done: HashMap::new(),
         };
         let root = b.tree(root)?;
@@ -239,6 +248,7 @@ fn collect_infos(nodes: &[&Node]) -> Result<Vec<AttributeInfo>, PrepareError> {
 }
 
 struct Builder<'a> {
+    materials: &'a [MaterialId],
     infos: &'a [AttributeInfo],
     index: HashMap<&'a str, usize>,
     sub: SubPreparer,
@@ -462,6 +472,9 @@ impl Builder<'_> {
         from: &str,
         map: &super::ConvMap,
     ) -> Result<OwnSrc, PrepareError> {
+        if let super::ConvMap::Mix { reuss, values } = map {
+            return self.mix(n, *reuss, values);
+        }
         let Some(&idx) = self.index.get(from) else {
             let have: Vec<&str> = self.infos.iter().map(|i| i.name.as_str()).collect();
             return Err(err(
@@ -483,6 +496,9 @@ impl Builder<'_> {
         }
         let map = match map {
             super::ConvMap::Table(t) => PConv::Table(t.clone()),
+            super::ConvMap::Mix { .. } => {
+                return Err(err(n, "mixes fractions (a bug in volcad)".into()));
+            }
             super::ConvMap::Expr(s) => {
                 let mut vars: Vec<&str> = COORD_VARS.to_vec();
                 vars.push(from);
@@ -502,6 +518,41 @@ impl Builder<'_> {
             from: idx,
             from_own: a.defs.iter().position(|o| o.name == from),
             map,
+            clamped: Default::default(),
+        })
+    }
+}
+
+impl Builder<'_> {
+    /// A conversion from the fractions: each material's dense slot.
+    fn mix(
+        &self,
+        n: &Node,
+        reuss: bool,
+        values: &[(MaterialId, f64)],
+    ) -> Result<OwnSrc, PrepareError> {
+        let mut slots = Vec::with_capacity(values.len());
+        for (id, _) in values {
+            let Some(s) = self.materials.iter().position(|m| m == id) else {
+                return Err(err(
+                    n,
+                    format!(
+                        "mixes a value for material {id}, which the design does not use; it uses {:?}",
+                        self.materials
+                    ),
+                ));
+            };
+            slots.push(s);
+        }
+        Ok(OwnSrc::Convert {
+            from: usize::MAX,
+            from_own: None,
+            map: PConv::Mix {
+                reuss,
+                slots,
+                values: values.iter().map(|v| v.1).collect(),
+                materials: self.materials.len(),
+            },
             clamped: Default::default(),
         })
     }

@@ -371,3 +371,23 @@ fn convert_refusals() {
     .unwrap_err();
     assert!(e.contains("cycle"), "{e}");
 }
+
+#[test]
+fn convert_fractions_by_voigt_and_reuss() {
+    // Half red, half blue everywhere.
+    let part = "let g = FGrade([\"0.5\", \"0.5\"], [m.id(\"red\"), m.id(\"blue\")], false, Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\")));";
+    let m = model(&format!(
+        "{part} Convert(g, \"fractions\", \"modulus\", \"voigt\", [[m.id(\"red\"), 2000.0], [m.id(\"blue\"), 1.0]])"
+    ));
+    assert!((at(&m, "modulus", [1.0, 0.0, 0.0]) - 1000.5).abs() < 1e-9);
+    let m = model(&format!(
+        "{part} Convert(g, \"fractions\", \"modulus\", \"reuss\", [[m.id(\"red\"), 2000.0], [m.id(\"blue\"), 1.0]])"
+    ));
+    // 1 / (0.5/2000 + 0.5/1).
+    assert!((at(&m, "modulus", [1.0, 0.0, 0.0]) - 1.0 / (0.5 / 2000.0 + 0.5)).abs() < 1e-9);
+    let e = try_model(&format!(
+        "{part} Convert(g, \"fractions\", \"modulus\", \"reuss\", [[m.id(\"red\"), 0.0]])"
+    ))
+    .unwrap_err();
+    assert!(e.contains("above 0"), "{e}");
+}

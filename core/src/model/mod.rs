@@ -106,17 +106,18 @@ impl SubDistance {
     pub(crate) fn interval(&self, b: &Aabb) -> Interval {
         self.node.interval(b)
     }
+
+    /// Fractions at `p` into `out` (the design's materials, dense).
+    pub(crate) fn fractions(&self, p: DVec3, out: &mut [f64]) {
+        out.fill(0.0);
+        self.node.eval(p, out);
+    }
 }
 
 /// Prepares the distances of script subtrees, sharing one cache.
 pub(crate) struct SubPreparer(prepare::Preparer);
 
 impl SubPreparer {
-    /// A preparer for a design using `materials`.
-    pub(crate) fn new(materials: &[MaterialId]) -> Result<Self, PrepareError> {
-        Ok(Self(prepare::Preparer::new(materials)?))
-    }
-
     /// The distance of the subtree `n`.
     pub(crate) fn distance(&mut self, n: &Node) -> Result<SubDistance, PrepareError> {
         let (node, bbox) = self.0.prepare(n)?;
@@ -168,7 +169,10 @@ impl Model {
                 message: "the design has no material".into(),
             });
         }
-        let attrs = crate::attribute::Evaluator::build(root, &materials)?.map(Arc::new);
+        // The attribute evaluator reuses the preparer's cache: each node's
+        // distance is prepared once for both.
+        let attrs =
+            crate::attribute::Evaluator::build(root, &materials, SubPreparer(p))?.map(Arc::new);
         Ok(Model {
             attrs,
             varying: root_p.varying_fractions(),

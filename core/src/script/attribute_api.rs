@@ -19,6 +19,7 @@ pub struct Vec4(pub DVec4);
 
 pub(super) fn register(engine: &mut Engine, ctx: &super::RunContext) {
     register_convert(engine, ctx);
+    register_mix(engine);
     engine.register_type_with_name::<Vec4>("Vec4");
     engine.register_fn(
         "Vec4",
@@ -91,6 +92,12 @@ fn check_name(name: &str, p: Position) -> RResult<()> {
             "set_attribute: the name is empty; give one such as \"modulus\"",
         );
     }
+    if name == crate::attribute::FRACTIONS {
+        return fail(
+            p,
+            "\"fractions\" names the material fractions (FGrade sets them); choose another name",
+        );
+    }
     if COORD_VARS.iter().any(|v| v.eq_ignore_ascii_case(name)) {
         return fail(
             p,
@@ -151,15 +158,16 @@ fn value_def(name: &str, v: &Dynamic, p: Position) -> RResult<AttrDef> {
     check_kind(name, kind, &what).or_else(|e| fail(p, e.to_string()))?;
     if let Some((lo, hi, unit)) = crate::attribute::range(name) {
         for c in &comps {
-            if let Component::Const(x) = c {
-                if *x < lo || *x > hi {
-                    return fail(
-                        p,
-                        format!(
-                            "{what}: {x} is outside {lo}..{hi} {unit}; give a value in that range"
-                        ),
-                    );
-                }
+            if let Component::Const(x) = c
+                && (*x < lo || *x > hi)
+            {
+                return fail(
+                    p,
+                    format!(
+                        "{what}: {x} is out of range; it must be {}",
+                        crate::attribute::range_text(lo, hi, unit)
+                    ),
+                );
             }
         }
     }
@@ -215,6 +223,9 @@ fn register_convert(engine: &mut Engine, ctx: &super::RunContext) {
         "Convert",
         move |cc: Ctx, child: Node, from: &str, to: &str, map: Dynamic| -> RResult<Node> {
             let p = cc.call_position();
+            if from == crate::attribute::FRACTIONS {
+                return fail(p, format!("Convert(\"fractions\" -> \"{to}\"): give a mixing rule and one value per material: Convert(child, \"fractions\", \"{to}\", \"voigt\", [[m.id(\"a\"), 2000], [m.id(\"b\"), 1]])"));
+            }
             check_name(from, p)?;
             check_name(to, p)?;
             let what = format!("Convert(\"{from}\" -> \"{to}\")");
@@ -253,6 +264,52 @@ fn register_convert(engine: &mut Engine, ctx: &super::RunContext) {
                 name: to.to_owned(),
                 kind: AttributeKind::Scalar,
                 source: AttrSource::Convert { from: from.to_owned(), map },
+                origin: origin(p),
+            });
+            Ok(n)
+        },
+    );
+}
+
+/// `Convert(child, "fractions", to, "voigt" | "reuss", [[id, value], ...])`:
+/// `to` from the child's material fractions by a mixing rule.
+fn register_mix(engine: &mut Engine) {
+    engine.register_fn(
+        "Convert",
+        |cc: Ctx, child: Node, from: &str, to: &str, rule: &str, values: rhai::Array| -> RResult<Node> {
+            let p = cc.call_position();
+            check_name(to, p)?;
+            let what = format!("Convert(\"{from}\" -> \"{to}\")");
+            if from != crate::attribute::FRACTIONS {
+                return fail(p, format!("{what}: a mixing rule converts \"fractions\"; for an attribute give a table or a math string: Convert(child, \"{from}\", \"{to}\", table)"));
+            }
+            check_kind(to, AttributeKind::Scalar, &what).or_else(|e| fail(p, e.to_string()))?;
+            let reuss = match rule.to_ascii_lowercase().as_str() {
+                "voigt" => false,
+                "reuss" => true,
+                _ => return fail(p, format!("{what}: the rule is \"voigt\" (parallel, Σ f·v) or \"reuss\" (series, 1/Σ f/v), got {rule:?}")),
+            };
+            let mut pairs = Vec::with_capacity(values.len());
+            for (i, r) in values.iter().enumerate() {
+                let row = format!("{what}: value {}", i + 1);
+                let Some(v) = r.clone().try_cast::<rhai::Array>().filter(|v| v.len() == 2) else {
+                    return fail(p, format!("{row} must be a pair [material id, value], got {}", described(r)));
+                };
+                let id = material(&v[0], p)?;
+                let x = finite(&v[1], &row, p)?;
+                if reuss && x <= 0.0 {
+                    return fail(p, format!("{row}: {x}; Reuss's rule divides by each value, so each must be above 0"));
+                }
+                pairs.push((id, x));
+            }
+            if pairs.is_empty() {
+                return fail(p, format!("{what}: give at least one [material id, value] pair"));
+            }
+            let mut n = Node::with_origin(NodeKind::Identity { child: Some(child) }, origin(p));
+            n.attributes_mut().set(AttrDef {
+                name: to.to_owned(),
+                kind: AttributeKind::Scalar,
+                source: AttrSource::Convert { from: from.to_owned(), map: ConvMap::Mix { reuss, values: pairs } },
                 origin: origin(p),
             });
             Ok(n)

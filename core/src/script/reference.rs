@@ -528,8 +528,11 @@ pub static FUNCTIONS: &[FnDoc] = &[
     f!(
         "Convert",
         Material,
-        ["Convert(child: Node, from: string, to: string, table: [[float, float]] | string)"],
-        "Sets attribute `to` from `from` below it (pyvcad 3's AttributeModifier): a piecewise-linear table of [input, output] rows (inline or a two-column .csv; inputs rising; clamped at the ends, counted in a warning) or a math string of x y z ... d and `from`.",
+        [
+            "Convert(child: Node, from: string, to: string, table: [[float, float]] | string)",
+            "Convert(child: Node, \"fractions\", to: string, rule: \"voigt\" | \"reuss\", values: [[int, float]])"
+        ],
+        "Sets attribute `to` from `from` below it (pyvcad 3's AttributeModifier): a piecewise-linear table of [input, output] rows (inline or a two-column .csv; inputs rising; clamped at the ends, counted in a warning) or a math string of x y z ... d and `from`; from \"fractions\", a Voigt or Reuss mix of one value per material.",
         "Convert(part, \"shore_hardness\", \"modulus\", [[30, 1.0], [85, 20.0]])",
         "let m = default_materials(); let s = Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\")); s.set_attribute(\"shore_hardness\", \"60 + 4*x\"); Convert(s, \"shore_hardness\", \"modulus\", [[30, 1.0], [85, 20.0]])"
     ),
