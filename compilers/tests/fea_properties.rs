@@ -109,3 +109,27 @@ fn property_bins_refuse_a_design_without_modulus() {
     );
     assert!(!dir.join("model.inp").exists());
 }
+
+/// The example column (`assets/examples/modulus_beam.rhai`) exports with
+/// its modulus, Poisson ratio and density and solves in CalculiX; its
+/// reaction force matches the series-spring estimate
+/// F = u A / ∫ dz/E(z), E = 500 + 2350 s, ∫ = L ln(2850/500) / 2350.
+#[test]
+fn modulus_beam_example_solves_in_calculix() {
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../assets/examples/modulus_beam.rhai");
+    let m = model(&std::fs::read_to_string(path).unwrap());
+    let (_scratch, dir) = scratch("beam");
+    let p = params(None);
+    let s = run(&dir, move |ctx| export_fea(&m, &p, ctx)).unwrap();
+    assert_eq!(s.units, 6 * 6 * 60, "{s:?}");
+    let deck = std::fs::read_to_string(dir.join("model.inp")).unwrap();
+    assert_eq!(deck.matches("*DENSITY\n0.00000000117\n").count(), 16);
+    assert_eq!(moduli(&dir.join("model.inp")).len(), 16);
+    if !run_ccx(&dir, "model") {
+        return;
+    }
+    let f = reaction(&dir.join("model.dat")).unwrap()[2].abs();
+    let f_1d = TOP_UZ.abs() * 36.0 / (60.0 * (2850.0f64 / 500.0).ln() / 2350.0);
+    assert!((f / f_1d - 1.0).abs() < 0.10, "{f} vs {f_1d}");
+}

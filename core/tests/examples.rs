@@ -193,3 +193,64 @@ fn text_label() {
     assert!(m.distance(DVec3::new(0.0, 0.0, 0.5)) > 0.0);
     assert_eq!(frac(&m, DVec3::new(-28.0, -10.0, -1.0), "gray"), 1.0);
 }
+
+/// Scalar attribute `name` of `m` at `p` (NaN where it is not set).
+fn attr(m: &Model, name: &str, p: DVec3) -> f64 {
+    let i = m
+        .attribute_index(name)
+        .unwrap_or_else(|| panic!("no {name}"));
+    let mut out = [f64::NAN];
+    m.attribute_at(i, p, &mut out).unwrap();
+    out[0]
+}
+
+/// Hardness by intent: Shore A 85 in the middle, 40 at the ends; the resin
+/// mix follows the same target (illustrative linear rule), and the modulus
+/// Gent's relation tabulated in the file.
+#[test]
+fn shore_grip() {
+    let m = example("shore_grip.rhai");
+    let names: Vec<&str> = m.attributes().iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(names, ["modulus", "shore_hardness"]);
+    let mid = DVec3::new(0.0, 0.0, 0.0);
+    let end = DVec3::new(0.0, 0.0, -49.0);
+    assert!((attr(&m, "shore_hardness", mid) - 85.0).abs() < 1e-9);
+    let s_end = 85.0 - 45.0 * (49.0f64 / 50.0).powi(2);
+    assert!((attr(&m, "shore_hardness", end) - s_end).abs() < 1e-9);
+    // Between the table's rows 80 (9.351) and 90 (20.844) MPa.
+    let e_mid = attr(&m, "modulus", mid);
+    assert!(
+        (e_mid - (9.351 + 0.5 * (20.844 - 9.351))).abs() < 1e-9,
+        "{e_mid}"
+    );
+    assert!(attr(&m, "modulus", end) < 2.0);
+    assert!((frac(&m, mid, "VeroClear") - 55.0 / 65.0).abs() < 1e-6);
+    assert!(frac(&m, end, "Agilus30Clr") > 0.8);
+    assert!(attr(&m, "modulus", DVec3::new(0.0, 0.0, 60.0)).is_nan());
+}
+
+/// The CalculiX column: modulus 500 → 2850 MPa along z, ν and density
+/// constant (`compilers/tests/fea_properties.rs` solves it).
+#[test]
+fn modulus_beam() {
+    let m = example("modulus_beam.rhai");
+    assert_eq!(attr(&m, "modulus", DVec3::new(0.0, 0.0, -30.0)), 500.0);
+    assert_eq!(attr(&m, "modulus", DVec3::new(1.0, 2.0, 30.0)), 2850.0);
+    assert_eq!(attr(&m, "poissons_ratio", DVec3::ZERO), 0.35);
+    assert_eq!(attr(&m, "density", DVec3::ZERO), 1.17);
+}
+
+/// The colour-graded ball: red at −x, blue at +x, green rising with z.
+#[test]
+fn color_gradient() {
+    let m = example("color_gradient.rhai");
+    let i = m.attribute_index("color").unwrap();
+    let mut c = [0.0; 4];
+    let near = |a: [f64; 4], b: [f64; 4]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-12);
+    m.attribute_at(i, DVec3::new(-19.0, 0.0, 0.0), &mut c)
+        .unwrap();
+    assert!(near(c, [0.975, 0.5, 0.025, 1.0]), "{c:?}");
+    m.attribute_at(i, DVec3::new(0.0, 0.0, 19.0), &mut c)
+        .unwrap();
+    assert!(near(c, [0.5, 0.975, 0.5, 1.0]), "{c:?}");
+}

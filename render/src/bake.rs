@@ -100,6 +100,8 @@ pub struct VolumeBake {
     /// In attribute mode, the range the scalar values were mapped over
     /// (the fixed range, or the baked values' smallest and largest).
     pub attribute_range: Option<[f64; 2]>,
+    /// True when the colour volume was filled from an attribute.
+    pub attribute_shaded: bool,
 }
 
 impl VolumeBake {
@@ -156,6 +158,7 @@ impl VolumeBake {
             bake_seconds: seconds,
             redistanced: false,
             attribute_range: None,
+            attribute_shaded: false,
         }
     }
 }
@@ -282,6 +285,7 @@ pub fn bake_shaded(
         bake_seconds: start.elapsed().as_secs_f32(),
         redistanced,
         attribute_range,
+        attribute_shaded: shading.is_some(),
     })
 }
 

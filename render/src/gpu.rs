@@ -122,6 +122,9 @@ struct VolumeMeta {
     channels: Vec<usize>,
     palette: Vec<[u8; 4]>,
     material_count: usize,
+    /// The colour volume holds an attribute's colours: the shader must not
+    /// remix the materials' palette over it.
+    attribute: bool,
 }
 
 impl Volume {
@@ -343,6 +346,7 @@ impl Renderer {
             channels: bake.channels.clone(),
             palette: bake.palette.clone(),
             material_count: bake.materials.len(),
+            attribute: bake.attribute_shaded,
         });
     }
 
@@ -501,7 +505,7 @@ impl Renderer {
             hidden |= u.opacity[c] <= 0.0;
         }
         u.flags[2] = hidden as u32;
-        let all_in_channels = m.material_count <= MAX_CHANNELS;
+        let all_in_channels = m.material_count <= MAX_CHANNELS && !m.attribute;
         let iso_channel = match s.mode {
             ViewMode::Iso { material_index, .. } => m
                 .channels

@@ -100,10 +100,7 @@ pub struct ExportArgs {
     /// fea: append a static step: bottom fixed, top displaced by this many mm in z.
     #[arg(long, allow_negative_numbers = true)]
     pub step: Option<f64>,
-    /// fea: with a `modulus` attribute, elastic sets per property (default 16).
-    #[arg(long, allow_negative_numbers = true)]
-    pub property_bins: Option<usize>,
-    /// fea: end sets and pieces.
+    /// fea: end sets, pieces and property bins.
     #[command(flatten)]
     pub fea_checks: Box<FeaChecks>,
     /// Override the refusals that protect your work and machine: replace a
@@ -114,8 +111,8 @@ pub struct ExportArgs {
     pub force: bool,
 }
 
-/// `volcad export fea` options that choose the end node sets and let a
-/// deck in pieces through (boxed: they would make every command's
+/// `volcad export fea` options that choose the end node sets, let a deck
+/// in pieces through, and bin property fields (boxed: they would make every command's
 /// arguments larger).
 #[derive(clap::Args, Debug)]
 pub struct FeaChecks {
@@ -131,6 +128,9 @@ pub struct FeaChecks {
     /// fea: write a deck whose elements fall into several pieces (refused otherwise).
     #[arg(long)]
     pub allow_pieces: bool,
+    /// fea: with a `modulus` attribute, elastic sets per property (default 16).
+    #[arg(long, allow_negative_numbers = true)]
+    pub property_bins: Option<usize>,
 }
 
 /// The voxel sizes accepted, in mm: a nanometre to a kilometre.
@@ -230,7 +230,11 @@ fn foreign_options(a: &ExportArgs) -> Vec<&'static str> {
         ("--max-cell", a.max_cell.is_some(), Kind::Fea),
         ("--sizing", a.sizing.is_some(), Kind::Fea),
         ("--step", a.step.is_some(), Kind::Fea),
-        ("--property-bins", a.property_bins.is_some(), Kind::Fea),
+        (
+            "--property-bins",
+            a.fea_checks.property_bins.is_some(),
+            Kind::Fea,
+        ),
         ("--fix-band", a.fea_checks.fix_band.is_some(), Kind::Fea),
         ("--fix", a.fea_checks.fix.is_some(), Kind::Fea),
         ("--load", a.fea_checks.load.is_some(), Kind::Fea),
@@ -450,7 +454,7 @@ fn fea_params(
         max_cell: a.max_cell.unwrap_or(min_cell * 4.0),
         sizing: a.sizing.clone().map_or(Sizing::Heterogeneity, Sizing::Expr),
         seed: a.seed,
-        property_bins: a.property_bins,
+        property_bins: a.fea_checks.property_bins,
         step: a.step.map(|d| StepParams {
             top_displacement: d,
         }),

@@ -567,7 +567,8 @@ impl StudioApp {
             .show(ui, |ui| {
                 // A fixed height, so the panels below do not jump as the
                 // read-out under the cursor changes length.
-                let h = ui.text_style_height(&egui::TextStyle::Monospace) * 8.0;
+                let lines = 9 + self.model().map_or(0, |m| m.attributes().len());
+                let h = ui.text_style_height(&egui::TextStyle::Monospace) * lines as f32;
                 egui::ScrollArea::vertical()
                     .id_salt("probe-scroll")
                     .max_height(h)

@@ -50,6 +50,9 @@ pub struct Sets {
     pub materials: Vec<MatOut>,
 }
 
+/// The bins of an element's modulus, Poisson ratio and density.
+type BinKey = (usize, usize, usize);
+
 /// The bin (0..n) of `v` on `[lo, hi]` in `n` equal widths; a range of
 /// zero width is one bin.
 fn bin(v: f64, lo: f64, hi: f64, n: usize) -> usize {
@@ -82,7 +85,7 @@ pub fn bin_elements(p: &ElementProps, n: usize) -> Sets {
         )
     };
     // Sums per occupied key: count, Σ E, Σ ν, Σ ρ.
-    let mut sums: BTreeMap<(usize, usize, usize), (usize, f64, f64, f64)> = BTreeMap::new();
+    let mut sums: BTreeMap<BinKey, (usize, f64, f64, f64)> = BTreeMap::new();
     for i in 0..p.modulus.len() {
         let s = sums.entry(key(i)).or_default();
         s.0 += 1;
@@ -90,7 +93,7 @@ pub fn bin_elements(p: &ElementProps, n: usize) -> Sets {
         s.2 += p.poisson[i];
         s.3 += p.density.as_ref().map_or(0.0, |d| d[i]);
     }
-    let index: BTreeMap<(usize, usize, usize), u16> = sums
+    let index: BTreeMap<BinKey, u16> = sums
         .keys()
         .enumerate()
         .map(|(i, k)| (*k, i as u16))
