@@ -269,6 +269,48 @@ where
     }
 }
 
+/// [`spawn`] for an export that is one file (`part.gcvf`): `work` writes
+/// `ctx.staging()/<dest's file name>`, which is moved to `dest` once the
+/// job has succeeded (a regular file there is replaced; a folder or a
+/// special file is refused before any work). The job's folder, manifest
+/// included, is removed; a failed or cancelled job leaves nothing.
+pub fn spawn_file<F>(dest: PathBuf, design_hash: String, work: F) -> JobHandle
+where
+    F: FnOnce(&JobContext) -> Result<Summary, ExportError> + Send + 'static,
+{
+    let (tx, rx) = sync_channel(64);
+    let cancel = Arc::new(AtomicBool::new(false));
+    let c2 = cancel.clone();
+    let d2 = dest.clone();
+    let thread = std::thread::Builder::new()
+        .name("volcad-export".into())
+        .spawn(move || {
+            let name = d2
+                .file_name()
+                .map(|n| n.to_string_lossy().to_string())
+                .ok_or_else(|| ExportError::Other(format!("{}: not a file name", d2.display())))?;
+            if std::fs::symlink_metadata(&d2).is_ok_and(|m| !m.is_file()) {
+                return Err(ExportError::Other(format!(
+                    "{}: exists and is not a regular file; give a new file name",
+                    d2.display()
+                )));
+            }
+            let job_dir = d2.with_file_name(format!(".{name}.job-{}", std::process::id()));
+            let summary = run_job(job_dir.clone(), design_hash, c2, tx, work)?;
+            let moved = std::fs::rename(job_dir.join(&name), &d2);
+            let _ = std::fs::remove_dir_all(&job_dir);
+            moved.map_err(|e| ExportError::io(&d2, e))?;
+            Ok(summary)
+        })
+        .expect("spawning a thread");
+    JobHandle {
+        progress: rx,
+        cancel,
+        thread: Some(thread),
+        dest,
+    }
+}
+
 /// Staging folders left beside `parent/name` by earlier runs whose process
 /// is gone (killed outright, or the machine went down) are removed, so
 /// crashed exports do not pile up hidden gigabytes beside the destination.

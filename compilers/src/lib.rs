@@ -6,11 +6,13 @@
 //! model through the core's one grid sampler (`volcad_core::sampler`).
 //!
 //! * [`png_stack`]: inkjet slice stacks, one PNG per layer.
+//! * [`gcvf`]: GrabCAD Voxel Print packages for PolyJet printers.
 //! * [`mesh`]: segmented meshes (STL, OBJ, one 3MF with per-part settings).
 //! * [`fea`]: Abaqus/CalculiX `.inp` meshes (C3D8R bricks, adaptive C3D4 tets).
 #![warn(missing_docs)]
 
 pub mod fea;
+pub mod gcvf;
 pub mod job;
 pub mod lazy_random;
 
@@ -21,7 +23,9 @@ pub mod par_deflate;
 pub mod png_io;
 pub mod png_stack;
 mod presets;
+pub mod printer_table;
 mod probe;
+pub mod slice_image;
 pub mod resources;
 pub mod thin;
 mod union_find;

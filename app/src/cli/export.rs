@@ -29,6 +29,8 @@ pub enum Kind {
     Mesh,
     /// FEA mesh for Abaqus/CalculiX (.inp).
     Fea,
+    /// GrabCAD Voxel Print package for PolyJet (J750) printers (.gcvf).
+    Gcvf,
 }
 
 /// `volcad export` options (spelled as scripts rely on them).
@@ -65,6 +67,9 @@ pub struct ExportArgs {
     /// png: also write 1-bit stacks, one folder per material.
     #[arg(long)]
     pub bitmaps: bool,
+    /// gcvf, and png with --preset j750: design material = J750 resin, e.g. red=VeroMgnt,blue=VeroCyan.
+    #[arg(long)]
+    pub map: Option<String>,
     /// mesh: number of fraction ranges with `--by MATERIAL` (default 4).
     #[arg(long, allow_negative_numbers = true)]
     pub segments: Option<usize>,
@@ -205,7 +210,7 @@ fn parse_formats(s: &str) -> anyhow::Result<MeshFormats> {
 fn foreign_options(a: &ExportArgs) -> Vec<&'static str> {
     let given = [
         ("--layers", a.layers.is_some(), Kind::Png),
-        ("--dither", a.dither.is_some(), Kind::Png),
+        ("--dither", a.dither.is_some() && a.kind != Kind::Gcvf, Kind::Png),
         ("--bitmaps", a.bitmaps, Kind::Png),
         ("--segments", a.segments.is_some(), Kind::Mesh),
         ("--by", a.by.is_some(), Kind::Mesh),
@@ -227,6 +232,15 @@ fn foreign_options(a: &ExportArgs) -> Vec<&'static str> {
         .filter(|(_, on, kind)| *on && *kind != a.kind)
         .map(|(name, ..)| *name)
         .collect()
+}
+
+/// `--dither` (default random).
+pub(super) fn parse_dither(d: Option<&str>) -> anyhow::Result<Dither> {
+    Ok(match d.unwrap_or("random") {
+        "random" => Dither::Random,
+        "diffusion" => Dither::Diffusion,
+        d => bail!("--dither {d}: expected random or diffusion"),
+    })
 }
 
 /// `--element` (default c3d8r).
@@ -311,12 +325,10 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
     // with the folder left behind (seen once in CI).
     let interrupted = interrupt_flag();
     let handle = match a.kind {
+        Kind::Gcvf => super::gcvf::start(a, model, voxel, hash, dest)?,
         Kind::Png => {
-            let dither = match a.dither.as_deref().unwrap_or("random") {
-                "random" => Dither::Random,
-                "diffusion" => Dither::Diffusion,
-                d => bail!("--dither {d}: expected random or diffusion"),
-            };
+            let dither = parse_dither(a.dither.as_deref())?;
+            let model = super::gcvf::printer_model(a, model)?;
             let p = PngParams {
                 voxel: voxel.context(
                     "--voxel or --preset is required for png (e.g. --voxel 0.1 or --preset j750)",
@@ -450,7 +462,7 @@ fn fea_params(
 
 /// Print the warnings about features thinner than `size` can resolve
 /// before the export starts (the summary repeats them).
-fn warn_thin(model: &volcad_core::Model, size: f64, option: &str) {
+pub(super) fn warn_thin(model: &volcad_core::Model, size: f64, option: &str) {
     for n in thin_feature_notes(model, size, option) {
         if n.starts_with("warning") {
             eprintln!("{n}");
@@ -480,7 +492,7 @@ fn fea_estimate(model: &volcad_core::Model, p: &FeaParams) -> anyhow::Result<()>
 
 /// A flag that Ctrl-C, SIGTERM and SIGHUP set, for [`follow`] to cancel the
 /// export with.
-fn interrupt_flag() -> Arc<AtomicBool> {
+pub(super) fn interrupt_flag() -> Arc<AtomicBool> {
     let interrupted = Arc::new(AtomicBool::new(false));
     let flag = interrupted.clone();
     // A second handler cannot be installed (e.g. in tests running several
@@ -498,7 +510,7 @@ fn interrupt_flag() -> Arc<AtomicBool> {
 }
 
 /// Show progress until the job ends; a signal (`interrupted`) cancels it.
-fn follow(handle: job::JobHandle, interrupted: &AtomicBool) -> anyhow::Result<()> {
+pub(super) fn follow(handle: job::JobHandle, interrupted: &AtomicBool) -> anyhow::Result<()> {
     let bar = indicatif::ProgressBar::new(1000);
     bar.set_style(
         indicatif::ProgressStyle::with_template(

@@ -22,6 +22,7 @@ macro_rules! note {
 
 mod design;
 mod export;
+mod gcvf;
 mod info;
 mod output;
 mod render;
