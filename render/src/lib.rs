@@ -61,7 +61,7 @@ pub mod viewport;
 
 pub use bake::{BakeError, MAX_CHANNELS, VolumeBake, bake};
 pub use camera::{Camera, StandardView};
-pub use gpu::{RENDER_SHADER, Renderer, THIN_BIAS_VOXELS};
+pub use gpu::{MAX_DENSITY, MIN_DENSITY, RENDER_SHADER, Renderer, THIN_BIAS_VOXELS};
 pub use offscreen::{Offscreen, render_offscreen};
 pub use probe::{HitSurface, ProbeHit, probe, probe_drawn};
 pub use progressive::{DEFAULT_LEVELS, ProgressiveBaker};
