@@ -37,7 +37,8 @@ fn params(voxel: DVec3, threads: Option<usize>) -> GcvfParams {
 }
 
 fn export(m: &Arc<Model>, p: &GcvfParams, dest: &Path) -> Result<Summary, ExportError> {
-    let (m, p) = (m.clone(), p.clone());
+    let (m, mut p) = (m.clone(), p.clone());
+    p.file_name = dest.file_name().unwrap().to_string_lossy().to_string();
     job::spawn_file(dest.to_path_buf(), "test".into(), move |ctx| {
         export_gcvf(&m, &p, ctx)
     })
