@@ -76,6 +76,9 @@ pub struct GcvfParams {
     pub threads: Option<usize>,
     /// The archive's file name inside the job's folder.
     pub file_name: String,
+    /// Remove the liquid (`M.Cleanser`) within this distance (mm) of the
+    /// surface (see [`crate::keep_out`]).
+    pub liquid_keep_out: Option<f64>,
 }
 
 impl GcvfParams {
@@ -87,6 +90,7 @@ impl GcvfParams {
             layers: None,
             per_material_bitmaps: false,
             threads: self.threads,
+            liquid_keep_out: self.liquid_keep_out,
         }
     }
 }
@@ -94,7 +98,10 @@ impl GcvfParams {
 /// The package's grid and size, and its resins; refuses what GrabCAD
 /// cannot take: a material the J750 table lacks (unless mapped), more
 /// than [`MAX_RESINS`] resins, more layers than a 16-bit z-buffer holds.
-pub fn estimate(model: &Model, p: &GcvfParams) -> Result<(Estimate, Vec<PrinterMaterial>), ExportError> {
+pub fn estimate(
+    model: &Model,
+    p: &GcvfParams,
+) -> Result<(Estimate, Vec<PrinterMaterial>), ExportError> {
     let mats = resolve(model, &MaterialTable::j750(), &p.map, "J750")?;
     if mats.len() > MAX_RESINS {
         let names: Vec<&str> = mats.iter().map(|m| m.name.as_str()).collect();
@@ -112,16 +119,18 @@ pub fn estimate(model: &Model, p: &GcvfParams) -> Result<(Estimate, Vec<PrinterM
     if nz > usize::from(u16::MAX) + 1 {
         return Err(ExportError::param(
             "--voxel",
-            format!(
-                "{nz} layers; the z-buffer holds at most 65536: use a thicker layer"
-            ),
+            format!("{nz} layers; the z-buffer holds at most 65536: use a thicker layer"),
         ));
     }
     Ok((est, mats))
 }
 
 /// Write the package into `ctx.staging()` as `p.file_name`.
-pub fn export_gcvf(model: &Model, p: &GcvfParams, ctx: &JobContext) -> Result<Summary, ExportError> {
+pub fn export_gcvf(
+    model: &Model,
+    p: &GcvfParams,
+    ctx: &JobContext,
+) -> Result<Summary, ExportError> {
     let (est, mats) = estimate(model, p)?;
     check_disk(est.disk_bytes, ctx.folder(), "a larger voxel size")?;
     run_with_threads(p.threads, || write_package(model, p, &est, &mats, ctx))
@@ -182,23 +191,33 @@ fn write_package(
                 for (t, c) in counts.iter_mut().zip(n) {
                     *t += c;
                 }
-                ctx.progress("slicing", *z as u64 + 1, nz as u64, "layers", (*z + 1) as f64 / nz as f64 * 0.95);
+                ctx.progress(
+                    "slicing",
+                    *z as u64 + 1,
+                    nz as u64,
+                    "layers",
+                    (*z + 1) as f64 / nz as f64 * 0.95,
+                );
             }
         }
         Ok(())
     })?;
     ctx.check_cancel()?;
-    let zbuf = zbuffer_png(&top, nx, ny).map_err(|e| ExportError::Other(format!("Zbuffer.png: {e}")))?;
+    let zbuf =
+        zbuffer_png(&top, nx, ny).map_err(|e| ExportError::Other(format!("Zbuffer.png: {e}")))?;
     zip.stored("Zbuffer.png", &zbuf).map_err(io)?;
     ctx.progress("mesh", 0, 1, "meshes", 0.96);
     let mesh = preview_mesh(model, est, ctx)?;
-    zip.entry("Mesh.stl", false, |w| write_stl(&mesh, "GCVF part surface", w))
-        .map_err(io)?;
+    zip.entry("Mesh.stl", false, |w| {
+        write_stl(&mesh, "GCVF part surface", w)
+    })
+    .map_err(io)?;
     let bbx: Vec<u8> = [0.0, 0.0, 0.0, nx as f32, ny as f32, nz as f32]
         .iter()
         .flat_map(|v: &f32| v.to_le_bytes())
         .collect();
-    zip.entry("MeshBbx.ktn", false, |w| w.write_all(&bbx)).map_err(io)?;
+    zip.entry("MeshBbx.ktn", false, |w| w.write_all(&bbx))
+        .map_err(io)?;
     let xml = config_xml(est, mats, &counts);
     zip.entry("ConfigFile.xml", false, |w| w.write_all(xml.as_bytes()))
         .map_err(io)?;
@@ -312,7 +331,9 @@ fn config_xml(est: &Estimate, mats: &[PrinterMaterial], counts: &[u64]) -> Strin
 }
 
 fn xml_escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
 }
 
 fn summary(p: &GcvfParams, est: &Estimate, mats: &[PrinterMaterial], counts: Vec<u64>) -> Summary {
@@ -333,7 +354,11 @@ fn summary(p: &GcvfParams, est: &Estimate, mats: &[PrinterMaterial], counts: Vec
         if m.name != m.design_name {
             notes.push(format!("{} printed as {}", m.design_name, m.name));
         }
-        notes.push(format!("{}: {c} voxels = {:.3} mm³", m.name, *c as f64 * v.x * v.y * v.z));
+        notes.push(format!(
+            "{}: {c} voxels = {:.3} mm³",
+            m.name,
+            *c as f64 * v.x * v.y * v.z
+        ));
     }
     Summary {
         kind: "gcvf".into(),
@@ -346,6 +371,7 @@ fn summary(p: &GcvfParams, est: &Estimate, mats: &[PrinterMaterial], counts: Vec
             "seed": p.seed,
             "dither": p.dither.name(),
             "map": p.map,
+            "liquid_keep_out_mm": p.liquid_keep_out,
             "grid": { "dims": [nx, ny, nz], "origin_mm": est.grid.origin.to_array() },
             "orientation": "column 0 = max X, row 0 = min Y, layer 0 = lowest Z",
         }),

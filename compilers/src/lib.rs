@@ -14,6 +14,7 @@
 pub mod fea;
 pub mod gcvf;
 pub mod job;
+pub mod keep_out;
 pub mod lazy_random;
 
 pub mod design;
@@ -25,8 +26,8 @@ pub mod png_stack;
 mod presets;
 pub mod printer_table;
 mod probe;
-pub mod slice_image;
 pub mod resources;
+pub mod slice_image;
 pub mod thin;
 mod union_find;
 pub mod zip_writer;

@@ -96,7 +96,14 @@ pub fn encode_gray(
     data: &[u8],
     pixel: Option<PixelsPerMetre>,
 ) -> Result<Vec<u8>, png::EncodingError> {
-    encode(width, height, ColorType::Grayscale, BitDepth::Eight, data, pixel)
+    encode(
+        width,
+        height,
+        ColorType::Grayscale,
+        BitDepth::Eight,
+        data,
+        pixel,
+    )
 }
 
 /// A 16-bit grayscale image: one big-endian `u16` a pixel (as PNG stores
@@ -107,7 +114,14 @@ pub fn encode_gray16(
     data: &[u16],
 ) -> Result<Vec<u8>, png::EncodingError> {
     let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_be_bytes()).collect();
-    encode(width, height, ColorType::Grayscale, BitDepth::Sixteen, &bytes, None)
+    encode(
+        width,
+        height,
+        ColorType::Grayscale,
+        BitDepth::Sixteen,
+        &bytes,
+        None,
+    )
 }
 
 /// Bytes per row of a 1-bit image.
@@ -123,7 +137,14 @@ pub fn encode_bits(
     data: &[u8],
     pixel: Option<PixelsPerMetre>,
 ) -> Result<Vec<u8>, png::EncodingError> {
-    encode(width, height, ColorType::Grayscale, BitDepth::One, data, pixel)
+    encode(
+        width,
+        height,
+        ColorType::Grayscale,
+        BitDepth::One,
+        data,
+        pixel,
+    )
 }
 
 #[cfg(test)]

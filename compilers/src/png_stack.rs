@@ -47,12 +47,13 @@ use volcad_core::sampler::{Grid, Sampler, Slab};
 use crate::design::{grid_for, palette};
 use crate::dither::{self, Diffuser};
 use crate::job::{ExportError, JobContext, Summary};
+use crate::keep_out;
 use crate::lazy_random;
 use crate::png_io::{self, PixelsPerMetre};
-use crate::slice_image::{ImageStyle, Orientation, bitmap_png, rgba_png};
 pub use crate::presets::{Preset, preset, presets};
 use crate::probe::{Look, probe, sampled_layers};
 use crate::resources::{check_disk, check_memory, run_with_threads};
+use crate::slice_image::{ImageStyle, Orientation, bitmap_png, rgba_png};
 
 /// How each voxel's material is chosen from its fractions.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -89,6 +90,9 @@ pub struct PngParams {
     pub per_material_bitmaps: bool,
     /// Worker threads (`None`: all cores).
     pub threads: Option<usize>,
+    /// Remove the liquid material within this distance (mm) of the
+    /// surface (see [`crate::keep_out`]).
+    pub liquid_keep_out: Option<f64>,
 }
 
 impl Default for PngParams {
@@ -101,6 +105,7 @@ impl Default for PngParams {
             layers: None,
             per_material_bitmaps: false,
             threads: None,
+            liquid_keep_out: None,
         }
     }
 }
@@ -144,6 +149,7 @@ pub fn estimate(model: &Model, p: &PngParams) -> Result<Estimate, ExportError> {
 
 fn estimate_with(model: &Model, p: &PngParams, look: Look) -> Result<Estimate, ExportError> {
     let pal = palette(model)?;
+    keep_out::plan(model, p.liquid_keep_out)?;
     let grid = grid_for(model, p.voxel, 0.0)?;
     let [nx, ny, nz] = grid.dims;
     let layers = match &p.layers {
@@ -332,10 +338,15 @@ pub(crate) fn for_each_slab(
     let [nx, ny, _] = grid.dims;
     let layer = nx * ny;
     let k = model.materials().len();
-    let single = single_material_code(model);
+    let keep = keep_out::plan(model, p.liquid_keep_out)?;
+    // Keep-out needs every voxel's distance and fractions.
+    let single = single_material_code(model).filter(|_| keep.is_none());
     let mut diffuser =
         (p.dither == Dither::Diffusion && single.is_none()).then(|| Diffuser::new(nx, ny, k));
-    let sampler = stack_sampler(model, grid, single, diffuser.is_some());
+    let sampler = match keep {
+        Some(_) => Sampler::new(model, grid, true),
+        None => stack_sampler(model, grid, single, diffuser.is_some()),
+    };
     let first = if diffuser.is_some() {
         Diffuser::warmup_start(est.layers.start)
     } else {
@@ -350,6 +361,9 @@ pub(crate) fn for_each_slab(
         sampler
             .sample_layers(z0, z1, &mut slab, ctx.cancel_flag())
             .map_err(|_| ExportError::Cancelled)?;
+        if let Some(keep) = &keep {
+            keep_out::apply(keep, model, &grid, z0, &mut slab.dist, &mut slab.fracs);
+        }
         let codes = &mut codes[..(z1 - z0) * layer];
         match diffuser.as_mut() {
             Some(d) => {
@@ -487,7 +501,9 @@ fn sampled_bytes(
         bytes += rgba_png(nx, ny, &codes, pal, style).ok()?.len();
         if p.per_material_bitmaps {
             for code in 1..=k as u8 {
-                bytes += bitmap_png(nx, ny, &codes, code, &mut bits, style).ok()?.len();
+                bytes += bitmap_png(nx, ny, &codes, code, &mut bits, style)
+                    .ok()?
+                    .len();
             }
         }
     }
@@ -593,6 +609,7 @@ fn summary(
             "layers": [est.layers.start, est.layers.end],
             "grid": { "dims": [nx, ny, nz], "origin_mm": o.to_array() },
             "per_material_bitmaps": p.per_material_bitmaps,
+            "liquid_keep_out_mm": p.liquid_keep_out,
             "orientation": "column 0 = min X, row 0 = max Y, layer 0 = lowest Z",
         }),
         notes,

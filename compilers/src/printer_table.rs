@@ -51,7 +51,11 @@ pub fn resolve(
     printer: &str,
 ) -> Result<Vec<PrinterMaterial>, ExportError> {
     let design = model.table();
-    let names: Vec<&str> = model.materials().iter().map(|id| design.name(*id)).collect();
+    let names: Vec<&str> = model
+        .materials()
+        .iter()
+        .map(|id| design.name(*id))
+        .collect();
     let mut problems = Vec::new();
     for (from, to) in map {
         if !names.contains(&from.as_str()) {
@@ -99,7 +103,10 @@ pub fn resolve(
 
 fn design_rgba(model: &Model, name: &str) -> [u8; 4] {
     let t = model.table();
-    t.id(name).ok().and_then(|id| t.get(id)).map_or([0; 4], |m| m.rgba())
+    t.id(name)
+        .ok()
+        .and_then(|id| t.get(id))
+        .map_or([0; 4], |m| m.rgba())
 }
 
 /// The `n` names of `table` nearest to `rgba` (squared RGB distance; ties
@@ -118,7 +125,10 @@ pub fn nearest_by_colour(table: &MaterialTable, rgba: [u8; 4], n: usize) -> Vec<
         .map(|(i, m)| (d(m.rgba()), i, m.name.as_str()))
         .collect();
     all.sort();
-    all.into_iter().take(n).map(|(.., s)| s.to_owned()).collect()
+    all.into_iter()
+        .take(n)
+        .map(|(.., s)| s.to_owned())
+        .collect()
 }
 
 /// `model` relabelled with the printer's names and colours (same ids, so

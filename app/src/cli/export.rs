@@ -70,6 +70,9 @@ pub struct ExportArgs {
     /// gcvf, and png with --preset j750: design material = J750 resin, e.g. red=VeroMgnt,blue=VeroCyan.
     #[arg(long)]
     pub map: Option<String>,
+    /// png, gcvf: remove the material named liquid (J750: M.Cleanser) within this many mm of the surface.
+    #[arg(long, allow_negative_numbers = true)]
+    pub liquid_keep_out: Option<f64>,
     /// mesh: number of fraction ranges with `--by MATERIAL` (default 4).
     #[arg(long, allow_negative_numbers = true)]
     pub segments: Option<usize>,
@@ -210,8 +213,17 @@ fn parse_formats(s: &str) -> anyhow::Result<MeshFormats> {
 fn foreign_options(a: &ExportArgs) -> Vec<&'static str> {
     let given = [
         ("--layers", a.layers.is_some(), Kind::Png),
-        ("--dither", a.dither.is_some() && a.kind != Kind::Gcvf, Kind::Png),
+        (
+            "--dither",
+            a.dither.is_some() && a.kind != Kind::Gcvf,
+            Kind::Png,
+        ),
         ("--bitmaps", a.bitmaps, Kind::Png),
+        (
+            "--liquid-keep-out",
+            a.liquid_keep_out.is_some() && a.kind != Kind::Gcvf,
+            Kind::Png,
+        ),
         ("--segments", a.segments.is_some(), Kind::Mesh),
         ("--by", a.by.is_some(), Kind::Mesh),
         ("--infill", a.infill.is_some(), Kind::Mesh),
@@ -338,6 +350,7 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
                 layers: a.layers.as_deref().map(parse_layers).transpose()?,
                 per_material_bitmaps: a.bitmaps,
                 threads,
+                liquid_keep_out: a.liquid_keep_out,
             };
             let est = png_stack::estimate(&model, &p)?;
             let [nx, ny, nz] = est.grid.dims;

@@ -3,6 +3,7 @@
 //! `--preset j750` brings to PNG stacks (`--map red=VeroMgnt`).
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use anyhow::{Context, bail};
 use glam::DVec3;
@@ -24,23 +25,25 @@ fn is_j750(preset: Option<&str>) -> bool {
 /// The design as a PNG stack writes it: with `--preset j750`, relabelled
 /// with J750 resins (refused when a material is not one and `--map` does
 /// not make it one); otherwise unchanged.
-pub(super) fn printer_model(a: &ExportArgs, model: Model) -> anyhow::Result<Model> {
+pub(super) fn printer_model(a: &ExportArgs, model: Arc<Model>) -> anyhow::Result<Arc<Model>> {
     if !is_j750(a.preset.as_deref()) {
         if let Some(m) = &a.map {
-            bail!("--map {m}: maps onto a printer's resins, so it needs --preset j750 (or `volcad export gcvf`)");
+            bail!(
+                "--map {m}: maps onto a printer's resins, so it needs --preset j750 (or `volcad export gcvf`)"
+            );
         }
         return Ok(model);
     }
     let map = parse_map(a.map.as_deref().unwrap_or(""))?;
     let table = MaterialTable::j750();
     let mats = resolve(&model, &table, &map, "J750")?;
-    Ok(relabel(&model, &mats, &table, "J750"))
+    Ok(Arc::new(relabel(&model, &mats, &table, "J750")))
 }
 
 /// Check everything and start the package's job (see [`gcvf`]).
 pub(super) fn start(
     a: &ExportArgs,
-    model: Model,
+    model: Arc<Model>,
     voxel: Option<DVec3>,
     hash: String,
     dest: PathBuf,
@@ -69,6 +72,7 @@ pub(super) fn start(
         map: parse_map(a.map.as_deref().unwrap_or(""))?,
         threads: a.threads,
         file_name,
+        liquid_keep_out: a.liquid_keep_out,
     };
     let (est, _) = gcvf::estimate(&model, &p)?;
     let [nx, ny, nz] = est.grid.dims;
