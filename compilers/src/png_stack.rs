@@ -516,6 +516,7 @@ fn sampled_bytes(
 }
 
 /// Colour, encode and write layer `z` from its codes; count its materials.
+#[allow(clippy::too_many_arguments)]
 fn write_layer(
     ctx: &JobContext,
     [nx, ny]: [usize; 2],
