@@ -88,6 +88,7 @@ impl GcvfParams {
             seed: self.seed,
             dither: self.dither,
             layers: None,
+            shard: None,
             per_material_bitmaps: false,
             threads: self.threads,
             liquid_keep_out: self.liquid_keep_out,

@@ -16,7 +16,7 @@ use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// One progress report.
 #[derive(Clone, Debug, PartialEq)]
@@ -89,8 +89,9 @@ impl ExportError {
     }
 }
 
-/// What a finished job reports, and what goes into `manifest.json`.
-#[derive(Clone, Debug, Default, Serialize)]
+/// What a finished job reports, and what goes into `manifest.json` (read
+/// back by [`crate::shard`]'s merge).
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct Summary {
     /// Export kind ("png", "mesh", "fea").
     pub kind: String,

@@ -9,6 +9,7 @@
 //! * [`gcvf`]: GrabCAD Voxel Print packages for PolyJet printers.
 //! * [`mesh`]: segmented meshes (STL, OBJ, one 3MF with per-part settings).
 //! * [`fea`]: Abaqus/CalculiX `.inp` meshes (C3D8R bricks, adaptive C3D4 tets).
+//! * [`shard`]: layer stacks split into N layer ranges and merged back.
 #![warn(missing_docs)]
 
 pub mod fea;
@@ -19,14 +20,15 @@ pub mod lazy_random;
 
 pub mod design;
 pub mod dither;
+mod estimate;
 pub mod mesh;
 pub mod par_deflate;
 pub mod png_io;
 pub mod png_stack;
 mod presets;
 pub mod printer_table;
-mod probe;
 pub mod resources;
+pub mod shard;
 pub mod slice_image;
 pub mod thin;
 mod union_find;

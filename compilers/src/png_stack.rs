@@ -12,7 +12,8 @@
 //! * `slice_00000.png` … one 8-bit RGBA PNG per layer, named by its *global*
 //!   layer index (zero padded to at least 5 digits, more when the grid has
 //!   ≥ 100 000 layers); layer 0 is the lowest Z. Parts of a job exported
-//!   with different `layers` ranges merge by copying files into one folder.
+//!   with different `layers` ranges (or `shard`s) hold the single export's
+//!   files; [`crate::shard`] merges them, manifest included.
 //! * Pixel = the material's colour from the material table; void is
 //!   transparent `(0, 0, 0, 0)`. Each PNG's `pHYs` chunk holds the voxel's
 //!   X and Y size, so image tools show the layer at its printed size.
@@ -46,13 +47,14 @@ use volcad_core::sampler::{Grid, Sampler, Slab};
 
 use crate::design::{grid_for, palette};
 use crate::dither::{self, Diffuser};
+use crate::estimate::{Look, coarse_estimate, sampled_layers};
 use crate::job::{ExportError, JobContext, Summary};
 use crate::keep_out;
 use crate::lazy_random;
 use crate::png_io::{self, PixelsPerMetre};
 pub use crate::presets::{Preset, preset, presets};
-use crate::probe::{Look, probe, sampled_layers};
 use crate::resources::{check_disk, check_memory, run_with_threads};
+use crate::shard::{Part, Shard};
 use crate::slice_image::{ImageStyle, Orientation, bitmap_png, rgba_png};
 
 /// How each voxel's material is chosen from its fractions.
@@ -86,6 +88,9 @@ pub struct PngParams {
     pub dither: Dither,
     /// Global layers to write (`None`: all).
     pub layers: Option<Range<usize>>,
+    /// Write only this shard's layers (K-th of N equal ranges, see
+    /// [`crate::shard`]); exclusive with `layers`.
+    pub shard: Option<Shard>,
     /// Also write one folder of 1-bit PNGs per material.
     pub per_material_bitmaps: bool,
     /// Worker threads (`None`: all cores).
@@ -103,6 +108,7 @@ impl Default for PngParams {
             seed: 0,
             dither: Dither::Random,
             layers: None,
+            shard: None,
             per_material_bitmaps: false,
             threads: None,
             liquid_keep_out: None,
@@ -152,10 +158,17 @@ fn estimate_with(model: &Model, p: &PngParams, look: Look) -> Result<Estimate, E
     keep_out::plan(model, p.liquid_keep_out)?;
     let grid = grid_for(model, p.voxel, 0.0)?;
     let [nx, ny, nz] = grid.dims;
-    let layers = match &p.layers {
-        None => 0..nz,
-        Some(r) if r.start < r.end && r.end <= nz => r.clone(),
-        Some(r) => {
+    let layers = match (&p.layers, p.shard) {
+        (Some(_), Some(s)) => {
+            return Err(ExportError::param(
+                "--shard",
+                format!("{s} and --layers both choose layers; give one of them"),
+            ));
+        }
+        (None, Some(s)) => s.layers(nz)?,
+        (None, None) => 0..nz,
+        (Some(r), None) if r.start < r.end && r.end <= nz => r.clone(),
+        (Some(r), None) => {
             return Err(ExportError::param(
                 "--layers",
                 format!(
@@ -193,7 +206,7 @@ fn estimate_with(model: &Model, p: &PngParams, look: Look) -> Result<Estimate, E
     // Rough output: pure material compresses to almost nothing, a two-way
     // mix to 0.7 (random) or 0.85 (diffusion) bytes per voxel (measured on
     // the graded bar at 0.02 mm), plus a row's worth and a header per file.
-    let pr = probe(model, p.voxel);
+    let pr = coarse_estimate(model, p.voxel);
     let mixed_bytes = match p.dither {
         Dither::Random => 0.7,
         Dither::Diffusion => 0.85,
@@ -211,7 +224,7 @@ fn estimate_with(model: &Model, p: &PngParams, look: Look) -> Result<Estimate, E
     // what it cannot.
     let sampled = match look {
         Look::Layers => sampled_bytes(model, p, grid, &layers, &pal),
-        Look::Probe => None,
+        Look::Coarse => None,
     };
     let disk = match sampled {
         Some(b) => disk.max(b as f64),
@@ -234,7 +247,7 @@ pub fn export_png_stack(
     p: &PngParams,
     ctx: &JobContext,
 ) -> Result<Summary, ExportError> {
-    let est = estimate_with(model, p, Look::Probe)?;
+    let est = estimate_with(model, p, Look::Coarse)?;
     check_disk(est.disk_bytes, ctx.folder(), "a larger voxel size")?;
     run_with_threads(p.threads, || write_stack(model, p, &est, ctx))
 }
@@ -560,60 +573,105 @@ fn summary(
 ) -> Summary {
     let [nx, ny, nz] = est.grid.dims;
     let table = model.table();
-    let voxel_mm3 = est.grid.voxel.x * est.grid.voxel.y * est.grid.voxel.z;
     let counts: Vec<(String, u64)> = model
         .materials()
         .iter()
         .zip(counts)
         .map(|(id, c)| (table.name(*id).to_owned(), c))
         .collect();
-    let mut notes = vec![
-        format!(
-            "{} layer(s) {}..{} of {nz}, {nx} × {ny} px each",
-            est.layers.len(),
-            est.layers.start,
-            est.layers.end
-        ),
-        "orientation: column 0 = min X, row 0 = max Y (top view), layer 0 = lowest Z".to_owned(),
-        // No working-memory figure: it grows with the thread count, and
-        // the notes go into the manifest, which must not (the command line
-        // prints the estimate before it starts).
-    ];
-    for (name, c) in &counts {
-        notes.push(format!(
-            "{name}: {c} voxels = {:.3} mm³",
-            *c as f64 * voxel_mm3
-        ));
-    }
-    notes.extend(crate::thin::thin_feature_notes(
-        model,
-        est.grid.voxel.max_element(),
-        "--voxel",
-    ));
-    if counts.iter().all(|(_, c)| *c == 0) {
-        notes.push(
-            "warning: no voxel centre is inside the design, so every slice is blank (the part is empty, or thinner than a voxel)"
-                .to_owned(),
-        );
-    }
+    let design_notes =
+        crate::thin::thin_feature_notes(model, est.grid.voxel.max_element(), "--voxel");
+    let g = est.grid;
+    let notes = stack_notes(g.dims, g.voxel, &est.layers, &counts, design_notes);
     let o = est.grid.origin;
+    let mut parameters = json!({
+        "voxel_mm": est.grid.voxel.to_array(),
+        "seed": p.seed,
+        "dither": p.dither.name(),
+        "layers": [est.layers.start, est.layers.end],
+        "grid": { "dims": [nx, ny, nz], "origin_mm": o.to_array() },
+        "per_material_bitmaps": p.per_material_bitmaps,
+        "liquid_keep_out_mm": p.liquid_keep_out,
+        "orientation": "column 0 = min X, row 0 = max Y, layer 0 = lowest Z",
+    });
+    if let Some(s) = p.shard {
+        parameters["shard"] = s.to_json();
+    }
     Summary {
         kind: "png".into(),
         files,
         counts,
         units: est.voxels,
         unit: "voxels".into(),
-        parameters: json!({
-            "voxel_mm": est.grid.voxel.to_array(),
-            "seed": p.seed,
-            "dither": p.dither.name(),
-            "layers": [est.layers.start, est.layers.end],
-            "grid": { "dims": [nx, ny, nz], "origin_mm": o.to_array() },
-            "per_material_bitmaps": p.per_material_bitmaps,
-            "liquid_keep_out_mm": p.liquid_keep_out,
-            "orientation": "column 0 = min X, row 0 = max Y, layer 0 = lowest Z",
-        }),
+        parameters,
         notes,
         seconds: 0.0,
     }
+}
+
+/// The notes of a stack's manifest: its layer range, orientation and
+/// volume per material, then `design_notes` (what the design alone
+/// decides: thin features), then a warning when every slice is blank.
+/// [`crate::shard`] rebuilds the whole stack's notes from its shards'
+/// with it, so a merged manifest reads as the single export's.
+fn stack_notes(
+    [nx, ny, nz]: [usize; 3],
+    voxel: DVec3,
+    layers: &Range<usize>,
+    counts: &[(String, u64)],
+    design_notes: Vec<String>,
+) -> Vec<String> {
+    let voxel_mm3 = voxel.x * voxel.y * voxel.z;
+    let mut notes = vec![
+        format!(
+            "{} layer(s) {}..{} of {nz}, {nx} × {ny} px each",
+            layers.len(),
+            layers.start,
+            layers.end
+        ),
+        "orientation: column 0 = min X, row 0 = max Y (top view), layer 0 = lowest Z".to_owned(),
+        // No working-memory figure: it grows with the thread count, and
+        // the notes go into the manifest, which must not (the command line
+        // prints the estimate before it starts).
+    ];
+    for (name, c) in counts {
+        notes.push(format!(
+            "{name}: {c} voxels = {:.3} mm³",
+            *c as f64 * voxel_mm3
+        ));
+    }
+    notes.extend(design_notes);
+    if counts.iter().all(|(_, c)| *c == 0) {
+        notes.push(
+            "warning: no voxel centre is inside the design, so every slice is blank (the part is empty, or thinner than a voxel)"
+                .to_owned(),
+        );
+    }
+    notes
+}
+
+/// The notes of `layers` holding `counts`, with the design notes of `part`
+/// (a shard of the same stack); `None` when `part`'s notes are not the ones
+/// this version writes (then its design notes cannot be told apart).
+pub(crate) fn merged_notes(
+    part: &Part,
+    layers: &Range<usize>,
+    counts: &[(String, u64)],
+) -> Option<Vec<String>> {
+    let own = stack_notes(
+        part.dims,
+        part.voxel,
+        &part.layers,
+        &part.summary.counts,
+        Vec::new(),
+    );
+    let notes = &part.summary.notes;
+    let head = 2 + part.summary.counts.len();
+    let tail = own.len().checked_sub(head)?;
+    let design_end = notes.len().checked_sub(tail)?;
+    if design_end < head || notes[..head] != own[..head] || notes[design_end..] != own[head..] {
+        return None;
+    }
+    let design = notes[head..design_end].to_vec();
+    Some(stack_notes(part.dims, part.voxel, layers, counts, design))
 }

@@ -13,13 +13,12 @@
 //! Agilus30 0.383 MPa / 0.5 (written as 0.49).
 
 use std::path::Path;
-use std::process::Command;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 mod common;
 
-use common::scratch;
+use common::{reaction, run_ccx, scratch};
 use volcad_compilers::fea::*;
 use volcad_compilers::job::{Summary, spawn};
 use volcad_core::Model;
@@ -48,61 +47,6 @@ fn export(model: &Arc<Model>, p: &FeaParams, dest: &Path) -> Summary {
     })
     .join()
     .unwrap()
-}
-
-/// Run `ccx -i <job>` in `dir`; false when ccx is absent and skipping is allowed.
-fn run_ccx(dir: &Path, job: &str) -> bool {
-    let out = Command::new("ccx")
-        .arg("-i")
-        .arg(job)
-        .current_dir(dir)
-        .env("OMP_NUM_THREADS", "1")
-        .output();
-    match out {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            if std::env::var("VOLCAD_SKIP_CCX").as_deref() == Ok("1") {
-                eprintln!("ccx not found; skipped (VOLCAD_SKIP_CCX=1)");
-                return false;
-            }
-            panic!(
-                "ccx (CalculiX) is not installed: install calculix-ccx, or set VOLCAD_SKIP_CCX=1 to skip"
-            );
-        }
-        Err(e) => panic!("running ccx: {e}"),
-        Ok(o) => {
-            let text = String::from_utf8_lossy(&o.stdout);
-            assert!(
-                o.status.success(),
-                "ccx failed ({}):\n{text}\n{}",
-                o.status,
-                String::from_utf8_lossy(&o.stderr)
-            );
-            assert!(!text.contains("*ERROR"), "ccx reported an error:\n{text}");
-            assert!(
-                dir.join(format!("{job}.frd")).exists(),
-                "no {job}.frd:\n{text}"
-            );
-            true
-        }
-    }
-}
-
-/// `total force (fx,fy,fz) for set NBOTTOM` from the `.dat`.
-fn reaction(dat: &Path) -> Option<[f64; 3]> {
-    let text = std::fs::read_to_string(dat).ok()?;
-    let mut lines = text.lines();
-    while let Some(l) = lines.next() {
-        if l.contains("total force") {
-            let v: Vec<f64> = lines
-                .by_ref()
-                .find(|l| !l.trim().is_empty())?
-                .split_whitespace()
-                .filter_map(|t| t.parse().ok())
-                .collect();
-            return (v.len() >= 3).then(|| [v[0], v[1], v[2]]);
-        }
-    }
-    None
 }
 
 /// Check a ccx result of the bar: finite, nonzero, bottom fixed, top at TOP_UZ.

@@ -76,6 +76,9 @@ pub enum CapMode {
 pub struct Node {
     pub(crate) kind: Arc<NodeKind>,
     pub(crate) origin: Option<Origin>,
+    /// Property fields set on this node (`set_attribute`); `None` for
+    /// almost every node, so a handle stays three words.
+    pub(crate) attrs: Option<Arc<crate::attribute::NodeAttributes>>,
 }
 
 /// What a node is. Parameters are as the script gave them; validation of
@@ -187,7 +190,7 @@ pub enum NodeKind {
     Blend { radius: f64, child: Option<Node> },
     /// A triangle mesh as signed distance (mesh import).
     Mesh {
-        mesh: Arc<crate::mesh::TriangleMesh>,
+        mesh: Arc<crate::trimesh::TriangleMesh>,
         material: MaterialId,
     },
     /// An FEA result field driving fractions (SimulationField).
@@ -357,6 +360,7 @@ impl Node {
         Self {
             kind: Arc::new(kind),
             origin: None,
+            attrs: None,
         }
     }
 
@@ -365,6 +369,7 @@ impl Node {
         Self {
             kind: Arc::new(kind),
             origin,
+            attrs: None,
         }
     }
 
@@ -402,6 +407,22 @@ impl Node {
     /// write, so other handles to the same node are not changed.
     pub(crate) fn kind_mut(&mut self) -> &mut NodeKind {
         Arc::make_mut(&mut self.kind)
+    }
+
+    /// The attributes set on this node, if any.
+    pub fn attributes(&self) -> Option<&crate::attribute::NodeAttributes> {
+        self.attrs.as_deref()
+    }
+
+    /// The attributes for `set_attribute` to change (copy on write, as
+    /// [`Node::kind_mut`]).
+    pub fn attributes_mut(&mut self) -> &mut crate::attribute::NodeAttributes {
+        Arc::make_mut(self.attrs.get_or_insert_with(Default::default))
+    }
+
+    /// Identity of the attribute set (0 for none), beside [`Node::ptr`].
+    pub(crate) fn attrs_ptr(&self) -> usize {
+        self.attrs.as_ref().map_or(0, |a| Arc::as_ptr(a) as usize)
     }
 
     /// The identity of the shared node (for caches during prepare).

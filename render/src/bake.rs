@@ -27,6 +27,8 @@ use rayon::prelude::*;
 use volcad_core::sampler::{Cancelled, Grid, GridError, Sampler, Slab};
 use volcad_core::{Aabb, MaterialId, Model};
 
+use crate::attribute_bake::{AttributeEval, AttributeShading, shade};
+
 /// Material fractions stored per voxel (one `Rgba8Unorm` texel).
 pub const MAX_CHANNELS: usize = 4;
 
@@ -48,6 +50,9 @@ pub enum BakeError {
     /// The design cannot be put on a grid (unbounded, or too large).
     #[error(transparent)]
     Grid(#[from] GridError),
+    /// The shading attribute has a value outside its range.
+    #[error("attribute: {0}")]
+    Attribute(String),
 }
 
 impl From<Cancelled> for BakeError {
@@ -92,6 +97,9 @@ pub struct VolumeBake {
     /// True when the model's value was not a distance and the distance
     /// volume holds distances rebuilt from its sign (`redistance`).
     pub redistanced: bool,
+    /// In attribute mode, the range the scalar values were mapped over
+    /// (the fixed range, or the baked values' smallest and largest).
+    pub attribute_range: Option<[f64; 2]>,
 }
 
 impl VolumeBake {
@@ -147,6 +155,7 @@ impl VolumeBake {
             resolution: 0,
             bake_seconds: seconds,
             redistanced: false,
+            attribute_range: None,
         }
     }
 }
@@ -172,6 +181,17 @@ fn palette(model: &Model) -> Vec<[u8; 4]> {
 /// An empty design gives an empty bake (nothing drawn), an unbounded one an
 /// error.
 pub fn bake(model: &Model, resolution: u32, cancel: &AtomicBool) -> Result<VolumeBake, BakeError> {
+    bake_shaded(model, resolution, None, cancel)
+}
+
+/// [`bake`], with the colour volume from an attribute (see
+/// [`crate::attribute_bake`]) when `shading` is given.
+pub fn bake_shaded(
+    model: &Model,
+    resolution: u32,
+    shading: Option<(&AttributeShading, &AttributeEval<'_>)>,
+    cancel: &AtomicBool,
+) -> Result<VolumeBake, BakeError> {
     let start = Instant::now();
     let bbox = model.bbox();
     if bbox.is_empty() {
@@ -228,6 +248,13 @@ pub fn bake(model: &Model, resolution: u32, cancel: &AtomicBool) -> Result<Volum
             });
         z0 = z1;
     }
+    let attribute_range = match shading {
+        Some((shading, eval)) => {
+            let inside = |v: usize| half::f16::from_bits(distance[v]).to_f32() <= 0.0;
+            shade(&grid, &inside, shading, eval, &mut color, cancel)?
+        }
+        None => None,
+    };
     let redistanced = !model.distance_is_bound()
         && redistance_if_needed(&mut distance, grid.dims, voxel as f32, cancel)?;
     dilate(
@@ -254,6 +281,7 @@ pub fn bake(model: &Model, resolution: u32, cancel: &AtomicBool) -> Result<Volum
         resolution,
         bake_seconds: start.elapsed().as_secs_f32(),
         redistanced,
+        attribute_range,
     })
 }
 

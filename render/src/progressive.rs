@@ -12,7 +12,8 @@ use std::sync::{Arc, Mutex};
 
 use volcad_core::Model;
 
-use crate::bake::{BakeError, VolumeBake, bake};
+use crate::attribute_bake::AttributeShading;
+use crate::bake::{BakeError, VolumeBake, bake_shaded};
 
 /// Bakes a model at increasing resolutions in the background.
 pub struct ProgressiveBaker {
@@ -22,6 +23,7 @@ pub struct ProgressiveBaker {
     rx: Receiver<Arc<VolumeBake>>,
     levels: Vec<u32>,
     wake: Arc<dyn Fn() + Send + Sync>,
+    shading: Option<AttributeShading>,
 }
 
 /// The default levels: a coarse image fast, then detail.
@@ -36,26 +38,38 @@ impl ProgressiveBaker {
         levels: Vec<u32>,
         wake: impl Fn() + Send + Sync + 'static,
     ) -> Self {
-        Self::spawn(model, levels, Arc::new(wake))
+        Self::spawn(model, levels, Arc::new(wake), None)
     }
 
-    fn spawn(model: Arc<Model>, levels: Vec<u32>, wake: Arc<dyn Fn() + Send + Sync>) -> Self {
+    fn spawn(
+        model: Arc<Model>,
+        levels: Vec<u32>,
+        wake: Arc<dyn Fn() + Send + Sync>,
+        shading: Option<AttributeShading>,
+    ) -> Self {
         let cancel = Arc::new(AtomicBool::new(false));
         let done = Arc::new(AtomicBool::new(false));
         let error = Arc::new(Mutex::new(None));
         let (tx, rx) = sync_channel(levels.len().max(1));
-        let (c, d, e, w, lv) = (
+        let (c, d, e, w, lv, sh) = (
             cancel.clone(),
             done.clone(),
             error.clone(),
             wake.clone(),
             levels.clone(),
+            shading.clone(),
         );
         let spawned = std::thread::Builder::new()
             .name("volcad-bake".into())
             .spawn(move || {
+                let eval = |pts: volcad_core::Points<'_>, out: &mut [f64]| {
+                    let index = sh.as_ref().map_or(0, |s| s.index);
+                    model
+                        .attribute_batch(index, pts, out)
+                        .map_err(|e| e.to_string())
+                };
                 for level in lv {
-                    match bake(&model, level, &c) {
+                    match bake_shaded(&model, level, sh.as_ref().map(|s| (s, &eval as _)), &c) {
                         Ok(b) => {
                             if c.load(Ordering::Relaxed) || tx.send(Arc::new(b)).is_err() {
                                 break;
@@ -87,14 +101,27 @@ impl ProgressiveBaker {
             rx,
             levels,
             wake,
+            shading,
         }
     }
 
-    /// Cancel the bake in flight and start baking `model` (same levels and
-    /// wake function).
+    /// Cancel the bake in flight and start baking `model` (same levels,
+    /// wake function and shading).
     pub fn restart(&mut self, model: Arc<Model>) {
-        let next = Self::spawn(model, self.levels.clone(), self.wake.clone());
+        let shading = self.shading.clone();
+        self.restart_shaded(model, shading);
+    }
+
+    /// Cancel the bake in flight and bake `model` with its colour volume
+    /// from an attribute (`Some`) or the materials (`None`).
+    pub fn restart_shaded(&mut self, model: Arc<Model>, shading: Option<AttributeShading>) {
+        let next = Self::spawn(model, self.levels.clone(), self.wake.clone(), shading);
         *self = next; // drops the old baker, which cancels it
+    }
+
+    /// The shading of the bakes.
+    pub fn shading(&self) -> Option<&AttributeShading> {
+        self.shading.as_ref()
     }
 
     /// The next finished level, if one arrived (call every frame; upload it).

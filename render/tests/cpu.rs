@@ -1,4 +1,4 @@
-//! CPU-side behaviour: bakes, the progressive baker, the probe, the camera.
+//! CPU-side behaviour: bakes, the progressive baker, the pick, the camera.
 
 mod common;
 
@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 
 use common::*;
 use glam::{Vec2, Vec3};
-use volcad_render::{BakeError, Camera, CutPlane, ProgressiveBaker, StandardView, bake, probe};
+use volcad_render::{BakeError, Camera, CutPlane, ProgressiveBaker, StandardView, bake, pick};
 
 #[test]
 fn bake_covers_the_box_with_padding_and_colours() {
@@ -91,10 +91,10 @@ fn progressive_baker_restart_replaces_the_model() {
 }
 
 #[test]
-fn probe_hits_the_front_face_with_fractions() {
+fn pick_hits_the_front_face_with_fractions() {
     let model = model(GRADED_BAR);
     let cam = Camera::fit(&model.bbox(), StandardView::Front);
-    let hit = probe(&model, &cam, None, Vec2::ZERO, 1.5).expect("centre ray hits the bar");
+    let hit = pick(&model, &cam, None, Vec2::ZERO, 1.5).expect("centre ray hits the bar");
     assert!((hit.point.y + 5.0).abs() < 1e-3, "{:?}", hit.point);
     let total: f64 = hit.fractions.iter().map(|f| f.1).sum();
     assert!((total - 1.0).abs() < 1e-6);
@@ -103,14 +103,14 @@ fn probe_hits_the_front_face_with_fractions() {
         "{:?}",
         hit.fractions
     );
-    assert!(probe(&model, &cam, None, Vec2::new(0.99, 0.99), 1.5).is_none());
+    assert!(pick(&model, &cam, None, Vec2::new(0.99, 0.99), 1.5).is_none());
     // A cut at y = 0 keeping y >= 0 moves the hit to the cut face.
     let cut = CutPlane {
         axis: 1,
         offset: 0.0,
         keep_below: false,
     };
-    let hit = probe(&model, &cam, Some(&cut), Vec2::ZERO, 1.5).expect("hits the cut face");
+    let hit = pick(&model, &cam, Some(&cut), Vec2::ZERO, 1.5).expect("hits the cut face");
     assert!(hit.point.y.abs() < 1e-3, "{:?}", hit.point);
 }
 
@@ -189,4 +189,75 @@ fn more_than_four_materials_keep_four_fraction_channels() {
         "cyan sphere colour {c:?}"
     );
     assert_eq!(b.fractions[b.index(v.0, v.1, v.2)], [0; 4]);
+}
+
+/// Attribute mode: the colour volume follows the attribute through the
+/// colour map over the automatic range (the baked values' extremes), a
+/// fixed range clamps, vec4 values are their own colour, and errors stop
+/// the bake with their message.
+#[test]
+fn attribute_bake_maps_values_through_viridis() {
+    use volcad_render::attribute_bake::{AttributeEval, UNDEFINED};
+    use volcad_render::{AttributeShading, ColorMap, bake_shaded};
+    let model = model(GRADED_BAR);
+    let no = AtomicBool::new(false);
+    // The attribute is x (mm) on the 15 mm bar; NaN for x > 5 ("undefined").
+    let x_eval = |p: volcad_core::Points<'_>, out: &mut [f64]| {
+        for (o, x) in out.iter_mut().zip(p.x) {
+            *o = if *x > 5.0 { f64::NAN } else { *x };
+        }
+        Ok(())
+    };
+    let eval: &AttributeEval<'_> = &x_eval;
+    let mut s = AttributeShading {
+        index: 0,
+        width: 1,
+        range: None,
+        map: ColorMap::Viridis,
+    };
+    let b = bake_shaded(&model, 32, Some((&s, eval)), &no).unwrap();
+    let [lo, hi] = b.attribute_range.unwrap();
+    assert!(lo > -7.5 && lo < -7.0, "{lo}");
+    assert!(hi > 4.5 && hi <= 5.0, "{hi}");
+    let [nx, ny, nz] = b.dims;
+    let centre = |i: u32| b.color[b.index(i, ny / 2, nz / 2)];
+    // Voxel centre x of column i.
+    let x_of = |i: u32| b.origin.x + (i as f32 + 0.5) * b.voxel.x;
+    let i0 = (0..nx).find(|i| x_of(*i) > -7.0).unwrap();
+    let i1 = (0..nx).find(|i| x_of(*i) > 0.0).unwrap();
+    assert_eq!(
+        centre(i1),
+        ColorMap::Viridis.color_in(x_of(i1) as f64, lo, hi)
+    );
+    assert_eq!(
+        centre(i0),
+        ColorMap::Viridis.color_in(x_of(i0) as f64, lo, hi)
+    );
+    let i2 = (0..nx).find(|i| x_of(*i) > 6.0).unwrap();
+    assert_eq!(centre(i2), UNDEFINED);
+    // A fixed range: x = 0 is its top, so the top colour.
+    s.range = Some([-10.0, 0.0]);
+    let f = bake_shaded(&model, 32, Some((&s, eval)), &no).unwrap();
+    assert_eq!(f.attribute_range, Some([-10.0, 0.0]));
+    assert_eq!(
+        f.color[f.index(i1, ny / 2, nz / 2)],
+        ColorMap::Viridis.color(1.0)
+    );
+    // Colours as they are.
+    let red = |_p: volcad_core::Points<'_>, out: &mut [f64]| {
+        for c in out.chunks_mut(4) {
+            c.copy_from_slice(&[1.0, 0.0, 0.0, 1.0]);
+        }
+        Ok(())
+    };
+    s.width = 4;
+    let c = bake_shaded(&model, 32, Some((&s, &red)), &no).unwrap();
+    assert_eq!(c.color[c.index(i1, ny / 2, nz / 2)], [255, 0, 0, 255]);
+    assert_eq!(c.attribute_range, None);
+    // An evaluation error is the bake's error.
+    let bad = |_p: volcad_core::Points<'_>, _o: &mut [f64]| Err("modulus -3 < 0".to_string());
+    assert_eq!(
+        bake_shaded(&model, 32, Some((&s, &bad)), &no).unwrap_err(),
+        BakeError::Attribute("modulus -3 < 0".into())
+    );
 }

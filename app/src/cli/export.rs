@@ -1,7 +1,7 @@
-//! `volcad export png|mesh|fea` and `volcad fea-result`: run an export job
+//! `volcad export png|mesh|fea`: run an export job
 //! with a progress bar; Ctrl-C cancels cleanly (nothing is left behind).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::RecvTimeoutError;
@@ -15,6 +15,7 @@ use volcad_compilers::job::{self, design_hash};
 use volcad_compilers::mesh::{MeshFormats, MeshParams, SegmentBy};
 use volcad_compilers::png_stack::{self, Dither, PngParams};
 use volcad_compilers::resources::check_disk_for;
+use volcad_compilers::shard;
 use volcad_compilers::thin::thin_feature_notes;
 
 use super::DesignArgs;
@@ -61,6 +62,11 @@ pub struct ExportArgs {
     /// included); file names keep the global layer indices.
     #[arg(long)]
     pub layers: Option<String>,
+    /// png: only the K-th of N equal layer ranges (K counts from 1: 1/4 is
+    /// the lowest quarter, 4/4 the top); file names keep the global layer
+    /// indices, and `volcad merge` joins the N folders into the single export.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<String>,
     /// png: random (default) or diffusion.
     #[arg(long)]
     pub dither: Option<String>,
@@ -100,6 +106,9 @@ pub struct ExportArgs {
     /// fea: append a static step: bottom fixed, top displaced by this many mm in z.
     #[arg(long, allow_negative_numbers = true)]
     pub step: Option<f64>,
+    /// fea: with a `modulus` attribute, elastic sets per property (default 16).
+    #[arg(long, allow_negative_numbers = true)]
+    pub property_bins: Option<usize>,
     /// fea: end sets, pieces and solver memory.
     #[command(flatten)]
     pub fea_checks: Box<FeaChecks>,
@@ -233,6 +242,7 @@ fn foreign_options(a: &ExportArgs) -> Vec<&'static str> {
         ("--max-cell", a.max_cell.is_some(), Kind::Fea),
         ("--sizing", a.sizing.is_some(), Kind::Fea),
         ("--step", a.step.is_some(), Kind::Fea),
+        ("--property-bins", a.property_bins.is_some(), Kind::Fea),
         ("--fix-band", a.fea_checks.fix_band.is_some(), Kind::Fea),
         ("--fix", a.fea_checks.fix.is_some(), Kind::Fea),
         ("--load", a.fea_checks.load.is_some(), Kind::Fea),
@@ -304,6 +314,11 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
             if foreign.len() == 1 { "does" } else { "do" }
         );
     }
+    if a.shard.is_some() && a.kind != Kind::Png {
+        bail!(shard::not_shardable(
+            &format!("{:?}", a.kind).to_lowercase()
+        ));
+    }
     if a.kind == Kind::Fea {
         refuse_tet_options(a, parse_element(a.element.as_deref())?)?;
     }
@@ -323,10 +338,16 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
         ),
         (None, None) => None,
     };
-    let hash = design_hash(&[
-        l.source.as_bytes(),
-        format!("{:?}", a.design.params).as_bytes(),
-    ]);
+    // The values the script ran with (from --param and --params/--set
+    // alike, in declaration order): two runs with the same values share a
+    // hash, which `volcad merge` relies on to join their shards.
+    let values: Vec<String> = l
+        .design
+        .params
+        .iter()
+        .map(|p| format!("{}={:?}", p.name, p.value))
+        .collect();
+    let hash = design_hash(&[l.source.as_bytes(), values.join("\n").as_bytes()]);
     if let Some(t) = a.threads {
         volcad_compilers::resources::check_threads(t)?;
     }
@@ -348,6 +369,7 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
                 seed: a.seed,
                 dither,
                 layers: a.layers.as_deref().map(parse_layers).transpose()?,
+                shard: a.shard.as_deref().map(str::parse).transpose()?,
                 per_material_bitmaps: a.bitmaps,
                 threads,
                 liquid_keep_out: a.liquid_keep_out,
@@ -458,6 +480,7 @@ fn fea_params(
         max_cell: a.max_cell.unwrap_or(min_cell * 4.0),
         sizing: a.sizing.clone().map_or(Sizing::Heterogeneity, Sizing::Expr),
         seed: a.seed,
+        property_bins: a.property_bins,
         step: a.step.map(|d| StepParams {
             top_displacement: d,
         }),
@@ -573,19 +596,5 @@ pub(super) fn follow(handle: job::JobHandle, interrupted: &AtomicBool) -> anyhow
     for n in &summary.notes {
         outln!("  {n}");
     }
-    Ok(())
-}
-
-/// `volcad fea-result JOB.frd --inp JOB.inp --out result.csv` (`--out -`
-/// for standard output). The CSV is made in memory first: a deck that does
-/// not match the result leaves no file.
-pub fn fea_result(frd: &Path, inp: &Path, out: &Path) -> anyhow::Result<()> {
-    super::output::check_regular(frd, "CalculiX result (.frd)")?;
-    super::output::check_regular(inp, "deck (.inp)")?;
-    super::output::target(out, "--out")?;
-    let r = volcad_compilers::fea::read_frd(frd)?;
-    let (text, _) = volcad_compilers::fea::result_csv(&r, Some(inp))?;
-    super::output::write_output(out, "--out", |w| w.write_all(text.as_bytes()))?;
-    note!("{} nodes -> {}", r.displacements.len(), out.display());
     Ok(())
 }

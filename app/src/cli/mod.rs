@@ -20,10 +20,14 @@ macro_rules! note {
     }};
 }
 
+mod bench;
 mod design;
+mod eval;
 mod export;
+mod fea_result;
 mod gcvf;
 mod info;
+mod merge;
 mod output;
 mod render;
 mod sample;
@@ -107,11 +111,18 @@ pub enum Command {
         /// Output CSV (`-` for standard output).
         #[arg(long)]
         out: PathBuf,
+        /// Attribute columns to add, comma-separated (`modulus,color`; a
+        /// Vec3 gives `name.x name.y name.z`, a Vec4 `name.r` .. `name.a`).
+        #[arg(long, value_delimiter = ',')]
+        attributes: Vec<String>,
     },
     /// Render a view to a PNG (offscreen GPU, lavapipe where there is no GPU).
     Render(render::RenderArgs),
-    /// Export for printers, slicers and solvers.
-    Export(export::ExportArgs),
+    /// Export for printers, slicers and solvers (boxed: its options
+    /// outweigh every other command's).
+    Export(Box<export::ExportArgs>),
+    /// Join the folders of `volcad export png --shard K/N` into the single export.
+    Merge(merge::MergeArgs),
     /// Convert a CalculiX .frd result to CSV (`node_id,x,y,z,dx,dy,dz`).
     FeaResult {
         /// The .frd file.
@@ -124,23 +135,25 @@ pub enum Command {
         out: PathBuf,
     },
     /// Measure evaluation and export throughput on designs (points/s, voxels/s).
-    Bench(info::BenchArgs),
+    Bench(bench::BenchArgs),
 }
 
 /// Run a parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Info(d) => info::info(&d),
-        Command::Eval { design, x, y, z } => info::eval(&design, x, y, z),
+        Command::Eval { design, x, y, z } => eval::eval(&design, x, y, z),
         Command::Sample {
             design,
             points,
             out,
-        } => sample::sample(&design, &points, &out),
+            attributes,
+        } => sample::sample(&design, &points, &out, &attributes),
         Command::Render(a) => render::render(&a),
         Command::Export(a) => export::export(&a),
-        Command::FeaResult { frd, inp, out } => export::fea_result(&frd, &inp, &out),
-        Command::Bench(a) => info::bench(&a),
+        Command::Merge(a) => merge::merge(&a),
+        Command::FeaResult { frd, inp, out } => fea_result::fea_result(&frd, &inp, &out),
+        Command::Bench(a) => bench::bench(&a),
     }
 }
 

@@ -55,33 +55,60 @@ fn read_points(path: &Path) -> anyhow::Result<Vec<DVec3>> {
     Ok(pts)
 }
 
-/// `volcad sample DESIGN --points in.csv --out out.csv`.
-pub fn sample(args: &DesignArgs, points: &Path, out: &Path) -> anyhow::Result<()> {
+/// `volcad sample DESIGN --points in.csv --out out.csv [--attributes a,b]`.
+pub fn sample(
+    args: &DesignArgs,
+    points: &Path,
+    out: &Path,
+    attributes: &[String],
+) -> anyhow::Result<()> {
     // A folder or socket as --out is refused before the work, not after.
     target(out, "--out")?;
     let pts = read_points(points)?;
     let l = load_design(args)?;
     let model = &l.model;
+    let wanted = attributes
+        .iter()
+        .map(|a| model.require_attribute(a.trim()))
+        .collect::<Result<Vec<usize>, _>>()
+        .map_err(|e| anyhow::anyhow!("--attributes: {e}"))?;
     let k = model.materials().len();
     let rows: Vec<String> = pts
         .par_iter()
         .map_init(
             || vec![0.0; k],
-            |f, p| {
+            |f, p| -> anyhow::Result<String> {
                 let d = model.eval_into(*p, f);
                 let mut s = format!("{},{},{},{}", p.x, p.y, p.z, d);
                 for v in f.iter() {
                     s.push(',');
                     s.push_str(&v.to_string());
                 }
-                s
+                for &i in &wanted {
+                    let mut v = [0.0; 4];
+                    let v = &mut v[..model.attributes()[i].kind.width()];
+                    model.attribute_at(i, *p, v)?;
+                    for x in v.iter() {
+                        s.push(',');
+                        s.push_str(&x.to_string());
+                    }
+                }
+                Ok(s)
             },
         )
-        .collect();
+        .collect::<Vec<anyhow::Result<String>>>()
+        .into_iter()
+        // The first failing point in input order, whatever the threads did.
+        .collect::<anyhow::Result<_>>()?;
     write_output(out, "--out", |w| {
         write!(w, "x,y,z,distance")?;
         for id in model.materials() {
             write!(w, ",{}", model.table().name(*id))?;
+        }
+        for &i in &wanted {
+            for c in volcad_core::attribute::column_names(&model.attributes()[i]) {
+                write!(w, ",{c}")?;
+            }
         }
         writeln!(w)?;
         for r in &rows {

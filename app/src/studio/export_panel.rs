@@ -15,7 +15,7 @@ use std::sync::mpsc::{Receiver, Sender, channel};
 
 use glam::DVec3;
 use volcad_compilers::fea::solver::solver_bytes;
-use volcad_compilers::fea::{Element, FeaParams, Sizing, StepParams};
+use volcad_compilers::fea::{Element, FeaParams, Sizing, StepParams, property_bins};
 use volcad_compilers::job::{self, design_hash};
 use volcad_compilers::mesh::{MeshFormats, MeshParams, SegmentBy};
 use volcad_compilers::png_stack::{self, Dither, PngParams};
@@ -612,6 +612,20 @@ impl ExportPanels {
             let label = ui.label("FEA seed").id;
             ui.add(egui::DragValue::new(&mut self.fea.seed))
                 .labelled_by(label);
+            ui.end_row();
+            let label = ui.label("Property bins").id;
+            let mut bins = self
+                .fea
+                .property_bins
+                .unwrap_or(property_bins::DEFAULT_BINS);
+            let changed = ui
+                .add(egui::DragValue::new(&mut bins).range(1..=property_bins::MAX_BINS))
+                .labelled_by(label)
+                .on_hover_text("Elastic sets per property when the design has a modulus attribute")
+                .changed();
+            if changed || self.fea.property_bins.is_some() {
+                self.fea.property_bins = Some(bins);
+            }
             ui.end_row();
             ui.label("Static step");
             ui.horizontal(|ui| {

@@ -235,7 +235,7 @@ pub fn duration_text(d: Duration) -> String {
 /// A compiler's message in the panel's words: its command-line option
 /// names become the fields that set them (`--voxel` → "Voxel (mm)").
 pub fn in_panel_words(message: &str) -> String {
-    const FIELDS: [(&str, &str); 12] = [
+    const FIELDS: [(&str, &str); 13] = [
         ("--min-cell", "\"Cell min\""),
         ("--max-cell", "\"Cell max\""),
         ("--sizing", "\"Size of h\""),
@@ -248,6 +248,7 @@ pub fn in_panel_words(message: &str) -> String {
         ("--threads", "the thread count"),
         ("--layers", "the layer range"),
         ("--step", "\"Static step\""),
+        ("--property-bins", "\"Property bins\""),
     ];
     let mut m = message.to_owned();
     for (flag, field) in FIELDS {

@@ -69,5 +69,8 @@ pub fn probe_ui(ui: &mut egui::Ui, m: &Model, hovered: Option<&Probe>, pinned: O
         for (id, f) in &p.hit.fractions {
             ui.monospace(format!("{:>10}  {:.3}", m.table().name(*id), f));
         }
+        for a in &p.attributes {
+            ui.monospace(a.text());
+        }
     }
 }

@@ -20,6 +20,7 @@
 //! modals), `screenshot` (the `--screenshot` smoke test).
 #![warn(missing_docs)]
 
+pub mod attribute_view;
 mod browser;
 mod commands;
 pub mod completion;

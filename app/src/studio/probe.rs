@@ -1,5 +1,5 @@
 //! The probe: what is under the cursor, read exactly from the model (not the
-//! baked preview) by `volcad_render::probe`, on a worker thread so a big
+//! baked preview) by `volcad_render::pick`, on a worker thread so a big
 //! design never stalls a frame. One probe runs at a time; while it runs, only
 //! the newest request waits (hover requests replace each other; a click's
 //! request is never replaced by a hover).
@@ -9,7 +9,7 @@ use std::sync::mpsc::{Receiver, Sender, channel};
 
 use egui::Pos2;
 use volcad_core::Model;
-use volcad_render::{ProbeHit, Vec2, ViewSettings};
+use volcad_render::{PickHit, Vec2, ViewSettings};
 
 /// One probe to run.
 #[derive(Clone)]
@@ -33,19 +33,98 @@ pub struct Probe {
     /// Where the cursor was (screen points).
     pub pos: Pos2,
     /// The hit: point, depth from the eye, fractions.
-    pub hit: ProbeHit,
+    pub hit: PickHit,
     /// The model's signed distance at the hit point (mm; ≤ 0 on the part).
     pub surface_distance: f64,
+    /// Every attribute of the design at the hit point, in
+    /// `Model::attributes()` order.
+    pub attributes: Vec<AttributeReading>,
+}
+
+/// One attribute at the probe's point.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AttributeReading {
+    /// The attribute's name.
+    pub name: String,
+    /// Its value (`width` numbers; NaN where no node sets it), or why it
+    /// has none (a value outside its range).
+    pub value: Result<Vec<f64>, String>,
+}
+
+impl AttributeReading {
+    /// `name  value unit` for the read-out.
+    pub fn text(&self) -> String {
+        let unit = super::attribute_view::unit(&self.name);
+        let value = match &self.value {
+            Ok(v) if v.iter().all(|x| x.is_nan()) => "not set here".to_owned(),
+            Ok(v) => {
+                let parts: Vec<String> = v.iter().map(|x| super::attribute_view::fmt(*x)).collect();
+                let joined = parts.join(", ");
+                let shown = if v.len() > 1 {
+                    format!("({joined})")
+                } else {
+                    joined
+                };
+                if unit.is_empty() {
+                    shown
+                } else {
+                    format!("{shown} {unit}")
+                }
+            }
+            Err(e) => format!("error: {e}"),
+        };
+        format!("{}  {value}", self.name)
+    }
+}
+
+/// `p`, or where a surface hit found just outside the part is moved along
+/// the distance's gradient (central differences) to just inside, so the
+/// read-out shows the part's values rather than "not set".
+fn just_inside(model: &Model, p: glam::DVec3, d: f64) -> glam::DVec3 {
+    if d <= 0.0 || !d.is_finite() {
+        return p;
+    }
+    let h = (1e-4 * model.bbox().size().max_element()).max(1e-6);
+    let g = glam::DVec3::new(
+        model.distance(p + glam::DVec3::X * h) - model.distance(p - glam::DVec3::X * h),
+        model.distance(p + glam::DVec3::Y * h) - model.distance(p - glam::DVec3::Y * h),
+        model.distance(p + glam::DVec3::Z * h) - model.distance(p - glam::DVec3::Z * h),
+    );
+    p - g.normalize_or_zero() * (d + h)
+}
+
+/// Every attribute of `model` at `p`.
+pub fn attributes_at(model: &Model, p: glam::DVec3) -> Vec<AttributeReading> {
+    model
+        .attributes()
+        .iter()
+        .enumerate()
+        .map(|(i, a)| {
+            let mut out = vec![f64::NAN; a.kind.width()];
+            AttributeReading {
+                name: a.name.clone(),
+                value: model
+                    .attribute_at(i, p, &mut out)
+                    .map(|_| out)
+                    .map_err(|e| e.to_string()),
+            }
+        })
+        .collect()
 }
 
 /// Run one probe (the worker's job; also handy in tests).
 pub fn run(req: &ProbeRequest) -> Option<Probe> {
-    let hit = volcad_render::probe_drawn(&req.model, &req.view, req.ndc, req.aspect)?;
+    let hit = volcad_render::pick_drawn(&req.model, &req.view, req.ndc, req.aspect)?;
     let surface_distance = req.model.distance(hit.point);
+    let attributes = attributes_at(
+        &req.model,
+        just_inside(&req.model, hit.point, surface_distance),
+    );
     Some(Probe {
         pos: req.pos,
         hit,
         surface_distance,
+        attributes,
     })
 }
 

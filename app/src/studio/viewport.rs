@@ -4,7 +4,7 @@
 //! ```text
 //! Arc<Model> ──ProgressiveBaker (thread)──► try_recv each frame ──► Arc<VolumeBake> (generation n)
 //! UploadOnce callback: uploads bake n once (tracks the last uploaded generation), then draws
-//! hover/click ──ProbeWorker (thread, newest request wins)──► ProbeHit ──► read-out
+//! hover/click ──ProbeWorker (thread, newest request wins)──► PickHit ──► read-out
 //! ```
 
 use std::sync::Arc;
@@ -19,6 +19,7 @@ use volcad_render::{
     Camera, CutPlane, ProgressiveBaker, StandardView, ViewMode, ViewSettings, VolumeBake,
 };
 
+use super::attribute_view::{self, Shading};
 use super::legend;
 use super::probe::{Probe, ProbeWorker};
 
@@ -78,6 +79,8 @@ impl egui_wgpu::CallbackTrait for UploadOnce {
 pub struct Viewport {
     /// What to show (camera, mode, cut, opacity, overlays).
     pub settings: ViewSettings,
+    /// What colours the surface and the cut plane (materials or an attribute).
+    pub shading: Shading,
     model: Option<Arc<Model>>,
     baker: Option<ProgressiveBaker>,
     levels: Vec<u32>,
@@ -111,6 +114,7 @@ impl Viewport {
     pub fn new(has_gpu: bool, levels: Vec<u32>) -> Self {
         Self {
             settings: ViewSettings::default(),
+            shading: Shading::default(),
             model: None,
             baker: None,
             levels,
@@ -152,22 +156,34 @@ impl Viewport {
         if let ViewMode::Iso { material_index, .. } = &mut self.settings.mode {
             *material_index = (*material_index).min(n.saturating_sub(1));
         }
-        let ctx = ctx.clone();
-        match &mut self.baker {
-            Some(b) => b.restart(model.clone()),
-            None => {
-                self.baker = Some(ProgressiveBaker::start(
-                    model.clone(),
-                    self.levels.clone(),
-                    move || ctx.request_repaint(),
-                ))
-            }
-        }
-        self.bake_started = Some(Instant::now());
-        self.model = Some(model);
+        self.model = Some(model.clone());
+        self.rebake(ctx);
         self.stale = false;
         self.pinned = None;
         self.hovered = None;
+    }
+
+    /// Bake the model on screen again (a new model, or a new shading).
+    fn rebake(&mut self, ctx: &egui::Context) {
+        let Some(model) = self.model.clone() else {
+            return;
+        };
+        let shading = self.shading.for_model(&model);
+        let ctx = ctx.clone();
+        match &mut self.baker {
+            Some(b) => b.restart_shaded(model, shading),
+            None => {
+                let mut b =
+                    ProgressiveBaker::start(model.clone(), self.levels.clone(), move || {
+                        ctx.request_repaint()
+                    });
+                if shading.is_some() {
+                    b.restart_shaded(model, shading);
+                }
+                self.baker = Some(b);
+            }
+        }
+        self.bake_started = Some(Instant::now());
     }
 
     /// Fit the camera to the next model that arrives (after opening a
@@ -312,6 +328,10 @@ impl Viewport {
                 .on_hover_text(
                     "How opaque the volume is: more shows the outer layers, less sees deeper",
                 );
+            }
+            ui.separator();
+            if self.shading.picker_ui(ui, self.model.as_deref()) {
+                self.rebake(ui.ctx());
             }
             ui.separator();
             let mut cut_on = self.settings.cut.is_some();
@@ -559,10 +579,17 @@ impl Viewport {
         s
     }
 
-    /// The material legend (right panel).
+    /// The material legend (right panel), after the attribute legend in
+    /// attribute mode.
     pub fn legend_ui(&mut self, ui: &mut egui::Ui) {
         match self.model.clone() {
-            Some(m) => legend::materials_ui(ui, &m, &mut self.settings),
+            Some(m) => {
+                let bake = self.bake.as_ref().map(|(_, b)| b.as_ref());
+                if attribute_view::legend_ui(ui, &m, &mut self.shading, bake) {
+                    self.rebake(ui.ctx());
+                }
+                legend::materials_ui(ui, &m, &mut self.settings)
+            }
             None => {
                 ui.weak("No design.");
             }

@@ -13,6 +13,9 @@
 //! * the bricks of voxel layer `k − 1` are emitted (their corners are layers
 //!   `k − 1` and `k`), in `(j, i)` order.
 //!
+//! The boundary faces and connected pieces are found on the way, from the
+//! masks of the layers beside each brick ([`GridFaces`]).
+//!
 //! Node order per brick is CalculiX's: bottom face counter-clockwise seen
 //! from +z, then the top face in the same order.
 
@@ -23,6 +26,7 @@ use volcad_core::Model;
 use volcad_core::material::VOID;
 use volcad_core::sampler::{Grid, Sampler, Slab};
 
+use super::topology::GridFaces;
 use super::{FeaMesh, draw};
 use crate::job::ExportError;
 
@@ -68,6 +72,7 @@ pub fn brick_mesh(
     let mut ids_lo: Vec<u32> = vec![u32::MAX; cw * (ny + 1)];
     let mut ids_hi: Vec<u32> = vec![u32::MAX; cw * (ny + 1)];
     let mut f = vec![0.0f64; slots.len()];
+    let mut faces = GridFaces::new(nx, ny);
     for k in 0..=nz {
         if k < nz {
             if k.is_multiple_of(SLAB) {
@@ -116,6 +121,7 @@ pub fn brick_mesh(
         }
         // Emit the bricks of voxel layer k − 1.
         if k > 0 {
+            let first = mesh.len();
             for j in 0..ny {
                 for i in 0..nx {
                     let s = prev[j * nx + i];
@@ -136,6 +142,7 @@ pub fn brick_mesh(
                     mesh.mat.push(s);
                 }
             }
+            faces.layer(&mesh, first, &prev, &cur);
             if mesh.mat.len() as u64 > max_elements {
                 return Err(ExportError::param(
                     "--voxel",
@@ -146,6 +153,7 @@ pub fn brick_mesh(
         std::mem::swap(&mut prev, &mut cur);
         std::mem::swap(&mut ids_lo, &mut ids_hi);
     }
+    mesh.topology = Some(faces.finish());
     let v = grid.voxel.x * grid.voxel.y * grid.voxel.z;
     mesh.notes.push(format!(
         "bricks: {} of {} × {} × {} voxels ({} mm); mesh volume {:.4} mm³",

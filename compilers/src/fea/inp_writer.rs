@@ -12,6 +12,7 @@
 //! *ELSET, ELSET=EALL          the material sets, one name a line
 //! *NSET, NSET=NBOTTOM / NTOP  nodes within tolerance of min / max z
 //! *MATERIAL, NAME=<name> + *ELASTIC E, ν    per material with elements
+//!   (+ *DENSITY in t/mm³ for property sets from a `density` field)
 //! *SOLID SECTION, ELSET=E_<name>, MATERIAL=<name>
 //! [step: *BOUNDARY NBOTTOM 1..3; *STEP *STATIC, NTOP dof 3 prescribed,
 //!  *NODE FILE U, *EL FILE S, *NODE PRINT RF totals on NBOTTOM, *END STEP]
@@ -39,6 +40,8 @@ pub struct MatOut {
     pub e: f64,
     /// Poisson ratio as written.
     pub nu: f64,
+    /// Density (g/cm³), written as `*DENSITY` in the deck's tonne/mm³.
+    pub density: Option<f64>,
 }
 
 /// Everything the deck needs besides the mesh.
@@ -213,6 +216,11 @@ pub fn write(w: &mut impl Write, d: &Deck<'_>) -> io::Result<()> {
         writeln!(w, "*MATERIAL, NAME={}", mat.name)?;
         writeln!(w, "*ELASTIC")?;
         writeln!(w, "{}, {}", num(mat.e), num(mat.nu))?;
+        if let Some(rho) = mat.density {
+            // mm, N, MPa: mass in tonnes, so 1 g/cm³ = 1e-9 t/mm³.
+            writeln!(w, "*DENSITY")?;
+            writeln!(w, "{}", num(rho * 1e-9))?;
+        }
         writeln!(
             w,
             "*SOLID SECTION, ELSET=E_{}, MATERIAL={}",

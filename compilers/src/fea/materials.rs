@@ -93,6 +93,7 @@ pub fn elastic_materials(model: &Model) -> Result<(Vec<MatOut>, Vec<String>), Ex
             original: name.to_string(),
             e,
             nu,
+            density: None,
         });
     }
     Ok((out, notes))

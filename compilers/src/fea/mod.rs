@@ -9,7 +9,10 @@
 //!   follows the material heterogeneity ([`sizing`]):
 //!   `L = min_cell + h (max_cell − min_cell)` or a math string of `h`.
 //!
-//! Every element gets **one** material, drawn from the fractions at its
+//! A design with a `modulus` attribute gets its elastic constants from the
+//! fields instead ([`property_bins`]): `modulus`, `poissons_ratio` and
+//! `density` at each element's centroid, grouped into a few elastic sets.
+//! Otherwise every element gets **one** material, drawn from the fractions at its
 //! centre with a counter-based generator keyed by the element (the voxel's
 //! grid index for bricks, the element's index for tetrahedra), so the output
 //! is the same bytes on any thread count. The deck ([`inp_writer`]) has a set,
@@ -23,6 +26,7 @@ pub mod frd;
 pub mod inp_writer;
 pub mod lattice;
 pub mod materials;
+pub mod property_bins;
 pub mod quality;
 pub mod refine;
 pub mod sizing;
@@ -105,6 +109,10 @@ pub struct FeaParams {
     pub sizing: Sizing,
     /// Seed of the material draw.
     pub seed: u64,
+    /// Bins per property for designs with a `modulus` attribute
+    /// (`None`: [`property_bins::DEFAULT_BINS`]; given for a design
+    /// without `modulus`, an error).
+    pub property_bins: Option<usize>,
     /// Append a ready static step.
     pub step: Option<StepParams>,
     /// How the `NBOTTOM` and `NTOP` node sets are chosen.
@@ -133,6 +141,7 @@ impl Default for FeaParams {
             max_cell: 4.0,
             sizing: Sizing::Heterogeneity,
             seed: 0,
+            property_bins: None,
             step: None,
             ends: EndSets::default(),
             allow_pieces: false,
@@ -188,6 +197,9 @@ pub struct FeaMesh {
     pub quality: Option<QualityReport>,
     /// Free-form figures for the summary.
     pub notes: Vec<String>,
+    /// Boundary faces and pieces, when the mesher found them on the way
+    /// (bricks); otherwise [`topology::topology`] finds them.
+    pub topology: Option<topology::Topology>,
 }
 
 impl FeaMesh {
@@ -199,6 +211,7 @@ impl FeaMesh {
             mat: Vec::new(),
             quality: None,
             notes: Vec::new(),
+            topology: None,
         }
     }
 
@@ -478,10 +491,33 @@ fn check_pieces(pieces: &[usize], allow: bool, option: &str) -> Result<Vec<Strin
     )])
 }
 
+/// True when the elastic constants come from the design's `modulus`
+/// field; `--property-bins` out of range, or given for a design without
+/// `modulus`, is an error (listing the attributes it has).
+fn check_property_bins(model: &Model, bins: Option<usize>) -> Result<bool, ExportError> {
+    if let Some(n) = bins {
+        if !(1..=property_bins::MAX_BINS).contains(&n) {
+            return Err(ExportError::param(
+                "--property-bins",
+                format!("must be 1 to {}, got {n}", property_bins::MAX_BINS),
+            ));
+        }
+        model
+            .require_attribute("modulus")
+            .map_err(|e| ExportError::param("--property-bins", e.to_string()))?;
+    }
+    Ok(model.attribute_index("modulus").is_some())
+}
+
 /// Mesh `model` and write `<staging>/model.inp` (see the module doc).
 pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summary, ExportError> {
     let start = Instant::now();
-    let (materials, mut notes) = elastic_materials(model)?;
+    let by_props = check_property_bins(model, p.property_bins)?;
+    let (materials, mut notes) = if by_props {
+        (Vec::new(), Vec::new())
+    } else {
+        elastic_materials(model)?
+    };
     let (element_size, size_option) = p.cell();
     notes.extend(crate::thin::thin_feature_notes(
         model,
@@ -494,7 +530,7 @@ pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summ
     let progress = |stage: &str, done: u64, total: u64, frac: f64| {
         ctx.progress(stage, done, total, "elements", frac * 0.9)
     };
-    let mesh = match p.threads {
+    let mut mesh = match p.threads {
         Some(0) => return Err(ExportError::param("--threads", "must be at least 1")),
         Some(n) => rayon::ThreadPoolBuilder::new()
             .num_threads(n)
@@ -504,13 +540,30 @@ pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summ
         None => build_mesh(model, p, ctx.cancel_flag(), &progress)?,
     };
     ctx.check_cancel()?;
+    let known = mesh.topology.take();
     if mesh.is_empty() {
         return Err(ExportError::Other("the mesh has no elements: the design is empty at this element size (try a smaller --voxel or --max-cell)".into()));
     }
-    let used: Vec<MatOut> = materials
-        .into_iter()
-        .filter(|m| mesh.mat.contains(&m.slot))
-        .collect();
+    let mut mesh = mesh;
+    let used: Vec<MatOut> = match property_bins::element_props(model, &mesh)? {
+        Some(props) => {
+            let bins = p.property_bins.unwrap_or(property_bins::DEFAULT_BINS);
+            let mut sets = property_bins::bin_elements(&props, bins);
+            notes.extend(property_bins::cap_poisson(&mut sets));
+            notes.push(format!(
+                "elastic sets from the modulus field: {} sets ({bins} bins per property over modulus {:.6} … {:.6} MPa), each with the mean of its elements' centroid values",
+                sets.materials.len(),
+                sets.materials.first().map_or(0.0, |m| m.e),
+                sets.materials.last().map_or(0.0, |m| m.e),
+            ));
+            mesh.mat = sets.set_of;
+            sets.materials
+        }
+        None => materials
+            .into_iter()
+            .filter(|m| mesh.mat.contains(&m.slot))
+            .collect(),
+    };
     notes.push(solver::check_solver_memory(
         mesh.nodes.len() as u64,
         match p.solver_memory {
@@ -547,7 +600,11 @@ pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summ
         mesh: &mesh,
         materials: &used,
         title: format!("Volcad Studio FEA export: {} {kind} elements, {} nodes, {} materials; units mm, N, MPa", mesh.len(), mesh.nodes.len(), used.len()),
-        comments: std::iter::once(format!("volcad-compilers {}; design {}; one material per element, drawn from the fractions at its centre (seed {})", env!("CARGO_PKG_VERSION"), ctx.design_hash, p.seed))
+        comments: std::iter::once(if by_props {
+            format!("volcad-compilers {}; design {}; elastic sets from the design's modulus field at the element centroids", env!("CARGO_PKG_VERSION"), ctx.design_hash)
+        } else {
+            format!("volcad-compilers {}; design {}; one material per element, drawn from the fractions at its centre (seed {})", env!("CARGO_PKG_VERSION"), ctx.design_hash, p.seed)
+        })
             .chain(notes.iter().cloned())
             .collect(),
         bottom: &bottom.ids,
@@ -572,7 +629,7 @@ pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summ
             .map_err(|e| ExportError::io(&path, e))
     };
     let faces = || {
-        let topo = topology::topology(&mesh);
+        let topo = known.unwrap_or_else(|| topology::topology(&mesh));
         let footprint = boundary::footprint(&mesh.nodes, &topo.boundary);
         (topo, footprint)
     };

@@ -88,13 +88,105 @@ pub fn topology(mesh: &FeaMesh) -> Topology {
         }
         i = j;
     }
-    let mut size = vec![0usize; mesh.len()];
-    for e in 0..mesh.len() as u32 {
-        size[find(&mut parent, e) as usize] += 1;
+    let pieces = piece_sizes(&mut parent, mesh.len());
+    Topology { boundary, pieces }
+}
+
+/// The faces and pieces of a brick mesh, found while its bricks are made
+/// layer by layer ([`super::bricks`]): a brick's neighbours are the grid
+/// cells beside it, so no face is keyed or sorted. Gives the same pieces
+/// and the same boundary faces as [`topology`] (in grid order).
+pub(super) struct GridFaces {
+    nx: usize,
+    /// Element id per cell of the layer below the one being added, and of
+    /// that layer (`u32::MAX`: no brick).
+    below: Vec<u32>,
+    here: Vec<u32>,
+    parent: Vec<u32>,
+    boundary: Vec<Face>,
+}
+
+impl GridFaces {
+    /// For a grid `nx` × `ny` cells across.
+    pub fn new(nx: usize, ny: usize) -> Self {
+        Self {
+            nx,
+            below: vec![u32::MAX; nx * ny],
+            here: vec![u32::MAX; nx * ny],
+            parent: Vec::new(),
+            boundary: Vec::new(),
+        }
+    }
+
+    /// Add the layer of bricks `first..` of `mesh` (made in `(j, i)` order
+    /// from the cells of `this` not `u16::MAX`); `above` marks the layer
+    /// above the same way.
+    pub fn layer(&mut self, mesh: &FeaMesh, first: usize, this: &[u16], above: &[u16]) {
+        let (nx, ny) = (self.nx, this.len() / self.nx.max(1));
+        let mut e = first as u32;
+        for (c, &m) in this.iter().enumerate() {
+            self.here[c] = if m == u16::MAX {
+                u32::MAX
+            } else {
+                e += 1;
+                e - 1
+            };
+        }
+        self.parent.extend(first as u32..e);
+        for c in 0..this.len() {
+            let e = self.here[c];
+            if e == u32::MAX {
+                continue;
+            }
+            let (i, j) = (c % nx, c / nx);
+            // (face of HEX_FACES, the neighbour's element or None when
+            // it is past the grid) for −x, −y, −z: joined when a brick;
+            // for +x, +y, +z: a brick there is joined from its side.
+            let lower = [
+                (5, (i > 0).then(|| self.here[c - 1])),
+                (2, (j > 0).then(|| self.here[c - nx])),
+                (0, Some(self.below[c])),
+            ];
+            for (f, nb) in lower {
+                match nb {
+                    Some(n) if n != u32::MAX => join(&mut self.parent, e, n),
+                    _ => self.boundary.push(face_nodes(mesh, e as usize, f)),
+                }
+            }
+            let brick = |m: Option<&u16>| m.is_some_and(|m| *m != u16::MAX);
+            let upper = [
+                (3, i + 1 < nx && brick(this.get(c + 1))),
+                (4, j + 1 < ny && brick(this.get(c + nx))),
+                (1, brick(above.get(c))),
+            ];
+            for (f, joined) in upper {
+                if !joined {
+                    self.boundary.push(face_nodes(mesh, e as usize, f));
+                }
+            }
+        }
+        std::mem::swap(&mut self.below, &mut self.here);
+    }
+
+    /// The boundary faces and pieces.
+    pub fn finish(mut self) -> Topology {
+        let n = self.parent.len();
+        Topology {
+            pieces: piece_sizes(&mut self.parent, n),
+            boundary: self.boundary,
+        }
+    }
+}
+
+/// Element count of each set of `parent`, largest first.
+fn piece_sizes(parent: &mut [u32], elements: usize) -> Vec<usize> {
+    let mut size = vec![0usize; elements];
+    for e in 0..elements as u32 {
+        size[find(parent, e) as usize] += 1;
     }
     let mut pieces: Vec<usize> = size.into_iter().filter(|&s| s > 0).collect();
     pieces.sort_unstable_by(|a, b| b.cmp(a));
-    Topology { boundary, pieces }
+    pieces
 }
 
 #[cfg(test)]
@@ -145,5 +237,29 @@ mod tests {
         let t = topology(&bricks(true));
         assert_eq!(t.pieces, vec![2, 1]);
         assert_eq!(t.boundary.len(), 16);
+    }
+
+    #[test]
+    fn grid_faces_match_the_sorted_faces() {
+        use volcad_core::script::{ScriptOptions, model_of};
+        // Struts that fall apart at this brick size: pieces joined at
+        // edges, and holes.
+        let src = r#"let m = default_materials();
+Intersection(false, [Tile(GraphLattice(LatticeType::BodyCenteredCubic, Vec3(5,5,5), 0.35, m.id("gray"))), Sphere(Vec3(0,0,0), 6, m.id("gray"))])"#;
+        let model = model_of(src, "t.rhai", &ScriptOptions::default()).expect("design");
+        let cancel = std::sync::atomic::AtomicBool::new(false);
+        let mut mesh =
+            crate::fea::bricks::brick_mesh(&model, 0.5, 0, u64::MAX, &cancel, &|_, _, _, _| {})
+                .expect("bricks");
+        let grid = mesh.topology.take().expect("found with the bricks");
+        let sorted = topology(&mesh);
+        assert!(grid.pieces.len() > 1, "{:?}", grid.pieces);
+        assert_eq!(grid.pieces, sorted.pieces);
+        let key = |b: &[Face]| {
+            let mut v = b.to_vec();
+            v.sort_unstable();
+            v
+        };
+        assert_eq!(key(&grid.boundary), key(&sorted.boundary));
     }
 }

@@ -20,10 +20,13 @@
 //!   `|s − r| = 1`), `t = (c − f_a) / (f_b − f_a)`;
 //! * dominant material `A` | `B`: where `f_A − f_B` changes sign;
 //!
-//! always computed from the edge's lower end, clamped to `[10⁻³, 1 − 10⁻³]`.
+//! always computed from the edge's lower end, clamped to `[0.05, 0.95]`
+//! (`T_MIN`: no sub-micron edges where the surface passes through a sample).
 //! With two labels in the tet, the interface is the usual marching-tetrahedra
 //! triangle or quad. With three or four, a point is added at the centroid of
-//! the edge points of each three-label face and of the tet, and the
+//! the edge points of each three-label face and of the tet (of those next to
+//! void alone when there are some, so the outer surface has no groove where
+//! an interface meets it), and the
 //! interface is the cone from the tet point over the curves on the faces
 //! (straight between edge points on two-label faces, through the face point
 //! on three-label faces). Each label's part of a tet is then a topological
@@ -60,8 +63,12 @@ pub struct Plane {
     pub value: Vec<f32>,
 }
 
-/// Edge-point parameter clamp: keeps every triangle off the sample points.
-const T_MIN: f64 = 1e-3;
+/// Edge-point parameter clamp: keeps every point a twentieth of an edge off
+/// the samples. Where the surface passes through a sample, the points of
+/// its edges cluster around it; at 10⁻³ of a voxel their sub-micron edges
+/// and needles stopped gmsh's boundary recovery (the surface moves by at
+/// most this much of an edge there).
+const T_MIN: f64 = 0.05;
 /// Axis orders of the six Kuhn tets (tet `π`: corners `0`, `e_π1`,
 /// `e_π1 + e_π2`, `(1,1,1)`); the FEA tet lattice splits its cubes the same
 /// way.
@@ -522,6 +529,27 @@ impl Contourer {
         pa + (pb - pa) * self.crossing(cube, a, b)
     }
 
+    /// Where a point joining three or four labels goes (a three-label
+    /// face's or a tet's): the centroid of the cut `edges`' points, or,
+    /// when some of them end in void, of those alone. Those lie on the
+    /// outer surface, so the rim where an interface meets it stays on that
+    /// surface; the centroid of every point lies inside the part and cut a
+    /// groove along each interface's rim.
+    fn junction(&self, cube: &Cube, edges: impl Iterator<Item = (u8, u8)>) -> DVec3 {
+        let (mut all, mut n) = (DVec3::ZERO, 0.0);
+        let (mut outer, mut m) = (DVec3::ZERO, 0.0);
+        for (a, b) in edges {
+            let p = self.edge_pos(cube, a, b);
+            all += p;
+            n += 1.0;
+            if cube.label[a as usize] == 0 || cube.label[b as usize] == 0 {
+                outer += p;
+                m += 1.0;
+            }
+        }
+        if m > 0.0 { outer / m } else { all / n }
+    }
+
     /// Key and position of a point of tet `perm` (corners `v`).
     fn resolve(&self, cube: &Cube, perm: usize, v: &[u8; 4], p: Pt) -> VRef {
         let (key, pos) = match p {
@@ -534,22 +562,18 @@ impl Contourer {
                     + FACE_KEY
                     + u64::from(b ^ a) * 8
                     + u64::from(c ^ a);
-                let sum = self.edge_pos(cube, a, b)
-                    + self.edge_pos(cube, b, c)
-                    + self.edge_pos(cube, a, c);
-                (key, sum / 3.0)
+                (
+                    key,
+                    self.junction(cube, [(a, b), (b, c), (a, c)].into_iter()),
+                )
             }
             Pt::Tet => {
                 let key = self.global(cube.base) * KEY_TYPES + TET_KEY + perm as u64;
-                let (mut sum, mut n) = (DVec3::ZERO, 0.0);
-                for (x, y) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
-                    let (a, b) = by_inclusion(v[x], v[y]);
-                    if cube.label[a as usize] != cube.label[b as usize] {
-                        sum += self.edge_pos(cube, a, b);
-                        n += 1.0;
-                    }
-                }
-                (key, sum / n)
+                let edges = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+                    .into_iter()
+                    .map(|(x, y)| by_inclusion(v[x], v[y]))
+                    .filter(|&(a, b)| cube.label[a as usize] != cube.label[b as usize]);
+                (key, self.junction(cube, edges))
             }
         };
         VRef {

@@ -1,10 +1,10 @@
 //! Triangulation of a flat region's outline (see [`super::flat`]).
 //!
 //! The outline is projected along the normal's largest axis. An outline
-//! that is one convex loop (a box's face, a slab's interface) is cut into
-//! a strip of triangles with exact orientation tests alone
-//! ([`convex_strip`]); any other is triangulated by a constrained Delaunay
-//! triangulation (spade, exact predicates). Both keep every outline point
+//! that is one convex loop (a box's face, a slab's interface) with evenly
+//! spaced points is cut into a strip of triangles with exact orientation
+//! tests alone ([`convex_strip`]); any other is triangulated by a
+//! constrained Delaunay triangulation (spade, exact predicates). Both keep every outline point
 //! (collinear ones included; dropping one would leave a T-junction). In
 //! the Delaunay path faces inside the outline are found by flood fill from
 //! the hull, flipping at each outline edge. Triangles are oriented like
@@ -68,7 +68,9 @@ pub(super) fn triangulate(
         .iter()
         .map(|[a, b]| pts[*a].x * pts[*b].y - pts[*b].x * pts[*a].y)
         .sum();
-    if let Some(strip) = convex_strip(&pts, &edges, area2) {
+    if evenly_spaced(&pts, &edges)
+        && let Some(strip) = convex_strip(&pts, &edges, area2)
+    {
         return oriented(strip, &pts, &global, area2);
     }
     let count = pts.len();
@@ -124,6 +126,27 @@ pub(super) fn triangulate(
         });
     let faces: Option<Vec<[usize; 3]>> = inside.collect();
     oriented(faces?, &pts, &global, area2)
+}
+
+/// Outline edges shorter than this fraction of the longest send the
+/// region to the Delaunay path.
+const STRIP_EDGE_RATIO: f64 = 0.25;
+
+/// Whether no outline edge is much shorter than the longest. Where a face
+/// passes through samples, the contourer's points cluster within `T_MIN`
+/// of each sample; a strip joins such a short edge to a point across the
+/// region, a needle of a few hundredths of a degree that stops gmsh's
+/// boundary recovery, where the Delaunay triangulation joins it to the
+/// nearest outline point.
+fn evenly_spaced(pts: &[Point2<f64>], edges: &[[usize; 2]]) -> bool {
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+    for &[a, b] in edges {
+        let (dx, dy) = (pts[b].x - pts[a].x, pts[b].y - pts[a].y);
+        let len2 = dx * dx + dy * dy;
+        lo = lo.min(len2);
+        hi = hi.max(len2);
+    }
+    lo >= STRIP_EDGE_RATIO * STRIP_EDGE_RATIO * hi
 }
 
 /// `faces` (local indices) as global indices oriented like the outline, or

@@ -7,9 +7,9 @@
 //! so `materials()` lists the ids it uses, ascending, and a point's fractions
 //! are `k = materials().len()` numbers in that order.
 
-mod bound;
+mod distance_interval;
 mod flatten;
-mod frac_bound;
+mod fraction_bound;
 mod fractions;
 mod pnode;
 pub mod polygon2d;
@@ -31,7 +31,7 @@ use std::time::{Duration, Instant};
 
 use glam::DVec3;
 
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 use crate::interval::Interval;
 use crate::material::{MaterialId, MaterialTable};
 use crate::node::Node;
@@ -74,6 +74,60 @@ pub struct Model {
     prepare_time: Duration,
     varying: bool,
     averaging: bool,
+    /// The attribute evaluator, only when some node carries an attribute
+    /// (kept apart from `root` so distances and fractions never look at it).
+    pub(crate) attrs: Option<Arc<crate::attribute::Evaluator>>,
+}
+
+/// The distance of one script subtree in its own frame (the attribute
+/// evaluator asks which children contain a point, and its math strings'
+/// `d`).
+#[derive(Debug, Clone)]
+pub(crate) struct SubDistance {
+    node: Arc<PNode>,
+    /// The subtree's box.
+    pub(crate) bbox: Aabb,
+}
+
+impl SubDistance {
+    /// Signed distance at `p`.
+    #[inline]
+    pub(crate) fn dist(&self, p: DVec3) -> f64 {
+        self.node.dist(p)
+    }
+
+    /// True when `p` is inside.
+    #[inline]
+    pub(crate) fn contains(&self, p: DVec3) -> bool {
+        self.node.contains(p)
+    }
+
+    /// Bounds of the distance over `b`.
+    pub(crate) fn interval(&self, b: &Aabb) -> Interval {
+        self.node.interval(b)
+    }
+
+    /// Fractions at `p` into `out` (the design's materials, dense).
+    pub(crate) fn fractions(&self, p: DVec3, out: &mut [f64]) {
+        out.fill(0.0);
+        self.node.eval(p, out);
+    }
+}
+
+/// Prepares the distances of script subtrees, sharing one cache.
+pub(crate) struct SubPreparer(prepare::Preparer);
+
+impl SubPreparer {
+    /// A preparer for a design using `materials`.
+    pub(crate) fn new(materials: &[MaterialId]) -> Result<Self, PrepareError> {
+        Ok(Self(prepare::Preparer::new(materials)?))
+    }
+
+    /// The distance of the subtree `n`.
+    pub(crate) fn distance(&mut self, n: &Node) -> Result<SubDistance, PrepareError> {
+        let (node, bbox) = self.0.prepare(n)?;
+        Ok(SubDistance { node, bbox })
+    }
 }
 
 /// Points as structure of arrays (mm).
@@ -120,7 +174,9 @@ impl Model {
                 message: "the design has no material".into(),
             });
         }
+        let attrs = crate::attribute::Evaluator::build(root, &materials)?.map(Arc::new);
         Ok(Model {
+            attrs,
             varying: root_p.varying_fractions(),
             averaging: root_p.averages_fractions(),
             root: root_p,
@@ -265,7 +321,7 @@ impl Model {
     /// with many children overlapping `b`, an FEA field with many
     /// tetrahedra in `b`).
     pub fn fraction_bounds(&self, b: &Aabb, out: &mut [Interval]) -> bool {
-        out.fill(frac_bound::ZERO);
+        out.fill(fraction_bound::ZERO);
         self.root.frac_bounds(b, out)
     }
 

@@ -10,6 +10,7 @@
 //! The design is the script's final value, or else a variable named `root`.
 
 mod arith;
+mod attribute_api;
 mod bulk;
 mod file_cache;
 mod files_api;
@@ -33,6 +34,7 @@ use rhai::{Dynamic, Engine, EvalAltResult, NativeCallContext as Ctx, Position, S
 
 use crate::material::MaterialTable;
 use crate::node::{LatticeType, Node};
+pub use attribute_api::Vec4;
 pub use values::Vec3;
 use values::{RResult, fail};
 
@@ -212,8 +214,9 @@ pub(crate) fn runtime_message(e: &EvalAltResult) -> String {
 }
 
 /// A mesh file, loaded once while it is unchanged (the cache scripts use).
-pub(crate) fn load_mesh(full: &Path) -> Result<Arc<crate::mesh::TriangleMesh>, String> {
-    file_cache::cached(&[full], || crate::mesh::TriangleMesh::load(full)).map_err(|e| e.to_string())
+pub(crate) fn load_mesh(full: &Path) -> Result<Arc<crate::trimesh::TriangleMesh>, String> {
+    file_cache::cached(&[full], || crate::trimesh::TriangleMesh::load(full))
+        .map_err(|e| e.to_string())
 }
 
 /// Run a design script and prepare its model (what tests, benchmarks and
@@ -555,6 +558,7 @@ fn build_engine(ctx: &RunContext, opts: &ScriptOptions) -> Engine {
     nodes_api::register_composites(&mut engine);
     shapes_api::register_shapes(&mut engine);
     nodes_api::register_methods(&mut engine);
+    attribute_api::register(&mut engine, ctx);
     files_api::register(&mut engine, ctx);
     query_api::register(&mut engine, ctx);
     text_api::register(&mut engine, ctx);

@@ -515,6 +515,36 @@ pub static FUNCTIONS: &[FnDoc] = &[
         "let m = default_materials(); let d = Difference(); d.set_left(Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\"))); d.set_right(Sphere(Vec3(3, 0, 0), 3.0, m.id(\"red\"))); d"
     ),
     f!(
+        "set_attribute",
+        Method,
+        [
+            "node.set_attribute(name: string, value: float | string | Vec3 | Vec4 | array)",
+            "node.set_attribute(name: string, field: SimulationField, column: string)"
+        ],
+        "Sets a property field (modulus MPa, poissons_ratio, density g/cm^3, shore_hardness, infill_density %, temperature, color Vec4, or any name): a number, a math string of x y z rho phic r theta phis d and the node's other attributes, a vector, or an FEA column; a parent's overrides its children's.",
+        "n.set_attribute(\"modulus\", 2850.0)",
+        "let m = default_materials(); let s = Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\")); s.set_attribute(\"modulus\", \"1000 + 100*z\"); s.set_attribute(\"color\", Vec4(1, 0, 0, 1)); s"
+    ),
+    f!(
+        "Convert",
+        Material,
+        [
+            "Convert(child: Node, from: string, to: string, table: [[float, float]] | string)",
+            "Convert(child: Node, \"fractions\", to: string, rule: \"voigt\" | \"reuss\", values: [[int, float]])"
+        ],
+        "Sets attribute `to` from `from` below it (pyvcad 3's AttributeModifier): a piecewise-linear table of [input, output] rows (inline or a two-column .csv; inputs rising; clamped at the ends, counted in a warning) or a math string of x y z ... d and `from`; from \"fractions\", a Voigt or Reuss mix of one value per material.",
+        "Convert(part, \"shore_hardness\", \"modulus\", [[30, 1.0], [85, 20.0]])",
+        "let m = default_materials(); let s = Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\")); s.set_attribute(\"shore_hardness\", \"60 + 4*x\"); Convert(s, \"shore_hardness\", \"modulus\", [[30, 1.0], [85, 20.0]])"
+    ),
+    f!(
+        "set_attribute_conflict_resolver",
+        Method,
+        ["node.set_attribute_conflict_resolver(name: string, resolver: string)"],
+        "How a Union, Intersection or Sum combines an attribute where children overlap: \"first\" (default), \"average\", \"min\", \"max\", \"sum\", or a math string of a and b.",
+        "u.set_attribute_conflict_resolver(\"modulus\", \"average\")",
+        "let m = default_materials(); let a = Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\")); a.set_attribute(\"modulus\", 10.0); let b = Sphere(Vec3(3, 0, 0), 5.0, m.id(\"red\")); b.set_attribute(\"modulus\", 20.0); let u = Union(false, [a, b]); u.set_attribute_conflict_resolver(\"modulus\", \"max\"); u"
+    ),
+    f!(
         "set_right",
         Method,
         ["node.set_right(child: Node)"],
@@ -569,6 +599,14 @@ pub static FUNCTIONS: &[FnDoc] = &[
         "The node's type name (\"Sphere\", \"Union\", ...).",
         "n.type()",
         "let m = default_materials(); let s = Sphere(Vec3(0, 0, 0), 1.0, m.id(\"red\")); let t = s.type(); s"
+    ),
+    f!(
+        "Vec4",
+        Value,
+        ["Vec4(r: float, g: float, b: float, a: float)"],
+        "Four numbers, such as an RGBA colour in 0-1 for the color attribute; `.r .g .b .a`.",
+        "Vec4(1, 0, 0, 1)",
+        "let m = default_materials(); let s = Sphere(Vec3(0, 0, 0), 1.0, m.id(\"red\")); s.set_attribute(\"color\", Vec4(1, 0.5, 0, 1)); s"
     ),
     f!(
         "Vec3",
