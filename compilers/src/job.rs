@@ -272,13 +272,54 @@ pub fn spawn_design<F>(
 where
     F: FnOnce(&JobContext) -> Result<Summary, ExportError> + Send + 'static,
 {
+    spawn_runner(dest, move |d, c, tx| {
+        run_job(d, (design_hash, design), c, tx, work)
+    })
+}
+
+/// [`spawn`] for an export that is one file (`part.gcvf`): `work` writes
+/// `ctx.staging()/<dest's file name>`, which is moved to `dest` once the
+/// job has succeeded (a regular file there is replaced; a folder or a
+/// special file is refused before any work). The job's folder, manifest
+/// included, is removed; a failed or cancelled job leaves nothing.
+pub fn spawn_file<F>(dest: PathBuf, design_hash: String, work: F) -> JobHandle
+where
+    F: FnOnce(&JobContext) -> Result<Summary, ExportError> + Send + 'static,
+{
+    spawn_runner(dest, move |d, c, tx| {
+        let name = d
+            .file_name()
+            .map(|n| n.to_string_lossy().to_string())
+            .ok_or_else(|| ExportError::Other(format!("{}: not a file name", d.display())))?;
+        if std::fs::symlink_metadata(&d).is_ok_and(|m| !m.is_file()) {
+            return Err(ExportError::Other(format!(
+                "{}: exists and is not a regular file; give a new file name",
+                d.display()
+            )));
+        }
+        let job_dir = d.with_file_name(format!(".{name}.job-{}", std::process::id()));
+        let summary = run_job(job_dir.clone(), (design_hash, None), c, tx, work)?;
+        let moved = std::fs::rename(job_dir.join(&name), &d);
+        let _ = std::fs::remove_dir_all(&job_dir);
+        moved.map_err(|e| ExportError::io(&d, e))?;
+        Ok(summary)
+    })
+}
+
+/// The thread, channel and cancel flag of a job that `runner` runs.
+fn spawn_runner<R>(dest: PathBuf, runner: R) -> JobHandle
+where
+    R: FnOnce(PathBuf, Arc<AtomicBool>, SyncSender<Progress>) -> Result<Summary, ExportError>
+        + Send
+        + 'static,
+{
     let (tx, rx) = sync_channel(64);
     let cancel = Arc::new(AtomicBool::new(false));
     let c2 = cancel.clone();
     let d2 = dest.clone();
     let thread = std::thread::Builder::new()
         .name("volcad-export".into())
-        .spawn(move || run_job(d2, (design_hash, design), c2, tx, work))
+        .spawn(move || runner(d2, c2, tx))
         .expect("spawning a thread");
     JobHandle {
         progress: rx,

@@ -6,13 +6,16 @@
 //! model through the core's one grid sampler (`volcad_core::sampler`).
 //!
 //! * [`png_stack`]: inkjet slice stacks, one PNG per layer.
+//! * [`gcvf`]: GrabCAD Voxel Print packages for PolyJet printers.
 //! * [`mesh`]: segmented meshes (STL, OBJ, one 3MF with per-part settings).
 //! * [`fea`]: Abaqus/CalculiX `.inp` meshes (C3D8R bricks, adaptive C3D4 tets).
 //! * [`shard`]: layer stacks split into N layer ranges and merged back.
 #![warn(missing_docs)]
 
 pub mod fea;
+pub mod gcvf;
 pub mod job;
+pub mod keep_out;
 pub mod lazy_random;
 
 pub mod design;
@@ -24,8 +27,10 @@ pub mod plan;
 pub mod png_io;
 pub mod png_stack;
 mod presets;
+pub mod printer_table;
 pub mod resources;
 pub mod shard;
+pub mod slice_image;
 pub mod thin;
 mod union_find;
 pub mod zip_writer;

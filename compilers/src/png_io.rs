@@ -8,7 +8,21 @@
 
 use std::io::Cursor;
 
-use png::{BitDepth, ColorType, Compression, Encoder};
+use png::{BitDepth, ColorType, Compression, Encoder, PixelDimensions, Unit};
+
+/// A pixel's physical size for the PNG `pHYs` chunk (PNG 1.2, section
+/// 4.2.4.3): whole pixels per metre along X and Y, so image tools show a
+/// slice at the printer's size (600 dpi = 23 622 px/m).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PixelsPerMetre(pub [u32; 2]);
+
+impl PixelsPerMetre {
+    /// Pixels per metre for a pixel `x_mm` by `y_mm` millimetres, rounded.
+    pub fn from_mm(x_mm: f64, y_mm: f64) -> Self {
+        let ppm = |mm: f64| (1000.0 / mm).round().clamp(1.0, u32::MAX as f64) as u32;
+        Self([ppm(x_mm), ppm(y_mm)])
+    }
+}
 
 /// Digits in slice numbers: at least 5, more when the grid has more layers,
 /// so that names sort and every part of a split job uses the same width
@@ -42,12 +56,20 @@ fn encode(
     color: ColorType,
     depth: BitDepth,
     data: &[u8],
+    pixel: Option<PixelsPerMetre>,
 ) -> Result<Vec<u8>, png::EncodingError> {
     let mut out = Cursor::new(Vec::with_capacity(data.len() / 8 + 256));
     {
         let mut enc = Encoder::new(&mut out, width as u32, height as u32);
         enc.set_color(color);
         enc.set_depth(depth);
+        if let Some(PixelsPerMetre([xppu, yppu])) = pixel {
+            enc.set_pixel_dims(Some(PixelDimensions {
+                xppu,
+                yppu,
+                unit: Unit::Meter,
+            }));
+        }
         enc.set_compression(Compression::Fastest);
         let mut w = enc.write_header()?;
         w.write_image_data(data)?;
@@ -56,13 +78,50 @@ fn encode(
     Ok(out.into_inner())
 }
 
-/// An 8-bit RGBA image, `data` row-major from the top row, 4 bytes a pixel.
+/// An 8-bit RGBA image, `data` row-major from the top row, 4 bytes a pixel,
+/// with its physical pixel size when `pixel` is given.
 pub fn encode_rgba(
     width: usize,
     height: usize,
     data: &[u8],
+    pixel: Option<PixelsPerMetre>,
 ) -> Result<Vec<u8>, png::EncodingError> {
-    encode(width, height, ColorType::Rgba, BitDepth::Eight, data)
+    encode(width, height, ColorType::Rgba, BitDepth::Eight, data, pixel)
+}
+
+/// An 8-bit grayscale image, one byte a pixel, rows from the top.
+pub fn encode_gray(
+    width: usize,
+    height: usize,
+    data: &[u8],
+    pixel: Option<PixelsPerMetre>,
+) -> Result<Vec<u8>, png::EncodingError> {
+    encode(
+        width,
+        height,
+        ColorType::Grayscale,
+        BitDepth::Eight,
+        data,
+        pixel,
+    )
+}
+
+/// A 16-bit grayscale image: one big-endian `u16` a pixel (as PNG stores
+/// them), rows from the top.
+pub fn encode_gray16(
+    width: usize,
+    height: usize,
+    data: &[u16],
+) -> Result<Vec<u8>, png::EncodingError> {
+    let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_be_bytes()).collect();
+    encode(
+        width,
+        height,
+        ColorType::Grayscale,
+        BitDepth::Sixteen,
+        &bytes,
+        None,
+    )
 }
 
 /// Bytes per row of a 1-bit image.
@@ -76,8 +135,16 @@ pub fn encode_bits(
     width: usize,
     height: usize,
     data: &[u8],
+    pixel: Option<PixelsPerMetre>,
 ) -> Result<Vec<u8>, png::EncodingError> {
-    encode(width, height, ColorType::Grayscale, BitDepth::One, data)
+    encode(
+        width,
+        height,
+        ColorType::Grayscale,
+        BitDepth::One,
+        data,
+        pixel,
+    )
 }
 
 #[cfg(test)]
@@ -106,18 +173,32 @@ mod tests {
     #[test]
     fn rgba_and_bits_round_trip() {
         let rgba: Vec<u8> = (0..3 * 2 * 4).map(|i| i as u8).collect();
-        let (info, back) = decode(&encode_rgba(3, 2, &rgba).unwrap());
+        let (info, back) = decode(&encode_rgba(3, 2, &rgba, None).unwrap());
         assert_eq!(
             (info.width, info.height, info.color_type, info.bit_depth),
             (3, 2, ColorType::Rgba, BitDepth::Eight)
         );
         assert_eq!(back, rgba);
         let bits = vec![0b1010_0000, 0b0100_0000];
-        let (info, back) = decode(&encode_bits(3, 2, &bits).unwrap());
+        let (info, back) = decode(&encode_bits(3, 2, &bits, None).unwrap());
         assert_eq!(
             (info.color_type, info.bit_depth),
             (ColorType::Grayscale, BitDepth::One)
         );
         assert_eq!(back, bits);
+    }
+
+    #[test]
+    fn phys_carries_the_printer_resolution() {
+        // J750: 600 x 300 dpi = 23 622 x 11 811 pixels per metre.
+        let ppm = PixelsPerMetre::from_mm(25.4 / 600.0, 25.4 / 300.0);
+        assert_eq!(ppm, PixelsPerMetre([23_622, 11_811]));
+        let bytes = encode_rgba(1, 1, &[1, 2, 3, 4], Some(ppm)).unwrap();
+        let r = png::Decoder::new(Cursor::new(&bytes)).read_info().unwrap();
+        let d = r.info().pixel_dims.expect("pHYs chunk");
+        assert_eq!((d.xppu, d.yppu, d.unit), (23_622, 11_811, Unit::Meter));
+        let (info, back) = decode(&encode_gray16(2, 1, &[258, 9]).unwrap());
+        assert_eq!(info.bit_depth, BitDepth::Sixteen);
+        assert_eq!(back, vec![1, 2, 0, 9]);
     }
 }

@@ -15,7 +15,8 @@
 //!   with different `layers` ranges (or `shard`s) hold the single export's
 //!   files; [`crate::shard`] merges them, manifest included.
 //! * Pixel = the material's colour from the material table; void is
-//!   transparent `(0, 0, 0, 0)`.
+//!   transparent `(0, 0, 0, 0)`. Each PNG's `pHYs` chunk holds the voxel's
+//!   X and Y size, so image tools show the layer at its printed size.
 //! * Orientation: image width is X, height is Y. **Column 0 = min X, row 0 =
 //!   max Y**: an image viewer shows the layer as seen from above (+Z) with +X
 //!   to the right and +Y up, not mirrored. (pyvcad puts min Y in row 0 and
@@ -48,11 +49,13 @@ use crate::design::{grid_for, palette};
 use crate::dither::{self, Diffuser};
 use crate::estimate::{Look, coarse_estimate, sampled_layers};
 use crate::job::{ExportError, JobContext, Summary};
+use crate::keep_out;
 use crate::lazy_random;
-use crate::png_io::{self, bit_row_bytes};
+use crate::png_io::{self, PixelsPerMetre};
 pub use crate::presets::{Preset, preset, presets};
 use crate::resources::{check_disk, check_memory, run_with_threads};
 use crate::shard::{Part, Shard};
+use crate::slice_image::{ImageStyle, Orientation, bitmap_png, rgba_png};
 
 /// How each voxel's material is chosen from its fractions.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -92,6 +95,9 @@ pub struct PngParams {
     pub per_material_bitmaps: bool,
     /// Worker threads (`None`: all cores).
     pub threads: Option<usize>,
+    /// Remove the liquid material within this distance (mm) of the
+    /// surface (see [`crate::keep_out`]).
+    pub liquid_keep_out: Option<f64>,
 }
 
 impl Default for PngParams {
@@ -105,6 +111,7 @@ impl Default for PngParams {
             shard: None,
             per_material_bitmaps: false,
             threads: None,
+            liquid_keep_out: None,
         }
     }
 }
@@ -148,6 +155,7 @@ pub fn estimate(model: &Model, p: &PngParams) -> Result<Estimate, ExportError> {
 
 fn estimate_with(model: &Model, p: &PngParams, look: Look) -> Result<Estimate, ExportError> {
     let pal = palette(model)?;
+    keep_out::plan(model, p.liquid_keep_out)?;
     let grid = grid_for(model, p.voxel, 0.0)?;
     let [nx, ny, nz] = grid.dims;
     let layers = match (&p.layers, p.shard) {
@@ -276,9 +284,7 @@ fn write_stack(
     est: &Estimate,
     ctx: &JobContext,
 ) -> Result<Summary, ExportError> {
-    let grid = est.grid;
-    let [nx, ny, nz] = grid.dims;
-    let layer = nx * ny;
+    let [nx, ny, nz] = est.grid.dims;
     let k = model.materials().len();
     let pal = palette(model)?;
     let digits = png_io::name_digits(nz);
@@ -291,10 +297,69 @@ fn write_stack(
         let dir = ctx.staging().join(&f.dir);
         std::fs::create_dir_all(&dir).map_err(|e| ExportError::io(&dir, e))?;
     }
-    let single = single_material_code(model);
+    let mut files = Vec::new();
+    let mut counts = vec![0u64; k];
+    let written = AtomicU64::new(0);
+    let layer = nx * ny;
+    let style = top_view(est.grid.voxel);
+    for_each_slab(model, p, est, ctx, |zs, codes| {
+        let outs: Vec<LayerOut> = zs
+            .clone()
+            .into_par_iter()
+            .map(|z| {
+                let i = z - zs.start;
+                let c = &codes[i * layer..(i + 1) * layer];
+                let out = write_layer(ctx, [nx, ny], z, digits, c, &pal, &folders, style)?;
+                // Per layer, in whatever order layers finish (reports are snapshots).
+                let n = written.fetch_add(1, Ordering::Relaxed) + 1;
+                let total = est.layers.len() as u64;
+                ctx.progress("slicing", n, total, "layers", n as f64 / total as f64);
+                Ok(out)
+            })
+            .collect::<Result<_, ExportError>>()?;
+        for o in outs {
+            files.extend(o.files);
+            for (t, c) in counts.iter_mut().zip(o.counts) {
+                *t += c;
+            }
+        }
+        Ok(())
+    })?;
+    Ok(summary(model, p, est, files, counts))
+}
+
+/// The PNG stack's images: top view, with the voxel's size in `pHYs`.
+fn top_view(voxel: DVec3) -> ImageStyle {
+    ImageStyle {
+        orientation: Orientation::TopView,
+        pixel: Some(PixelsPerMetre::from_mm(voxel.x, voxel.y)),
+    }
+}
+
+/// Sample and code the stack's layers one slab at a time and hand each
+/// slab's layers to `f`: the global layer range and one material code per
+/// voxel (x fastest, then y, then layer; 0 = void). Layers below
+/// `est.layers` that error diffusion warms up on are not handed over.
+pub(crate) fn for_each_slab(
+    model: &Model,
+    p: &PngParams,
+    est: &Estimate,
+    ctx: &JobContext,
+    mut f: impl FnMut(Range<usize>, &[u8]) -> Result<(), ExportError>,
+) -> Result<(), ExportError> {
+    let grid = est.grid;
+    let [nx, ny, _] = grid.dims;
+    let layer = nx * ny;
+    let k = model.materials().len();
+    let keep = keep_out::plan(model, p.liquid_keep_out)?;
+    // Keep-out needs every voxel's distance and fractions.
+    let single = single_material_code(model).filter(|_| keep.is_none());
     let mut diffuser =
         (p.dither == Dither::Diffusion && single.is_none()).then(|| Diffuser::new(nx, ny, k));
-    let sampler = stack_sampler(model, grid, single, diffuser.is_some());
+    let sampler = match keep {
+        Some(_) => Sampler::new(model, grid, true),
+        None => stack_sampler(model, grid, single, diffuser.is_some()),
+    };
     let first = if diffuser.is_some() {
         Diffuser::warmup_start(est.layers.start)
     } else {
@@ -302,9 +367,6 @@ fn write_stack(
     };
     let mut slab = Slab::default();
     let mut codes = vec![0u8; est.slab_layers * layer];
-    let mut files = Vec::new();
-    let mut counts = vec![0u64; k];
-    let written = AtomicU64::new(0);
     let mut z0 = first;
     while z0 < est.layers.end {
         ctx.check_cancel()?;
@@ -312,6 +374,9 @@ fn write_stack(
         sampler
             .sample_layers(z0, z1, &mut slab, ctx.cancel_flag())
             .map_err(|_| ExportError::Cancelled)?;
+        if let Some(keep) = &keep {
+            keep_out::apply(keep, model, &grid, z0, &mut slab.dist, &mut slab.fracs);
+        }
         let codes = &mut codes[..(z1 - z0) * layer];
         match diffuser.as_mut() {
             Some(d) => {
@@ -328,28 +393,11 @@ fn write_stack(
             None => pick_codes(model, grid, p.seed, single, z0, &slab, codes),
         }
         ctx.check_cancel()?;
-        let write_from = z0.max(est.layers.start);
-        let outs: Vec<LayerOut> = (write_from..z1)
-            .into_par_iter()
-            .map(|z| {
-                let c = &codes[(z - z0) * layer..(z - z0 + 1) * layer];
-                let out = write_layer(ctx, [nx, ny], z, digits, c, &pal, &folders)?;
-                // Per layer, in whatever order layers finish (reports are snapshots).
-                let n = written.fetch_add(1, Ordering::Relaxed) + 1;
-                let total = est.layers.len() as u64;
-                ctx.progress("slicing", n, total, "layers", n as f64 / total as f64);
-                Ok(out)
-            })
-            .collect::<Result<_, ExportError>>()?;
-        for o in outs {
-            files.extend(o.files);
-            for (t, c) in counts.iter_mut().zip(o.counts) {
-                *t += c;
-            }
-        }
+        let from = z0.max(est.layers.start);
+        f(from..z1, &codes[(from - z0) * layer..])?;
         z0 = z1;
     }
-    Ok(summary(model, p, est, files, counts))
+    Ok(())
 }
 
 /// The code every inside voxel gets when the design has one material
@@ -450,6 +498,7 @@ fn sampled_bytes(
     let mut slab = Slab::default();
     let mut codes = vec![0u8; nx * ny];
     let mut bits = Vec::new();
+    let style = top_view(grid.voxel);
     let (mut bytes, mut picks) = (0usize, 0usize);
     for z in sampled_layers(layers.clone(), SAMPLED_LAYERS) {
         picks += 1;
@@ -462,10 +511,12 @@ fn sampled_bytes(
             )
             .ok()?;
         pick_codes(model, grid, p.seed, single, z, &slab, &mut codes);
-        bytes += rgba_png(nx, ny, &codes, pal).ok()?.len();
+        bytes += rgba_png(nx, ny, &codes, pal, style).ok()?.len();
         if p.per_material_bitmaps {
             for code in 1..=k as u8 {
-                bytes += bitmap_png(nx, ny, &codes, code, &mut bits).ok()?.len();
+                bytes += bitmap_png(nx, ny, &codes, code, &mut bits, style)
+                    .ok()?
+                    .len();
             }
         }
     }
@@ -477,48 +528,8 @@ fn sampled_bytes(
     Some((bytes as f64 * scale * layers.len() as f64 / picks.max(1) as f64) as u64)
 }
 
-/// The layer's PNG: one RGBA pixel per voxel, row 0 the highest y (see the
-/// module docs).
-fn rgba_png(
-    nx: usize,
-    ny: usize,
-    codes: &[u8],
-    pal: &[[u8; 4]],
-) -> Result<Vec<u8>, png::EncodingError> {
-    let mut rgba = vec![0u8; nx * ny * 4];
-    for (j, row) in codes.chunks_exact(nx).enumerate() {
-        let out = &mut rgba[(ny - 1 - j) * nx * 4..(ny - j) * nx * 4];
-        for (px, c) in out.chunks_exact_mut(4).zip(row) {
-            px.copy_from_slice(&pal[*c as usize]);
-        }
-    }
-    png_io::encode_rgba(nx, ny, &rgba)
-}
-
-/// The layer's 1-bit PNG of material `code`: white where the voxel is it.
-/// `bits` is scratch space, reused for a layer's several materials.
-fn bitmap_png(
-    nx: usize,
-    ny: usize,
-    codes: &[u8],
-    code: u8,
-    bits: &mut Vec<u8>,
-) -> Result<Vec<u8>, png::EncodingError> {
-    let rb = bit_row_bytes(nx);
-    bits.clear();
-    bits.resize(rb * ny, 0);
-    for (j, row) in codes.chunks_exact(nx).enumerate() {
-        let out = &mut bits[(ny - 1 - j) * rb..(ny - j) * rb];
-        for (x, c) in row.iter().enumerate() {
-            if *c == code {
-                out[x / 8] |= 0x80 >> (x % 8);
-            }
-        }
-    }
-    png_io::encode_bits(nx, ny, bits)
-}
-
 /// Colour, encode and write layer `z` from its codes; count its materials.
+#[allow(clippy::too_many_arguments)]
 fn write_layer(
     ctx: &JobContext,
     [nx, ny]: [usize; 2],
@@ -527,6 +538,7 @@ fn write_layer(
     codes: &[u8],
     pal: &[[u8; 4]],
     folders: &[BitmapFolder],
+    style: ImageStyle,
 ) -> Result<LayerOut, ExportError> {
     let name = png_io::slice_name(z, digits);
     let mut counts = vec![0u64; pal.len() - 1];
@@ -536,7 +548,7 @@ fn write_layer(
         }
     }
     let path = ctx.staging().join(&name);
-    let bytes = rgba_png(nx, ny, codes, pal)
+    let bytes = rgba_png(nx, ny, codes, pal, style)
         .map_err(|e| ExportError::Other(format!("{}: PNG encoding: {e}", path.display())))?;
     std::fs::write(&path, bytes).map_err(|e| ExportError::io(&path, e))?;
     let mut files = vec![name.clone()];
@@ -544,7 +556,7 @@ fn write_layer(
     for f in folders {
         let rel = format!("{}/{name}", f.dir);
         let path = ctx.staging().join(&f.dir).join(&name);
-        let bytes = bitmap_png(nx, ny, codes, f.slot as u8 + 1, &mut bits)
+        let bytes = bitmap_png(nx, ny, codes, f.slot as u8 + 1, &mut bits, style)
             .map_err(|e| ExportError::Other(format!("{}: PNG encoding: {e}", path.display())))?;
         std::fs::write(&path, bytes).map_err(|e| ExportError::io(&path, e))?;
         files.push(rel);
@@ -585,6 +597,7 @@ fn summary(
         "layers": [est.layers.start, est.layers.end],
         "grid": { "dims": [nx, ny, nz], "origin_mm": o.to_array() },
         "per_material_bitmaps": p.per_material_bitmaps,
+        "liquid_keep_out_mm": p.liquid_keep_out,
         "orientation": "column 0 = min X, row 0 = max Y, layer 0 = lowest Z",
     });
     if let Some(s) = p.shard {

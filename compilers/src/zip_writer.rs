@@ -28,6 +28,8 @@ struct Entry {
     d: Deflated,
     /// The local header carries a Zip64 extra field.
     zip64: bool,
+    /// 8 = deflate, 0 = stored.
+    method: u16,
 }
 
 /// A ZIP archive being written to `w`.
@@ -112,6 +114,48 @@ impl<W: Write + Seek> ZipOut<W> {
             offset,
             d,
             zip64: large,
+            method: 8,
+        });
+        Ok(())
+    }
+
+    /// Adds entry `name` holding `bytes` as they are (method 0, "stored"):
+    /// for data compressed already, such as PNG images, which deflate
+    /// would only slow down. Entries of 4 GiB or more are refused.
+    pub fn stored(&mut self, name: &str, bytes: &[u8]) -> io::Result<()> {
+        let size = u32::try_from(bytes.len())
+            .ok()
+            .filter(|s| u64::from(*s) < MAX32)
+            .ok_or_else(|| io::Error::other(format!("{name}: 4 GiB or more in one entry")))?;
+        let offset = self.w.stream_position()?;
+        let mut crc = crc32fast::Hasher::new();
+        crc.update(bytes);
+        let crc = crc.finalize();
+        let mut h = Vec::with_capacity(30 + name.len());
+        put32(&mut h, 0x0403_4b50);
+        put16(&mut h, 20);
+        put16(&mut h, general_flags(name));
+        put16(&mut h, 0); // stored
+        put16(&mut h, 0);
+        put16(&mut h, DOS_DATE);
+        put32(&mut h, crc);
+        put32(&mut h, size);
+        put32(&mut h, size);
+        put16(&mut h, name.len() as u16);
+        put16(&mut h, 0);
+        h.extend_from_slice(name.as_bytes());
+        self.w.write_all(&h)?;
+        self.w.write_all(bytes)?;
+        self.entries.push(Entry {
+            name: name.to_owned(),
+            offset,
+            d: Deflated {
+                crc,
+                raw: u64::from(size),
+                compressed: u64::from(size),
+            },
+            zip64: false,
+            method: 0,
         });
         Ok(())
     }
@@ -136,7 +180,7 @@ impl<W: Write + Seek> ZipOut<W> {
             put16(&mut cd, (3 << 8) | 45); // made by: Unix, 4.5
             put16(&mut cd, if needs64 { 45 } else { 20 });
             put16(&mut cd, general_flags(&e.name));
-            put16(&mut cd, 8);
+            put16(&mut cd, e.method);
             put16(&mut cd, 0);
             put16(&mut cd, DOS_DATE);
             put32(&mut cd, e.d.crc);
@@ -227,6 +271,7 @@ mod tests {
         })
         .unwrap();
         z.entry("empty", false, |_| Ok(())).unwrap();
+        z.stored("kept.bin", &[7; 1000]).unwrap();
         z.finish().unwrap().into_inner()
     }
 
@@ -237,7 +282,13 @@ mod tests {
             assert_eq!(bytes, archive(large), "deterministic");
             let mut z = zip::ZipArchive::new(Cursor::new(bytes)).unwrap();
             let names: Vec<String> = z.file_names().map(String::from).collect();
-            assert_eq!(names.len(), 3);
+            assert_eq!(names.len(), 4);
+            let mut kept = Vec::new();
+            let mut f = z.by_name("kept.bin").unwrap();
+            assert_eq!(f.compression(), zip::CompressionMethod::Stored);
+            f.read_to_end(&mut kept).unwrap();
+            assert_eq!(kept, vec![7; 1000]);
+            drop(f);
             let mut s = String::new();
             z.by_name("a.txt").unwrap().read_to_string(&mut s).unwrap();
             assert_eq!(s, "hello");
@@ -275,7 +326,7 @@ mod tests {
             );
             assert_eq!(
                 String::from_utf8_lossy(&out.stdout).trim(),
-                "[0, 5, 3088890]"
+                "[0, 5, 1000, 3088890]"
             );
         }
     }

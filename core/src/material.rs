@@ -184,6 +184,28 @@ impl MaterialTable {
         Self::from_json(J750_JSON, "<j750>").expect("bundled j750.json is valid")
     }
 
+    /// This table with the materials `with` gives in place of those at
+    /// their ids (a printer's resin for each material of a design, the ids
+    /// unchanged), named `origin`.
+    pub fn replaced(&self, with: &[(MaterialId, Material)], origin: &str) -> Self {
+        let mut materials = self.materials.clone();
+        for (id, m) in with {
+            if let Some(slot) = materials.get_mut(*id as usize) {
+                *slot = m.clone();
+            }
+        }
+        let by_name = materials
+            .iter()
+            .enumerate()
+            .map(|(id, m)| (m.name.clone(), id as MaterialId))
+            .collect();
+        Self {
+            materials,
+            by_name,
+            origin: origin.to_owned(),
+        }
+    }
+
     /// Where the table came from (a path or `<default>`).
     pub fn origin(&self) -> &str {
         &self.origin

@@ -28,6 +28,8 @@ pub enum Kind {
     Mesh,
     /// FEA mesh for Abaqus/CalculiX (.inp).
     Fea,
+    /// GrabCAD Voxel Print package for PolyJet (J750) printers (.gcvf).
+    Gcvf,
 }
 
 /// `volcad export` options (spelled as scripts rely on them).
@@ -73,6 +75,12 @@ pub struct ExportArgs {
     /// png: also write 1-bit stacks, one folder per material.
     #[arg(long)]
     pub bitmaps: bool,
+    /// gcvf, and png with --preset j750: design material = J750 resin, e.g. red=VeroMgnt,blue=VeroCyan.
+    #[arg(long)]
+    pub map: Option<String>,
+    /// png, gcvf: remove the material named liquid (J750: M.Cleanser) within this many mm of the surface.
+    #[arg(long, allow_negative_numbers = true)]
+    pub liquid_keep_out: Option<f64>,
     /// mesh: number of fraction ranges with `--by MATERIAL` (default 4).
     #[arg(long, allow_negative_numbers = true)]
     pub segments: Option<usize>,
@@ -219,8 +227,17 @@ fn parse_formats(s: &str) -> anyhow::Result<MeshFormats> {
 fn foreign_options(a: &ExportArgs) -> Vec<&'static str> {
     let given = [
         ("--layers", a.layers.is_some(), Kind::Png),
-        ("--dither", a.dither.is_some(), Kind::Png),
+        (
+            "--dither",
+            a.dither.is_some() && a.kind != Kind::Gcvf,
+            Kind::Png,
+        ),
         ("--bitmaps", a.bitmaps, Kind::Png),
+        (
+            "--liquid-keep-out",
+            a.liquid_keep_out.is_some() && a.kind != Kind::Gcvf,
+            Kind::Png,
+        ),
         ("--segments", a.segments.is_some(), Kind::Mesh),
         ("--by", a.by.is_some(), Kind::Mesh),
         ("--infill", a.infill.is_some(), Kind::Mesh),
@@ -245,6 +262,15 @@ fn foreign_options(a: &ExportArgs) -> Vec<&'static str> {
         .filter(|(_, on, kind)| *on && *kind != a.kind)
         .map(|(name, ..)| *name)
         .collect()
+}
+
+/// `--dither` (default random).
+pub(super) fn parse_dither(d: Option<&str>) -> anyhow::Result<Dither> {
+    Ok(match d.unwrap_or("random") {
+        "random" => Dither::Random,
+        "diffusion" => Dither::Diffusion,
+        d => bail!("--dither {d}: expected random or diffusion"),
+    })
 }
 
 /// `--element` (default c3d8r).
@@ -333,8 +359,21 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
     if let Some(t) = a.threads {
         volcad_compilers::resources::check_threads(t)?;
     }
+    // A GrabCAD package is one file, not a folder of ours: it has its own
+    // checks and job (`gcvf.rs`).
+    if a.kind == Kind::Gcvf {
+        let interrupted = interrupt_flag();
+        let handle = super::gcvf::start(a, model, voxel, hash, a.out.clone())?;
+        return follow(handle, &interrupted);
+    }
+    // `--preset j750` relabels the design with the printer's resins.
+    let model = if a.kind == Kind::Png {
+        super::gcvf::printer_model(a, model)?
+    } else {
+        model
+    };
     let params = match a.kind {
-        Kind::Png => ExportParams::Png(png_params(a, voxel)?),
+        Kind::Gcvf | Kind::Png => ExportParams::Png(png_params(a, voxel)?),
         Kind::Mesh => ExportParams::Mesh(mesh_params(a, voxel, &model)?),
         Kind::Fea => ExportParams::Fea(fea_params(a, voxel, &model)?),
     };
@@ -396,6 +435,7 @@ fn png_params(a: &ExportArgs, voxel: Option<DVec3>) -> anyhow::Result<PngParams>
         shard: a.shard.as_deref().map(str::parse).transpose()?,
         per_material_bitmaps: a.bitmaps,
         threads: a.threads,
+        liquid_keep_out: a.liquid_keep_out,
     })
 }
 
@@ -469,6 +509,16 @@ fn fea_params(
         solver_memory: None,
         threads: a.threads,
     })
+}
+
+/// Print the warnings about features thinner than `size` can resolve
+/// before the export starts (the summary repeats them).
+pub(super) fn warn_thin(model: &volcad_core::Model, size: f64, option: &str) {
+    for n in volcad_compilers::thin::thin_feature_notes(model, size, option) {
+        if n.starts_with("warning") {
+            eprintln!("{n}");
+        }
+    }
 }
 
 /// A flag that Ctrl-C, SIGTERM and SIGHUP set, for [`follow`] to cancel the

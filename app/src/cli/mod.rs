@@ -25,6 +25,7 @@ mod design;
 mod eval;
 mod export;
 mod fea_result;
+mod gcvf;
 mod info;
 mod merge;
 mod output;

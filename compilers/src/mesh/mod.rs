@@ -29,7 +29,7 @@
 
 pub mod bodies;
 pub mod contour;
-mod field;
+pub mod field;
 mod flat;
 pub mod indexed;
 mod interface;

@@ -201,6 +201,13 @@ impl Model {
         &self.table
     }
 
+    /// The same design written against `table` (same ids: a printer's
+    /// names and colours for the design's materials).
+    pub fn with_table(mut self, table: Arc<MaterialTable>) -> Model {
+        self.table = table;
+        self
+    }
+
     /// The shared table.
     pub fn table_arc(&self) -> Arc<MaterialTable> {
         self.table.clone()
