@@ -16,12 +16,12 @@ pub mod lazy_random;
 
 pub mod design;
 pub mod dither;
+mod estimate;
 pub mod mesh;
 pub mod par_deflate;
 pub mod png_io;
 pub mod png_stack;
 mod presets;
-mod probe;
 pub mod resources;
 pub mod thin;
 mod union_find;

@@ -45,11 +45,11 @@ use volcad_core::sampler::{Grid, Sampler, Slab};
 
 use crate::design::{grid_for, palette};
 use crate::dither::{self, Diffuser};
+use crate::estimate::{Look, coarse_estimate, sampled_layers};
 use crate::job::{ExportError, JobContext, Summary};
 use crate::lazy_random;
 use crate::png_io::{self, bit_row_bytes};
 pub use crate::presets::{Preset, preset, presets};
-use crate::probe::{Look, probe, sampled_layers};
 use crate::resources::{check_disk, check_memory, run_with_threads};
 
 /// How each voxel's material is chosen from its fractions.
@@ -185,7 +185,7 @@ fn estimate_with(model: &Model, p: &PngParams, look: Look) -> Result<Estimate, E
     // Rough output: pure material compresses to almost nothing, a two-way
     // mix to 0.7 (random) or 0.85 (diffusion) bytes per voxel (measured on
     // the graded bar at 0.02 mm), plus a row's worth and a header per file.
-    let pr = probe(model, p.voxel);
+    let pr = coarse_estimate(model, p.voxel);
     let mixed_bytes = match p.dither {
         Dither::Random => 0.7,
         Dither::Diffusion => 0.85,
@@ -203,7 +203,7 @@ fn estimate_with(model: &Model, p: &PngParams, look: Look) -> Result<Estimate, E
     // what it cannot.
     let sampled = match look {
         Look::Layers => sampled_bytes(model, p, grid, &layers, &pal),
-        Look::Probe => None,
+        Look::Coarse => None,
     };
     let disk = match sampled {
         Some(b) => disk.max(b as f64),
@@ -226,7 +226,7 @@ pub fn export_png_stack(
     p: &PngParams,
     ctx: &JobContext,
 ) -> Result<Summary, ExportError> {
-    let est = estimate_with(model, p, Look::Probe)?;
+    let est = estimate_with(model, p, Look::Coarse)?;
     check_disk(est.disk_bytes, ctx.folder(), "a larger voxel size")?;
     run_with_threads(p.threads, || write_stack(model, p, &est, ctx))
 }

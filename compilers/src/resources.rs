@@ -116,7 +116,7 @@ pub fn check_memory(needed: u64, what: &str) -> Result<(), ExportError> {
 /// started, with an error, before the kernel's out-of-memory killer stops
 /// the whole process (which leaves the staging folder behind and, in the
 /// studio, loses the session). The estimates behind [`check_memory`] can
-/// miss: the size probe does not see parts or interfaces much thinner than
+/// miss: the size estimate does not see parts or interfaces much thinner than
 /// its cells. Reads the heap that [`volcad_core::heap::CountingAllocator`]
 /// counts; without it (a library user's program) there is no guard.
 pub struct MemoryGuard {

@@ -65,7 +65,7 @@ fn the_estimate_covers_the_flat_faces_kept_to_the_end() {
 #[test]
 fn the_guard_stops_an_export_that_outgrows_its_limit() {
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    // Estimates can miss (the size probe does not see parts thinner than
+    // Estimates can miss (the size estimate does not see parts thinner than
     // its cells); the mesh export checks the heap after every slab.
     let g = MemoryGuard::with_limit(8 << 20).expect("the counting allocator is installed");
     assert!(g.check(|| "at the start".into()).is_ok());

@@ -24,8 +24,8 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod aabb;
 pub mod bench;
-pub mod bounds;
 pub mod cells;
 pub mod expr;
 pub mod fastmath;
@@ -33,7 +33,6 @@ pub mod heap;
 pub mod interval;
 pub mod lattice;
 pub mod material;
-pub mod mesh;
 pub mod model;
 pub mod names;
 pub mod node;
@@ -42,10 +41,11 @@ pub mod sampler;
 pub mod script;
 pub mod simfield;
 pub mod text;
+pub mod trimesh;
 pub mod vcad;
 pub mod xorshift;
 
-pub use bounds::Aabb;
+pub use aabb::Aabb;
 pub use glam::DVec3;
 pub use material::{MaterialId, MaterialTable};
 pub use model::{Model, Points, PrepareError};

@@ -187,7 +187,7 @@ pub enum NodeKind {
     Blend { radius: f64, child: Option<Node> },
     /// A triangle mesh as signed distance (mesh import).
     Mesh {
-        mesh: Arc<crate::mesh::TriangleMesh>,
+        mesh: Arc<crate::trimesh::TriangleMesh>,
         material: MaterialId,
     },
     /// An FEA result field driving fractions (SimulationField).

@@ -14,8 +14,8 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 use volcad_core::Model;
-use volcad_core::mesh::TriangleMesh;
 use volcad_core::script::{ScriptOptions, run_script};
+use volcad_core::trimesh::TriangleMesh;
 
 const BUNNY: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),

@@ -31,6 +31,12 @@ pub const THIN_BIAS_VOXELS: f32 = 0.25;
 /// keeps `e^-VOLUME_DEPTH` of the light behind it, for plates and bars alike.
 const VOLUME_DEPTH: f32 = 1.5;
 
+/// The range of `ViewSettings::volume_density`: beyond it the picture is
+/// either the surface only or nothing at all.
+pub const MIN_DENSITY: f32 = 0.05;
+/// See [`MIN_DENSITY`].
+pub const MAX_DENSITY: f32 = 20.0;
+
 /// Materials below this alpha (0..1) are "clear": drawn in Solid mode with
 /// their (light) colour, and at this alpha in Volume mode.
 const MIN_VOLUME_ALPHA: f32 = 0.08;
@@ -472,7 +478,8 @@ impl Renderer {
         u.bbox_min = v4(m.bbox_min, if m.empty { 0.0 } else { 1.0 });
         let e = (m.bbox_max - m.bbox_min).max(Vec3::splat(1e-6));
         let mean_chord = 2.0 * e.x * e.y * e.z / (e.x * e.y + e.y * e.z + e.z * e.x);
-        u.bbox_max = v4(m.bbox_max, VOLUME_DEPTH / mean_chord);
+        let density = s.volume_density.clamp(MIN_DENSITY, MAX_DENSITY);
+        u.bbox_max = v4(m.bbox_max, VOLUME_DEPTH * density / mean_chord);
         // Ground grid spacing: a power of ten giving 5..50 lines across.
         u.viewport[2] = 10f32.powf((extent / 5.0).log10().floor());
         if m.empty {

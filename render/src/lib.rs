@@ -23,7 +23,7 @@
 //! - [`Renderer`]: pipelines and textures, created once per device.
 //! - [`viewport`]: the egui-wgpu paint callback.
 //! - [`render_offscreen`], [`Offscreen`]: own device, image out (tests, CLI).
-//! - [`probe`]: exact CPU ray cast for the cursor read-out.
+//! - [`pick`]: exact CPU ray cast for the cursor read-out.
 //!
 //! **Modes.** Solid: opaque lit surface, colour = fraction-weighted mix of
 //! the material colours (materials with very low alpha, like `clear`, keep
@@ -52,7 +52,7 @@ mod bake;
 mod camera;
 mod gpu;
 mod offscreen;
-mod probe;
+mod pick;
 mod progressive;
 mod redistance;
 mod settings;
@@ -61,9 +61,9 @@ pub mod viewport;
 
 pub use bake::{BakeError, MAX_CHANNELS, VolumeBake, bake};
 pub use camera::{Camera, StandardView};
-pub use gpu::{RENDER_SHADER, Renderer, THIN_BIAS_VOXELS};
+pub use gpu::{MAX_DENSITY, MIN_DENSITY, RENDER_SHADER, Renderer, THIN_BIAS_VOXELS};
 pub use offscreen::{Offscreen, render_offscreen};
-pub use probe::{HitSurface, ProbeHit, probe, probe_drawn};
+pub use pick::{HitSurface, PickHit, pick, pick_drawn};
 pub use progressive::{DEFAULT_LEVELS, ProgressiveBaker};
 pub use settings::{CutPlane, ViewMode, ViewSettings};
 pub use upscale::BLIT_SHADER;

@@ -68,6 +68,10 @@ pub struct ViewSettings {
     /// below 1 the image is rendered smaller and upscaled. Use about 0.5 on a
     /// software renderer (lavapipe) or while the camera moves, 1 when still.
     pub render_scale: f32,
+    /// Volume mode: multiplies the optical depth (1 = an average ray through
+    /// a solid part keeps e^-1.5 of the light behind it; more shows the
+    /// surface layers, less sees deeper).
+    pub volume_density: f32,
 }
 
 impl Default for ViewSettings {
@@ -82,6 +86,7 @@ impl Default for ViewSettings {
             show_axes: true,
             background: [0.13, 0.14, 0.16, 1.0],
             render_scale: 1.0,
+            volume_density: 1.0,
         }
     }
 }

@@ -1,4 +1,4 @@
-//! CPU-side behaviour: bakes, the progressive baker, the probe, the camera.
+//! CPU-side behaviour: bakes, the progressive baker, the pick, the camera.
 
 mod common;
 
@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 
 use common::*;
 use glam::{Vec2, Vec3};
-use volcad_render::{BakeError, Camera, CutPlane, ProgressiveBaker, StandardView, bake, probe};
+use volcad_render::{BakeError, Camera, CutPlane, ProgressiveBaker, StandardView, bake, pick};
 
 #[test]
 fn bake_covers_the_box_with_padding_and_colours() {
@@ -91,10 +91,10 @@ fn progressive_baker_restart_replaces_the_model() {
 }
 
 #[test]
-fn probe_hits_the_front_face_with_fractions() {
+fn pick_hits_the_front_face_with_fractions() {
     let model = model(GRADED_BAR);
     let cam = Camera::fit(&model.bbox(), StandardView::Front);
-    let hit = probe(&model, &cam, None, Vec2::ZERO, 1.5).expect("centre ray hits the bar");
+    let hit = pick(&model, &cam, None, Vec2::ZERO, 1.5).expect("centre ray hits the bar");
     assert!((hit.point.y + 5.0).abs() < 1e-3, "{:?}", hit.point);
     let total: f64 = hit.fractions.iter().map(|f| f.1).sum();
     assert!((total - 1.0).abs() < 1e-6);
@@ -103,14 +103,14 @@ fn probe_hits_the_front_face_with_fractions() {
         "{:?}",
         hit.fractions
     );
-    assert!(probe(&model, &cam, None, Vec2::new(0.99, 0.99), 1.5).is_none());
+    assert!(pick(&model, &cam, None, Vec2::new(0.99, 0.99), 1.5).is_none());
     // A cut at y = 0 keeping y >= 0 moves the hit to the cut face.
     let cut = CutPlane {
         axis: 1,
         offset: 0.0,
         keep_below: false,
     };
-    let hit = probe(&model, &cam, Some(&cut), Vec2::ZERO, 1.5).expect("hits the cut face");
+    let hit = pick(&model, &cam, Some(&cut), Vec2::ZERO, 1.5).expect("hits the cut face");
     assert!(hit.point.y.abs() < 1e-3, "{:?}", hit.point);
 }
 

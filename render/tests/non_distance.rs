@@ -1,6 +1,6 @@
 //! A design whose value is not a distance: pyvcad's mug with a quartic
 //! `Function` handle (`assets/examples/mug.rhai`). The viewport bake
-//! redistances it, so the handle is drawn; the CPU probe, marching by sign,
+//! redistances it, so the handle is drawn; the CPU pick, marching by sign,
 //! finds the same surface. Runs on a real device (lavapipe where there is
 //! no GPU), like `render.rs`.
 
@@ -8,9 +8,7 @@ mod common;
 
 use common::*;
 use glam::{DVec3, Vec3};
-use volcad_render::{
-    Camera, Offscreen, StandardView, ViewMode, ViewSettings, bake_blocking, probe,
-};
+use volcad_render::{Camera, Offscreen, StandardView, ViewMode, ViewSettings, bake_blocking, pick};
 
 const MUG: &str = include_str!("../../assets/examples/mug.rhai");
 const SIZE: [u32; 2] = [320, 240];
@@ -29,7 +27,7 @@ fn torus_distance(p: DVec3) -> f64 {
 }
 
 #[test]
-fn the_quartic_handle_is_drawn_and_probed() {
+fn the_quartic_handle_is_drawn_and_picked() {
     let model = model(MUG);
     assert!(!model.distance_is_bound(), "a Function is not a distance");
     let bake = bake_blocking(&model, 128).expect("bake");
@@ -73,22 +71,22 @@ fn the_quartic_handle_is_drawn_and_probed() {
         "cup not grey: {c:?}"
     );
 
-    // The CPU probe through the outer arc hits the torus's front, red.
+    // The CPU pick through the outer arc hits the torus's front, red.
     let aspect = SIZE[0] as f32 / SIZE[1] as f32;
     let (px, py) = project(&cam, Vec3::new((CX + RING) as f32, 0.0, 0.0), SIZE);
     let ndc = glam::Vec2::new(
         (px as f32 + 0.5) / SIZE[0] as f32 * 2.0 - 1.0,
         1.0 - (py as f32 + 0.5) / SIZE[1] as f32 * 2.0,
     );
-    let hit = probe(&model, &cam, None, ndc, aspect).expect("probe hits the handle");
+    let hit = pick(&model, &cam, None, ndc, aspect).expect("pick hits the handle");
     let err = torus_distance(hit.point);
-    eprintln!("probe: {:?}, torus distance {err:.2e}", hit.point);
+    eprintln!("pick: {:?}, torus distance {err:.2e}", hit.point);
     assert!(
         err.abs() < 1e-3,
-        "probe hit {:?} off the torus by {err}",
+        "pick hit {:?} off the torus by {err}",
         hit.point
     );
-    assert!(hit.point.y < 0.0, "probe hit the back of the tube");
+    assert!(hit.point.y < 0.0, "pick hit the back of the tube");
     let red = model.table().id("red").expect("red");
     assert_eq!(hit.fractions, vec![(red, 1.0)]);
 }

@@ -1,6 +1,6 @@
 //! Volcad Studio: the desktop IDE.
 //!
-//! `volcad-studio [--script FILE | --example NAME] [--screenshot PATH] [--quit-after-frames N]`
+//! `volcad-studio [--script FILE | --example NAME] [--then-example NAME] [--screenshot PATH] [--quit-after-frames N]`
 //!
 //! `--screenshot` is for the smoke test: the studio opens, runs the script,
 //! waits for the preview to finish baking, saves a screenshot and quits
@@ -27,6 +27,11 @@ struct Args {
     /// Open a bundled example by name (e.g. graded_bar, bunny_lattice).
     #[arg(long, value_name = "NAME", conflicts_with = "script")]
     example: Option<String>,
+    /// With `--screenshot`: once the first design is baked, open this bundled
+    /// example the way the Examples menu does, and take the screenshot of it
+    /// (the smoke test checks that the second design is framed).
+    #[arg(long, value_name = "NAME", requires = "screenshot")]
+    then_example: Option<String>,
     /// Save a screenshot of the window here once the preview is baked, then quit.
     #[arg(long, value_name = "PATH")]
     screenshot: Option<PathBuf>,
@@ -45,6 +50,7 @@ fn main() -> anyhow::Result<()> {
     let opts = StudioOptions {
         script: args.script,
         example: args.example,
+        then_example: args.then_example,
         screenshot: args.screenshot,
         quit_after_frames: args.quit_after_frames,
         // Automated runs leave the user's settings alone.

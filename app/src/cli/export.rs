@@ -1,7 +1,7 @@
-//! `volcad export png|mesh|fea` and `volcad fea-result`: run an export job
+//! `volcad export png|mesh|fea`: run an export job
 //! with a progress bar; Ctrl-C cancels cleanly (nothing is left behind).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::RecvTimeoutError;
@@ -548,19 +548,5 @@ fn follow(handle: job::JobHandle, interrupted: &AtomicBool) -> anyhow::Result<()
     for n in &summary.notes {
         outln!("  {n}");
     }
-    Ok(())
-}
-
-/// `volcad fea-result JOB.frd --inp JOB.inp --out result.csv` (`--out -`
-/// for standard output). The CSV is made in memory first: a deck that does
-/// not match the result leaves no file.
-pub fn fea_result(frd: &Path, inp: &Path, out: &Path) -> anyhow::Result<()> {
-    super::output::check_regular(frd, "CalculiX result (.frd)")?;
-    super::output::check_regular(inp, "deck (.inp)")?;
-    super::output::target(out, "--out")?;
-    let r = volcad_compilers::fea::read_frd(frd)?;
-    let (text, _) = volcad_compilers::fea::result_csv(&r, Some(inp))?;
-    super::output::write_output(out, "--out", |w| w.write_all(text.as_bytes()))?;
-    note!("{} nodes -> {}", r.displacements.len(), out.display());
     Ok(())
 }

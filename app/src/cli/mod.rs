@@ -20,8 +20,11 @@ macro_rules! note {
     }};
 }
 
+mod bench;
 mod design;
+mod eval;
 mod export;
+mod fea_result;
 mod info;
 mod output;
 mod render;
@@ -123,14 +126,14 @@ pub enum Command {
         out: PathBuf,
     },
     /// Measure evaluation and export throughput on designs (points/s, voxels/s).
-    Bench(info::BenchArgs),
+    Bench(bench::BenchArgs),
 }
 
 /// Run a parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Info(d) => info::info(&d),
-        Command::Eval { design, x, y, z } => info::eval(&design, x, y, z),
+        Command::Eval { design, x, y, z } => eval::eval(&design, x, y, z),
         Command::Sample {
             design,
             points,
@@ -138,8 +141,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         } => sample::sample(&design, &points, &out),
         Command::Render(a) => render::render(&a),
         Command::Export(a) => export::export(&a),
-        Command::FeaResult { frd, inp, out } => export::fea_result(&frd, &inp, &out),
-        Command::Bench(a) => info::bench(&a),
+        Command::FeaResult { frd, inp, out } => fea_result::fea_result(&frd, &inp, &out),
+        Command::Bench(a) => bench::bench(&a),
     }
 }
 

@@ -71,6 +71,9 @@ pub struct StudioOptions {
     pub script: Option<PathBuf>,
     /// Open this bundled example, by file name (`--example graded_bar`).
     pub example: Option<String>,
+    /// Screenshot mode: open this example once the first design is baked,
+    /// and screenshot that one instead.
+    pub then_example: Option<String>,
     /// Start with this text, untitled (tests).
     pub initial_text: Option<String>,
     /// Save a screenshot here once the first design is baked, then quit.
@@ -96,6 +99,7 @@ impl Default for StudioOptions {
         Self {
             script: None,
             example: None,
+            then_example: None,
             initial_text: None,
             screenshot: None,
             quit_after_frames: None,

@@ -1,5 +1,5 @@
 //! The probe: what is under the cursor, read exactly from the model (not the
-//! baked preview) by `volcad_render::probe`, on a worker thread so a big
+//! baked preview) by `volcad_render::pick`, on a worker thread so a big
 //! design never stalls a frame. One probe runs at a time; while it runs, only
 //! the newest request waits (hover requests replace each other; a click's
 //! request is never replaced by a hover).
@@ -9,7 +9,7 @@ use std::sync::mpsc::{Receiver, Sender, channel};
 
 use egui::Pos2;
 use volcad_core::Model;
-use volcad_render::{ProbeHit, Vec2, ViewSettings};
+use volcad_render::{PickHit, Vec2, ViewSettings};
 
 /// One probe to run.
 #[derive(Clone)]
@@ -33,14 +33,14 @@ pub struct Probe {
     /// Where the cursor was (screen points).
     pub pos: Pos2,
     /// The hit: point, depth from the eye, fractions.
-    pub hit: ProbeHit,
+    pub hit: PickHit,
     /// The model's signed distance at the hit point (mm; ≤ 0 on the part).
     pub surface_distance: f64,
 }
 
 /// Run one probe (the worker's job; also handy in tests).
 pub fn run(req: &ProbeRequest) -> Option<Probe> {
-    let hit = volcad_render::probe_drawn(&req.model, &req.view, req.ndc, req.aspect)?;
+    let hit = volcad_render::pick_drawn(&req.model, &req.view, req.ndc, req.aspect)?;
     let surface_distance = req.model.distance(hit.point);
     Some(Probe {
         pos: req.pos,

@@ -103,8 +103,10 @@ impl BottomPanel {
             }
         });
         ui.separator();
+        // One scroll state per tab: the log's starts at its newest entry
+        // (stuck to the end) instead of inheriting the problem list's top.
         egui::ScrollArea::vertical()
-            .id_salt("bottom-scroll")
+            .id_salt(("bottom-scroll", self.tab == Tab::Log))
             .auto_shrink([false, false])
             .stick_to_bottom(self.tab == Tab::Log)
             .show(ui, |ui| match self.tab {

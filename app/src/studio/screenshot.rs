@@ -2,6 +2,9 @@
 //! waits until the script ran and the preview finished baking (every level),
 //! paints two more frames so the picture is on screen, asks eframe for a
 //! screenshot (`ViewportCommand::Screenshot`), writes the PNG and closes.
+//! With `--then-example NAME` it then opens that example as the Examples
+//! menu does and waits for its bake before the picture (the smoke test's
+//! check that a newly opened design is framed).
 //! `--quit-after-frames N` closes after N frames whatever happened (exit
 //! status 2 when no screenshot was written by then).
 
@@ -16,8 +19,9 @@ use super::StudioApp;
 const SETTLE_FRAMES: u32 = 2;
 
 enum State {
-    /// Waiting for the design and its bake.
-    Waiting { settled: u32 },
+    /// Waiting for the design and its bake (a bake numbered above
+    /// `after`: bakes of a design opened earlier do not count).
+    Waiting { settled: u32, after: u64 },
     /// Asked eframe; the image comes through the channel.
     Requested(Receiver<Arc<egui::ColorImage>>),
     /// Written (or failed); closing.
@@ -35,7 +39,10 @@ impl Screenshot {
     pub fn new(path: Option<PathBuf>) -> Self {
         Self {
             path,
-            state: State::Waiting { settled: 0 },
+            state: State::Waiting {
+                settled: 0,
+                after: 0,
+            },
         }
     }
 }
@@ -72,15 +79,31 @@ impl StudioApp {
         };
         self.allow_close = true;
         match &mut self.shot.state {
-            State::Waiting { settled } => {
+            State::Waiting { settled, after } => {
                 ctx.request_repaint();
                 let ready = !self.live.is_busy()
                     && (self.error.is_some()
-                        || (self.viewport.bakes_received() > 0 && !self.viewport.is_baking()));
+                        || (self.viewport.bakes_received() > *after && !self.viewport.is_baking()));
                 if ready {
                     *settled += 1;
                 }
-                if *settled > SETTLE_FRAMES {
+                if *settled > SETTLE_FRAMES
+                    && let Some(next) = self.opts.then_example.take()
+                {
+                    // `--then-example`: open it as the Examples menu does
+                    // and wait for its own bake.
+                    *after = self.viewport.bakes_received();
+                    *settled = 0;
+                    match super::examples::find(&next) {
+                        Some(e) => self.request(ctx, super::commands::Pending::Example(e.file)),
+                        None => {
+                            eprintln!("volcad-studio: no example called {next}");
+                            self.opts.exit_status.store(1, Ordering::Relaxed);
+                            self.shot.state = State::Done;
+                            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+                        }
+                    }
+                } else if *settled > SETTLE_FRAMES {
                     let (tx, rx) = channel();
                     let c = ctx.clone();
                     ctx.request_screenshot(move |img| {

@@ -300,6 +300,19 @@ impl Viewport {
                     level: 0.5,
                 };
             }
+            if *mode == ViewMode::Volume {
+                ui.add(
+                    egui::Slider::new(
+                        &mut self.settings.volume_density,
+                        volcad_render::MIN_DENSITY..=volcad_render::MAX_DENSITY,
+                    )
+                    .logarithmic(true)
+                    .text("density"),
+                )
+                .on_hover_text(
+                    "How opaque the volume is: more shows the outer layers, less sees deeper",
+                );
+            }
             ui.separator();
             let mut cut_on = self.settings.cut.is_some();
             if ui.checkbox(&mut cut_on, "Cut").changed() {

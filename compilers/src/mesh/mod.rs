@@ -58,9 +58,9 @@ pub use field::marching_cubes;
 pub use indexed::{EdgeReport, IndexedMesh};
 
 use crate::design::{grid_for, palette};
+use crate::estimate::{Look, coarse_estimate, sampled_layers};
 use crate::job::{ExportError, JobContext, Summary};
 use crate::png_io::folder_name;
-use crate::probe::{Look, probe, sampled_layers};
 use crate::resources::{MemoryGuard, check_disk, check_memory, human_bytes, run_with_threads};
 use contour::{Contourer, Plane};
 use layer_dist::{DistPool, LayerDist};
@@ -84,10 +84,10 @@ const SLAB_LAYERS: usize = 4;
 /// Triangles per voxel face of surface (measured on spheres and lattices).
 const TRIANGLES_PER_FACE: f64 = 9.0;
 /// Cube layers the triangle estimate samples at the export's voxel size
-/// (see `sampled_triangles`), when the probe's cells are more than
+/// (see `sampled_triangles`), when the coarse grid's cells are more than
 /// [`SAMPLE_BEYOND`] voxels across.
 const SAMPLED_LAYERS: usize = 3;
-/// Probe cells at most this many voxels across see what the export sees.
+/// Coarse cells at most this many voxels across see what the export sees.
 const SAMPLE_BEYOND: f64 = 2.0;
 /// Triangles of merged flat faces per voxel of `sqrt(flat area)`: a 10 mm
 /// cube makes about 12 thousand at 0.1 mm and 24 thousand at 0.05 mm,
@@ -181,7 +181,7 @@ pub struct MeshEstimate {
     pub segments: usize,
     /// Layers sampled per slab.
     pub slab_layers: usize,
-    /// Rough triangle count over all segments, from the probed surface area
+    /// Rough triangle count over all segments, from the coarsely estimated surface area
     /// as marching tetrahedra would cut it: flat faces merge into far fewer
     /// (the memory and disk checks err on the safe side there).
     pub triangles: u64,
@@ -278,7 +278,7 @@ fn plan(model: &Model, p: &MeshParams, look: Look) -> Result<Plan, ExportError> 
     let slab_layers = (SLAB_BUDGET / per_layer.max(1))
         .clamp(1, SLAB_LAYERS)
         .min(nz);
-    let pr = probe(model, p.voxel);
+    let pr = coarse_estimate(model, p.voxel);
     let face = (p.voxel.x * p.voxel.y * p.voxel.z).powf(2.0 / 3.0);
     let segments = classifier.segments();
     // Interfaces add surface; assume about half the outer area per extra segment.
@@ -287,8 +287,8 @@ fn plan(model: &Model, p: &MeshParams, look: Look) -> Result<Plan, ExportError> 
     // with their outlines, about their length in voxels (each segment has
     // its own).
     let flat_triangles = FLAT_TRIANGLES_PER_EDGE * (pr.flat_mm2 / face).sqrt() * more;
-    let probed = pr.surface_mm2 * more / face * TRIANGLES_PER_FACE;
-    // Sampled layers see what the probe's cells are too coarse for. Two
+    let coarse = pr.surface_mm2 * more / face * TRIANGLES_PER_FACE;
+    // Sampled layers see what the coarse grid's cells are too coarse for. Two
     // layers and their planes must fit the slab budget: a grid whose layer
     // alone outgrows memory is refused below, not sampled first.
     let pair_bytes = 2 * layer * (4 + 4 * k + 2 + 4 + 4 * stride);
@@ -300,7 +300,7 @@ fn plan(model: &Model, p: &MeshParams, look: Look) -> Result<Plan, ExportError> 
     } else {
         0.0
     };
-    let triangles = (probed.max(sampled) + flat_triangles) as u64;
+    let triangles = (coarse.max(sampled) + flat_triangles) as u64;
     // Meshes: 12 B per triangle, ~½ vertex per triangle at 12 B + map entry.
     let mesh_bytes = triangles * 12 + triangles / 2 * 40;
     // Flat cubes are kept to the end: the box's faces, planar interfaces
@@ -378,7 +378,7 @@ pub fn segment_meshes(
     cancel: &AtomicBool,
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<Vec<SegmentMesh>, ExportError> {
-    let pl = plan(model, p, Look::Probe)?;
+    let pl = plan(model, p, Look::Coarse)?;
     run_with_threads(p.threads, || build(model, p, &pl, cancel, &progress))
 }
 
@@ -394,8 +394,8 @@ fn sampler_for<'a>(model: &'a Model, grid: Grid, uniform: Option<UniformTest<'a>
 
 /// Triangles of the curved (not flat-merged) surface, from a few cube
 /// layers sampled and contoured at the export's own voxel size and scaled
-/// to all layers. The coarse probe cannot see parts thinner than its cells:
-/// on the bunny lattice at 0.26 mm (struts 1 mm across, probe cells 1.6 mm)
+/// to all layers. The coarse grid cannot see parts thinner than its cells:
+/// on the bunny lattice at 0.26 mm (struts 1 mm across, coarse cells 1.6 mm)
 /// it saw the bunny and not the struts, and estimated 2.1 million
 /// triangles for 9.9 million.
 fn sampled_triangles(model: &Model, grid: Grid, classifier: &Classifier) -> u64 {
@@ -566,7 +566,7 @@ pub fn export_meshes(
     p: &MeshParams,
     ctx: &JobContext,
 ) -> Result<Summary, ExportError> {
-    let pl = plan(model, p, Look::Probe)?;
+    let pl = plan(model, p, Look::Coarse)?;
     check_disk(pl.estimate.disk_bytes, ctx.folder(), "a larger voxel size")?;
     let thin = crate::thin::thin_feature_notes(model, p.voxel.max_element(), "--voxel");
     run_with_threads(p.threads, || {
@@ -582,7 +582,7 @@ pub fn export_meshes(
         })?;
         debug_assert!(nz > 0);
         ctx.check_cancel()?;
-        // The up-front check went by the coarse probe, which misses parts
+        // The up-front check went by the coarse grid, which misses parts
         // thinner than its cells; the triangles are known now, and nothing
         // is written yet.
         let made: usize = segs.iter().map(|s| s.mesh.triangles.len()).sum();

@@ -3,7 +3,7 @@
 use volcad_core::script::{ScriptOptions, model_of, model_of_file};
 
 use super::*;
-use crate::probe::Look;
+use crate::estimate::Look;
 use std::sync::atomic::Ordering;
 
 /// `src` after `let m = default_materials();`, run and prepared (shared
@@ -16,7 +16,7 @@ pub(crate) fn model(src: &str) -> Model {
 /// Segment meshes of `m` through a plan that `adjust` changes first (the
 /// switches tests compare).
 fn built(m: &Model, p: &MeshParams, adjust: impl Fn(&mut Plan)) -> Vec<SegmentMesh> {
-    let mut pl = plan(m, p, Look::Probe).expect("plan");
+    let mut pl = plan(m, p, Look::Coarse).expect("plan");
     adjust(&mut pl);
     build(m, p, &pl, &AtomicBool::new(false), &|_, _| {}).expect("build")
 }
@@ -56,8 +56,8 @@ fn triangle_estimates_are_within_twice_the_count() {
     let cube = model(r#"RectPrism(Vec3(0,0,0), Vec3(10,10,10), m.id("red"))"#);
     let bar = graded_bar();
     let ball = model(r#"Sphere(Vec3(0,0,0), 5, m.id("red"))"#);
-    // Wires 0.12 mm across and 0.5 mm probe cells: most of them fall
-    // between the probe's samples, which saw a seventh of the triangles
+    // Wires 0.12 mm across and 0.5 mm coarse cells: most of them fall
+    // between the coarse grid's samples, which saw a seventh of the triangles
     // (and a fifth of the bunny lattice's), the sampled layers all of them.
     let wires = model(
         r#"let u = Union();
@@ -164,7 +164,7 @@ fn uniform_tiles_are_used_and_agree_on_labels() {
         SegmentBy::Material(bar.table().id("red").expect("red")),
         4,
     );
-    let pl = plan(&bar, &p, Look::Probe).expect("plan");
+    let pl = plan(&bar, &p, Look::Coarse).expect("plan");
     let dims = pl.grid.dims;
     let test = |b: &[volcad_core::interval::Interval]| pl.classifier.uniform(b);
     let fast = Sampler::new(&bar, pl.grid, true).with_uniform(&test);
@@ -243,7 +243,7 @@ fn blocks_through_layers_agree_on_labels() {
             by,
             ..MeshParams::default()
         };
-        let pl = plan(&m, &p, Look::Probe).expect("plan");
+        let pl = plan(&m, &p, Look::Coarse).expect("plan");
         let dims = pl.grid.dims;
         let test = |b: &[volcad_core::interval::Interval]| pl.classifier.uniform(b);
         let plain = Sampler::new(&m, pl.grid, true);

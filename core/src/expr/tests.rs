@@ -627,7 +627,7 @@ fn affine_intervals_contain_points_and_reach_the_corners() {
     for src in ["x/15+0.5", "-x/15+0.5", "0.3 - 2*y + z/7", "(x - y)/3 - z"] {
         let e = Expr::compile(src, &vars).unwrap();
         assert!(e.is_affine(), "{src}");
-        let mut rng = crate::mesh::tests::Rng::new(5);
+        let mut rng = crate::trimesh::tests::Rng::new(5);
         let mut unit = || rng.f64();
         for _ in 0..200 {
             let lo: Vec<f64> = (0..3).map(|_| unit() * 20.0 - 10.0).collect();

@@ -28,7 +28,7 @@ use glam::{DMat3, DVec3};
 
 use super::pnode::{Affine, PNode};
 use super::prepare::Prepared;
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 use crate::node::{Node, NodeKind};
 
 /// Runs of moves or offsets at least this long are composed into one node.

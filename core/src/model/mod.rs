@@ -7,9 +7,9 @@
 //! so `materials()` lists the ids it uses, ascending, and a point's fractions
 //! are `k = materials().len()` numbers in that order.
 
-mod bound;
+mod distance_interval;
 mod flatten;
-mod frac_bound;
+mod fraction_bound;
 mod fractions;
 mod pnode;
 pub mod polygon2d;
@@ -31,7 +31,7 @@ use std::time::{Duration, Instant};
 
 use glam::DVec3;
 
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 use crate::interval::Interval;
 use crate::material::{MaterialId, MaterialTable};
 use crate::node::Node;
@@ -258,7 +258,7 @@ impl Model {
     /// with many children overlapping `b`, an FEA field with many
     /// tetrahedra in `b`).
     pub fn fraction_bounds(&self, b: &Aabb, out: &mut [Interval]) -> bool {
-        out.fill(frac_bound::ZERO);
+        out.fill(fraction_bound::ZERO);
         self.root.frac_bounds(b, out)
     }
 

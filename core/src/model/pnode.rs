@@ -14,7 +14,7 @@ use super::sdf;
 use super::strut_grid::StrutGrid;
 use super::tpms::Tpms;
 use super::union_index::{Candidates, UnionIndex};
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 use crate::expr::Expr;
 
 /// Dense material index within one model (position in `Model::materials`).
@@ -193,7 +193,7 @@ pub enum PNode {
         child: Arc<PNode>,
     },
     Mesh {
-        mesh: Arc<crate::mesh::TriangleMesh>,
+        mesh: Arc<crate::trimesh::TriangleMesh>,
         m: Slot,
     },
     SimField(Box<SimGrade>),

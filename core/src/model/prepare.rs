@@ -14,7 +14,7 @@ use super::strut_grid::StrutGrid;
 use super::tpms::Tpms;
 use super::union_index::UnionIndex;
 use super::{MAX_MATERIALS, PrepareError};
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 use crate::material::MaterialId;
 use crate::node::{Node, NodeKind};
 

@@ -8,7 +8,7 @@ use super::super::PrepareError;
 use super::super::pnode::{Capsule, PNode};
 use super::super::shapes::{Beam, Cone, Revolve, Shape};
 use super::{Preparer, err};
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 use crate::material::MaterialId;
 use crate::node::{CapMode, Node, NodeKind};
 
@@ -92,7 +92,7 @@ impl Preparer {
                 child,
             } => {
                 let (c, b) = self.child(n, child)?;
-                let m = super::super::bound::reflection(*normal);
+                let m = super::super::distance_interval::reflection(*normal);
                 (
                     PNode::Mirror {
                         point: *point,

@@ -9,7 +9,7 @@
 use glam::{DVec2, DVec3};
 
 use super::sdf;
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 use crate::node::CapMode;
 
 /// One prepared primitive of this module.

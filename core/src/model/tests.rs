@@ -5,7 +5,7 @@
 use glam::DVec3;
 
 use crate::Model;
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 use crate::script::{ScriptOptions, model_of, run_script};
 
 /// `src` after `let m = default_materials();`, run and prepared (shared by

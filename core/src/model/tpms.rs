@@ -26,7 +26,7 @@
 
 use glam::DVec3;
 
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 use crate::interval::Interval;
 use crate::node::TpmsType;
 

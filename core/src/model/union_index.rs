@@ -18,7 +18,7 @@
 
 use glam::DVec3;
 
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 use crate::cells::CellLattice;
 
 /// Cell-list entries per child (on average) that the grid may hold before

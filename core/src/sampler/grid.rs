@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 
 /// A regular voxel grid.
 #[derive(Clone, Copy, Debug, PartialEq)]

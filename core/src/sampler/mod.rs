@@ -27,7 +27,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use rayon::prelude::*;
 
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 use crate::interval::Interval;
 use crate::model::{MAX_MATERIALS, Model};
 

@@ -87,7 +87,7 @@ fn register_mesh(engine: &mut Engine, ctx: &RunContext) {
         let p = cc.call_position();
         let form = MeshArgs::parse(args, p)?;
         let full = c.resolve(path, p)?;
-        let mesh = file_cache::cached(&[&full], || crate::mesh::TriangleMesh::load(&full))
+        let mesh = file_cache::cached(&[&full], || crate::trimesh::TriangleMesh::load(&full))
             .or_else(|e| fail(p, e.to_string()))?;
         if form.validate {
             // Named as the script wrote it, so the suggested call is one to paste.

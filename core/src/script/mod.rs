@@ -212,8 +212,9 @@ pub(crate) fn runtime_message(e: &EvalAltResult) -> String {
 }
 
 /// A mesh file, loaded once while it is unchanged (the cache scripts use).
-pub(crate) fn load_mesh(full: &Path) -> Result<Arc<crate::mesh::TriangleMesh>, String> {
-    file_cache::cached(&[full], || crate::mesh::TriangleMesh::load(full)).map_err(|e| e.to_string())
+pub(crate) fn load_mesh(full: &Path) -> Result<Arc<crate::trimesh::TriangleMesh>, String> {
+    file_cache::cached(&[full], || crate::trimesh::TriangleMesh::load(full))
+        .map_err(|e| e.to_string())
 }
 
 /// Run a design script and prepare its model (what tests, benchmarks and

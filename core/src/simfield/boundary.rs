@@ -5,7 +5,7 @@
 //! corners of an inverted one); its faces `(0,2,1)`, `(0,1,3)`, `(1,2,3)`,
 //! `(0,3,2)` then have counter-clockwise order seen from outside, so the
 //! boundary triangles come out with outward normals, as
-//! [`crate::mesh::TriangleMesh`] expects for its pseudo-normal sign.
+//! [`crate::trimesh::TriangleMesh`] expects for its pseudo-normal sign.
 
 use glam::DVec3;
 

@@ -23,9 +23,9 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 use crate::interval::Interval;
-use crate::mesh::TriangleMesh;
+use crate::trimesh::TriangleMesh;
 
 use self::ranges::NodeRanges;
 use self::tet_bvh::TetLocator;

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 
 use super::{SimField, SimFieldError};
-use crate::mesh::tests::{Rng, temp_path, throughput};
+use crate::trimesh::tests::{Rng, temp_path, throughput};
 
 const SEAT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/seat/");
 /// The mesh and the table CSV ship with the bicycle-seat example.
@@ -69,7 +69,7 @@ fn seat_bounds_hold_at_every_sample_of_random_boxes() {
     for i in 0..300 {
         let size = [0.5, 2.0, 6.0][i % 3];
         let c = rng.in_box(&bb);
-        let b = crate::bounds::Aabb::new(c - DVec3::splat(size), c + DVec3::splat(size));
+        let b = crate::aabb::Aabb::new(c - DVec3::splat(size), c + DVec3::splat(size));
         if !f.bounds(&b, &mut iv) {
             continue;
         }
@@ -107,7 +107,7 @@ fn seat_bounds_from_the_node_table_equal_the_tetrahedra_one_by_one() {
         // From a fraction of one tetrahedron to more than MAX_BOUND_TETS.
         let size = [0.2, 1.0, 3.0, 6.0, 10.0, 20.0][i % 6];
         let c = rng.in_box(&bb);
-        let b = crate::bounds::Aabb::new(c - DVec3::splat(size), c + DVec3::splat(size));
+        let b = crate::aabb::Aabb::new(c - DVec3::splat(size), c + DVec3::splat(size));
         let got = f.bounds(&b, &mut iv);
         let want = one_by_one.bounds(&b, &mut want_iv);
         assert_eq!(got, want, "box {b:?}");

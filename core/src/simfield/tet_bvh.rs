@@ -23,7 +23,7 @@
 //!    near its centre;
 //! 3. when the walk leaves the mesh (a non-convex boundary between start and
 //!    `p`, or `p` outside) or exceeds its step limit: the BVH over the
-//!    tetrahedra's boxes (4-wide, [`crate::mesh::wide`]), which tests every
+//!    tetrahedra's boxes (4-wide, [`crate::trimesh::wide`]), which tests every
 //!    tetrahedron whose box contains `p`.
 //!
 //! A point on (or within the tolerance of) a face, edge or node is inside
@@ -37,10 +37,10 @@
 
 use glam::DVec3;
 
-use crate::bounds::Aabb;
-use crate::mesh::TriangleMesh;
-use crate::mesh::bvh;
-use crate::mesh::wide::{WideBvh, WideChild};
+use crate::aabb::Aabb;
+use crate::trimesh::TriangleMesh;
+use crate::trimesh::bvh;
+use crate::trimesh::wide::{WideBvh, WideChild};
 
 /// Barycentric tolerance (dimensionless).
 const TOLERANCE: f64 = -1e-12;

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use glam::DVec3;
-use volcad_core::mesh::{MeshError, TriangleMesh};
+use volcad_core::trimesh::{MeshError, TriangleMesh};
 
 use super::{write, writers};
 

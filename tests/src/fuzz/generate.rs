@@ -332,7 +332,7 @@ fn mesh(u: &mut Unstructured) -> Result<Case> {
     };
     // Mesh-file faults this harness found (truncated binary STL, `1e39` in
     // an ASCII STL, repeated triangles) are fixed in
-    // `core/src/mesh/formats/`; none is open.
+    // `core/src/trimesh/formats/`; none is open.
     let open = None;
     let (name, bytes, expect): (&str, Vec<u8>, Expect) = match u.int_in_range(0..=8)? {
         0 => ("m.stl", Vec::new(), Expect::Fail),

@@ -1,4 +1,4 @@
-//! Tests of [`crate::mesh`]: brute-force agreement on the bunny, a cube with
+//! Tests of [`crate::trimesh`]: brute-force agreement on the bunny, a cube with
 //! known distances, STL/OBJ reading and errors, open meshes.
 
 use std::path::PathBuf;
@@ -11,7 +11,7 @@ use super::{MeshError, TriangleMesh};
 #[allow(dead_code)]
 #[path = "../../tests/meshio/writers.rs"]
 mod writers;
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 
 const BUNNY: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -626,7 +626,7 @@ fn broken_files_report_line_or_size() {
 
 /// Throughput of `signed_distance` on the bunny for points within 2 mm of
 /// the surface (release build):
-/// `cargo test -p volcad-core --release --lib mesh::tests::perf -- --ignored --nocapture`
+/// `cargo test -p volcad-core --release --lib trimesh::tests::perf -- --ignored --nocapture`
 #[test]
 #[ignore]
 fn perf_bunny_band() {

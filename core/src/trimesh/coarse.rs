@@ -12,7 +12,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 
 /// Most cells along the longest side of the mesh box.
 const MAX_CELLS: f64 = 32.0;

@@ -2,7 +2,7 @@
 //! of the box is inside, how much of that is a mix of materials, and about
 //! how much surface there is.
 //!
-//! The design is sampled on at most [`PROBE_CELLS`]³ voxels (through the one
+//! The design is sampled on at most [`COARSE_CELLS`]³ voxels (through the one
 //! sampler). The surface area is estimated from sign changes between
 //! neighbouring samples: each change along axis `a` stands for one voxel face
 //! of area `Π_{b≠a} h_b`; summed, that is the area of the blocky (cuberille)
@@ -16,19 +16,19 @@ use glam::DVec3;
 use volcad_core::Model;
 use volcad_core::sampler::{Grid, Sampler, Slab};
 
-/// Samples per axis of the probe grid (at most).
-pub const PROBE_CELLS: usize = 40;
+/// Samples per axis of the coarse grid (at most).
+pub const COARSE_CELLS: usize = 40;
 
 /// How closely an export's estimate looks at the design.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Look {
-    /// The coarse probe and rules of thumb only (about a millisecond): what
+    /// The coarse grid and rules of thumb only (about a millisecond): what
     /// an export job checks up front.
-    Probe,
+    Coarse,
     /// Also a few layers sampled at the export's own voxel size and run
     /// through its next steps (meshes contour them, slice stacks encode
     /// them): what the estimates shown before an export use, and the CLI
-    /// checks with. Parts thinner than the probe's cells, and layers that
+    /// checks with. Parts thinner than the coarse grid's cells, and layers that
     /// compress worse than the rule says, show there.
     Layers,
 }
@@ -40,9 +40,9 @@ pub fn sampled_layers(layers: Range<usize>, picks: usize) -> impl Iterator<Item 
     (0..picks).map(move |i| layers.start + (2 * i + 1) * layers.len() / (2 * picks))
 }
 
-/// What the probe saw.
+/// What the coarse grid saw.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Probe {
+pub struct CoarseEstimate {
     /// Share of the box inside the part, 0..=1.
     pub inside: f64,
     /// Share of the box inside with no material at 99% or more, 0..=1.
@@ -52,17 +52,17 @@ pub struct Probe {
     /// Area of the part's faces on its bounding box (mm²): planar, so a
     /// mesh export merges them into few triangles.
     pub flat_mm2: f64,
-    /// The probe's voxel (mm): parts thinner than this may be missed.
+    /// The coarse grid's voxel (mm): parts thinner than this may be missed.
     pub cell: DVec3,
 }
 
-/// Probe `model` over its bounding box with voxels no finer than `voxel`.
+/// Sample `model` coarsely over its bounding box with voxels no finer than `voxel`.
 /// Returns the default (all zero) for an unbounded or empty box.
-pub fn probe(model: &Model, voxel: DVec3) -> Probe {
+pub fn coarse_estimate(model: &Model, voxel: DVec3) -> CoarseEstimate {
     let bbox = model.bbox();
-    let coarse = (bbox.size() / PROBE_CELLS as f64).max(voxel);
-    let Ok(grid) = Grid::covering(&bbox, coarse, (PROBE_CELLS as u128 + 1).pow(3)) else {
-        return Probe::default();
+    let coarse = (bbox.size() / COARSE_CELLS as f64).max(voxel);
+    let Ok(grid) = Grid::covering(&bbox, coarse, (COARSE_CELLS as u128 + 1).pow(3)) else {
+        return CoarseEstimate::default();
     };
     let [nx, ny, nz] = grid.dims;
     // Counts read signs only.
@@ -72,7 +72,7 @@ pub fn probe(model: &Model, voxel: DVec3) -> Probe {
         .sample_layers(0, nz, &mut slab, &AtomicBool::new(false))
         .is_err()
     {
-        return Probe::default();
+        return CoarseEstimate::default();
     }
     let k = slab.k;
     let inside = |v: usize| slab.dist[v] <= 0.0;
@@ -111,7 +111,7 @@ pub fn probe(model: &Model, voxel: DVec3) -> Probe {
     let faces = [h.y * h.z, h.x * h.z, h.x * h.y];
     let area =
         |counts: [usize; 3]| -> f64 { counts.iter().zip(faces).map(|(c, a)| *c as f64 * a).sum() };
-    Probe {
+    CoarseEstimate {
         inside: n_in as f64 / total,
         mixed: n_mixed as f64 / total,
         surface_mm2: area(crossings) * 2.0 / 3.0,
@@ -134,17 +134,17 @@ mod tests {
     }
 
     #[test]
-    fn sphere_probe_is_about_right() {
+    fn sphere_coarse_estimate_is_about_right() {
         let src = "let m = default_materials(); Sphere(Vec3(0,0,0), 10, m.id(\"red\"))";
         let d = volcad_core::script::run_script(src, "t.rhai", &Default::default()).unwrap();
         let model = Model::prepare(&d.root, d.materials.clone()).unwrap();
-        let p = probe(&model, DVec3::splat(0.1));
+        let p = coarse_estimate(&model, DVec3::splat(0.1));
         // Sphere in its box: π/6 ≈ 0.524 inside; area 4π·100 ≈ 1257 mm².
         assert!((p.inside - 0.524).abs() < 0.05, "{p:?}");
         assert_eq!(p.mixed, 0.0);
         assert!((p.surface_mm2 / 1257.0 - 1.0).abs() < 0.25, "{p:?}");
         // It touches its box only at six points (a little more at the
-        // probe's resolution).
+        // coarse grid's resolution).
         assert!(p.flat_mm2 < 0.1 * 1257.0, "{p:?}");
     }
 
@@ -154,7 +154,7 @@ mod tests {
             "let m = default_materials(); RectPrism(Vec3(0,0,0), Vec3(10,10,10), m.id(\"red\"))";
         let d = volcad_core::script::run_script(src, "t.rhai", &Default::default()).unwrap();
         let model = Model::prepare(&d.root, d.materials.clone()).unwrap();
-        let p = probe(&model, DVec3::splat(0.1));
+        let p = coarse_estimate(&model, DVec3::splat(0.1));
         // Its 600 mm² all lie on its box.
         assert!(p.inside > 0.9, "{p:?}");
         assert!((p.flat_mm2 / 600.0 - 1.0).abs() < 0.05, "{p:?}");

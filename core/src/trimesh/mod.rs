@@ -40,7 +40,7 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 
 use self::topology::Topology;
 use self::triangle::Tri;

@@ -16,7 +16,7 @@
 
 use glam::DVec3;
 
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 
 /// Depth after which the builder stops using SAH and splits at the median,
 /// which halves the primitive count per level. SAH alone can peel one

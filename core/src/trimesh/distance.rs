@@ -4,7 +4,7 @@ use glam::DVec3;
 
 use super::TriangleMesh;
 use super::triangle::Feature;
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 use crate::interval::Interval;
 
 impl TriangleMesh {

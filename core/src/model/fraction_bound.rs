@@ -30,9 +30,9 @@ use std::sync::Arc;
 use glam::DVec3;
 
 use super::MAX_MATERIALS;
-use super::bound::coord_intervals;
+use super::distance_interval::coord_intervals;
 use super::pnode::{COORD_SLOTS, Grade, NAry, PNode, SimGrade, Slot};
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 use crate::expr::Expr;
 use crate::interval::Interval;
 
@@ -265,7 +265,7 @@ mod tests {
     fn check(m: &Model, size: f64) -> usize {
         let k = m.materials().len();
         let bb = m.bbox();
-        let mut rng = crate::mesh::tests::Rng::new(3);
+        let mut rng = crate::trimesh::tests::Rng::new(3);
         let mut next = || rng.f64();
         let mut checked = 0;
         let mut iv = [ZERO; MAX_MATERIALS];

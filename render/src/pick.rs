@@ -1,4 +1,4 @@
-//! The cursor probe: an exact CPU ray cast against the model (not the baked
+//! The cursor pick: an exact CPU ray cast against the model (not the baked
 //! volume), for the "what is under the cursor" read-out. It reads what the
 //! picture draws: the cut plane removes its half, hidden materials (opacity
 //! 0) and the iso mode's level decide which part of the inside is drawn, as
@@ -10,7 +10,7 @@ use volcad_core::{MaterialId, Model};
 use crate::camera::Camera;
 use crate::settings::{CutPlane, ViewMode, ViewSettings};
 
-/// Which surface the probe ray stopped on.
+/// Which surface the pick ray stopped on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum HitSurface {
     /// The part's outer surface.
@@ -33,9 +33,9 @@ impl HitSurface {
     }
 }
 
-/// What the probe ray hit.
+/// What the pick ray hit.
 #[derive(Clone, Debug, PartialEq)]
-pub struct ProbeHit {
+pub struct PickHit {
     /// The surface point (mm), just inside the part.
     pub point: DVec3,
     /// Distance from the ray origin to the point (mm).
@@ -105,25 +105,25 @@ impl Drawn {
 /// whose value is not a distance bound is marched by its sign instead
 /// ([`sign_march`]). Every material counts as drawn. `None` when the ray
 /// misses.
-pub fn probe(
+pub fn pick(
     model: &Model,
     camera: &Camera,
     cut: Option<&CutPlane>,
     ndc: Vec2,
     aspect: f32,
-) -> Option<ProbeHit> {
+) -> Option<PickHit> {
     march(model, camera, cut, &Drawn::All, ndc, aspect)
 }
 
-/// The probe as the picture drawn with `settings` shows the part: its
+/// The pick as the picture drawn with `settings` shows the part: its
 /// camera and cut plane, and only the materials it draws (hidden
 /// materials are looked through; iso mode stops at the level's surface).
-pub fn probe_drawn(
+pub fn pick_drawn(
     model: &Model,
     settings: &ViewSettings,
     ndc: Vec2,
     aspect: f32,
-) -> Option<ProbeHit> {
+) -> Option<PickHit> {
     let drawn = Drawn::from_settings(settings, model);
     march(
         model,
@@ -146,7 +146,7 @@ fn march(
     drawn: &Drawn,
     ndc: Vec2,
     aspect: f32,
-) -> Option<ProbeHit> {
+) -> Option<PickHit> {
     let bbox = model.bbox();
     if bbox.is_empty() || !bbox.is_finite() {
         return None;
@@ -220,7 +220,7 @@ fn march(
                 (tt, fr, HitSurface::Region)
             }
         };
-        return Some(ProbeHit {
+        return Some(PickHit {
             point: at(tt),
             distance: tt,
             fractions: fr.into_iter().filter(|(_, f)| *f > 0.0).collect(),
@@ -255,10 +255,10 @@ fn bisect<T>(
 
 /// The hit at `point` of a sign march (hidden materials are not looked
 /// through there: such fields are rare and the march is coarse already).
-fn hit_at(model: &Model, cut: Option<&CutPlane>, point: DVec3, distance: f64) -> ProbeHit {
+fn hit_at(model: &Model, cut: Option<&CutPlane>, point: DVec3, distance: f64) -> PickHit {
     let (dm, fr) = model.eval_point(point);
     let on_cut = cut.is_some_and(|c| c.distance(point.to_array()) >= dm);
-    ProbeHit {
+    PickHit {
         point,
         distance,
         fractions: fr.into_iter().filter(|(_, f)| *f > 0.0).collect(),
@@ -271,7 +271,7 @@ fn hit_at(model: &Model, cut: Option<&CutPlane>, point: DVec3, distance: f64) ->
 }
 
 /// Steps per bounding-box size of the sign march: four per voxel of the
-/// viewport's finest bake (256 along the longest side), so the probe finds
+/// viewport's finest bake (256 along the longest side), so the pick finds
 /// every feature the viewport draws.
 const SIGN_STEPS: f64 = 1024.0;
 
@@ -286,7 +286,7 @@ fn sign_march(
     d: DVec3,
     span: (f64, f64),
     scale: f64,
-) -> Option<ProbeHit> {
+) -> Option<PickHit> {
     let (tmin, tmax) = span;
     let step = scale / SIGN_STEPS;
     if sdf(o + d * tmin) <= 0.0 {

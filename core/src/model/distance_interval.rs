@@ -12,7 +12,7 @@ use glam::DVec3;
 
 use super::pnode::{COORD_SLOTS, D_SLOT, NAry, PNode, tile_local};
 use super::sdf;
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 use crate::interval::Interval;
 
 /// `d(centre) ± half diagonal` for a 1-Lipschitz field.
@@ -68,7 +68,7 @@ fn lipschitz(node: &PNode, b: &Aabb) -> Interval {
 /// the surface is within `2r` of the centre, else only the side that matters
 /// (`[d − r, ∞)` outside, `(−∞, d + r]` inside) from the mesh's coarse grid,
 /// without a closest-triangle search. Samplers ask this for every tile.
-fn mesh_interval(mesh: &crate::mesh::TriangleMesh, b: &Aabb) -> Interval {
+fn mesh_interval(mesh: &crate::trimesh::TriangleMesh, b: &Aabb) -> Interval {
     let r = b.half_diagonal();
     let reach = 2.0 * r + 1e-9;
     let d = mesh.signed_distance_bound(b.center(), reach);

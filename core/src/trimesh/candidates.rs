@@ -30,7 +30,7 @@ use rayon::prelude::*;
 use super::TriangleMesh;
 use super::certificate::{self, Skips};
 use super::triangle::Feature;
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 use crate::cells::CellLattice;
 
 /// Fewest cells along the longest side of the mesh box. On the bunny

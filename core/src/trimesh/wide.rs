@@ -17,7 +17,7 @@
 
 use glam::{BVec4A, DVec3, Vec4};
 
-use crate::bounds::Aabb;
+use crate::aabb::Aabb;
 
 use super::bvh::Bvh;
 
