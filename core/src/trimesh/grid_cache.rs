@@ -96,12 +96,10 @@ fn key(mesh: &TriangleMesh) -> u64 {
     mesh.vertices
         .iter()
         .for_each(|v| v.to_array().iter().for_each(|c| h.word(c.to_bits())));
-    mesh.triangles
-        .iter()
-        .for_each(|t| {
-            h.word(u64::from(t[0]) | (u64::from(t[1]) << 32));
-            h.word(u64::from(t[2]));
-        });
+    mesh.triangles.iter().for_each(|t| {
+        h.word(u64::from(t[0]) | (u64::from(t[1]) << 32));
+        h.word(u64::from(t[2]));
+    });
     h.finish()
 }
 
@@ -135,7 +133,10 @@ impl Hash {
 /// The file's bytes for `mesh`'s grids.
 fn encode(mesh: &TriangleMesh) -> Vec<u8> {
     let mut w = Vec::with_capacity(
-        64 + mesh.candidates.as_ref().map_or(0, |g| 4 * (g.records.len() + g.items.len())),
+        64 + mesh
+            .candidates
+            .as_ref()
+            .map_or(0, |g| 4 * (g.records.len() + g.items.len())),
     );
     w.extend_from_slice(MAGIC);
     put_u32(&mut w, FORMAT);
@@ -163,7 +164,10 @@ fn encode(mesh: &TriangleMesh) -> Vec<u8> {
             w.push(1);
             put_vec(&mut w, g.cells.origin());
             put_vec(&mut w, g.cells.cell());
-            g.cells.dims().iter().for_each(|&n| put_u64(&mut w, n as u64));
+            g.cells
+                .dims()
+                .iter()
+                .for_each(|&n| put_u64(&mut w, n as u64));
             for list in [&g.records, &g.items] {
                 put_u64(&mut w, list.len() as u64);
                 w.reserve(4 * list.len());
@@ -313,10 +317,14 @@ fn candidate_grid(r: &mut Reader, mesh: &TriangleMesh) -> Option<CandidateGrid> 
         return None;
     }
     // The layout this mesh's build gives (see `CandidateGrid::new`).
-    let want_slot_bits =
-        (usize::BITS - (mesh.tris.len().max(2) - 1).leading_zeros()).min(31);
+    let want_slot_bits = (usize::BITS - (mesh.tris.len().max(2) - 1).leading_zeros()).min(31);
     let certified = candidates::certified(slot_bits);
-    let want_q = slot_bits + if certified { super::certificate::BITS } else { 0 };
+    let want_q = slot_bits
+        + if certified {
+            super::certificate::BITS
+        } else {
+            0
+        };
     if slot_bits != want_slot_bits || q_shift != want_q {
         return None;
     }

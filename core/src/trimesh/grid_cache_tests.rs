@@ -35,13 +35,19 @@ fn grid_files(dir: &Path) -> Vec<PathBuf> {
 
 /// The grids, compared through their bits (`f64` NaN-safe).
 fn same_grids(a: &TriangleMesh, b: &TriangleMesh) {
-    let (ca, cb) = (a.coarse.as_ref().expect("coarse"), b.coarse.as_ref().expect("coarse"));
+    let (ca, cb) = (
+        a.coarse.as_ref().expect("coarse"),
+        b.coarse.as_ref().expect("coarse"),
+    );
     assert_eq!(ca.dims, cb.dims);
     assert_eq!(ca.origin, cb.origin);
     assert_eq!(ca.cell.to_bits(), cb.cell.to_bits());
     let bits = |d: &[f64]| d.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(&ca.d), bits(&cb.d));
-    let (ga, gb) = (a.candidates.as_ref().expect("grid"), b.candidates.as_ref().expect("grid"));
+    let (ga, gb) = (
+        a.candidates.as_ref().expect("grid"),
+        b.candidates.as_ref().expect("grid"),
+    );
     assert_eq!(ga.records, gb.records);
     assert_eq!(ga.items, gb.items);
     assert_eq!((ga.slot_bits, ga.q_shift), (gb.slot_bits, gb.q_shift));
@@ -53,7 +59,11 @@ fn same_grids(a: &TriangleMesh, b: &TriangleMesh) {
     let bbox = a.bbox().expand(3.0);
     for _ in 0..20_000 {
         let p = rng.in_box(&bbox);
-        assert_eq!(a.signed_distance(p).to_bits(), b.signed_distance(p).to_bits(), "{p}");
+        assert_eq!(
+            a.signed_distance(p).to_bits(),
+            b.signed_distance(p).to_bits(),
+            "{p}"
+        );
     }
 }
 
@@ -64,7 +74,10 @@ fn a_read_grid_is_the_built_grid() {
     let first = build(Some(dir.path()));
     let files = grid_files(dir.path());
     assert_eq!(files.len(), 1, "{files:?}");
-    assert_eq!(files[0].file_name().and_then(|n| n.to_str()), Some(&*format!("{:016x}.grid", key(&built))));
+    assert_eq!(
+        files[0].file_name().and_then(|n| n.to_str()),
+        Some(&*format!("{:016x}.grid", key(&built)))
+    );
     let second = build(Some(dir.path()));
     same_grids(&built, &first);
     same_grids(&built, &second);
@@ -87,7 +100,10 @@ fn damaged_files_are_rebuilt_never_trusted() {
         ("checksum wrong", bad_sum),
         ("truncated", good[..good.len() - 1000].to_vec()),
         ("empty", Vec::new()),
-        ("a different format", [b"VCADGRIX".as_slice(), &good[8..]].concat()),
+        (
+            "a different format",
+            [b"VCADGRIX".as_slice(), &good[8..]].concat(),
+        ),
     ];
     for (what, bytes) in cases {
         fs::write(&path, &bytes).expect("write");
@@ -124,7 +140,8 @@ fn the_folder_is_trimmed_oldest_first() {
     for (i, n) in names.iter().enumerate() {
         let f = fs::File::create(dir.path().join(n)).expect("create");
         f.set_len(1000).expect("len");
-        let when = std::time::SystemTime::UNIX_EPOCH + std::time::Duration::from_secs(1_000_000 + i as u64);
+        let when = std::time::SystemTime::UNIX_EPOCH
+            + std::time::Duration::from_secs(1_000_000 + i as u64);
         f.set_modified(when).expect("mtime");
     }
     trim(dir.path(), 2500);
