@@ -35,7 +35,7 @@ const FORMAT: u32 = 1;
 /// Meshes with fewer triangles build faster than a file is found and read.
 const MIN_TRIANGLES: usize = 1000;
 /// Bound on the folder's size (the bunny's grids are about 16 MB).
-pub(super) const MAX_BYTES: u64 = 512 << 20;
+const MAX_BYTES: u64 = 512 << 20;
 /// Largest grid dimension accepted from a file (the builders stay far below).
 const MAX_DIM: u64 = 1 << 16;
 
@@ -311,9 +311,8 @@ fn candidate_grid(r: &mut Reader, mesh: &TriangleMesh) -> Option<CandidateGrid> 
     let (slot_bits, q_shift) = (r.u32()?, r.u32()?);
     let (inv_unit, tiny) = (r.f64()?, r.f64()?);
     let positive = |x: f64| x.is_finite() && x > 0.0;
-    if !(min.is_finite() && cell.cmpgt(DVec3::ZERO).all() && cell.is_finite())
-        || !(positive(inv_unit) && positive(tiny))
-    {
+    let lattice_ok = min.is_finite() && cell.cmpgt(DVec3::ZERO).all() && cell.is_finite();
+    if !lattice_ok || !positive(inv_unit) || !positive(tiny) {
         return None;
     }
     // The layout this mesh's build gives (see `CandidateGrid::new`).
