@@ -3,10 +3,11 @@
  * missing and `import pyvcad` fails with "undefined symbol:
  * __isoc23_strtoll". These forward to the classic functions, which differ
  * only in accepting a "0b" prefix, which pyvcad's number parsing of the
- * benchmark designs never meets. Only for assets/bench/pyvcad_mesh.py:
+ * benchmark designs never meets. Only for the benchmark (README.md here):
  *
  *   cc -shared -fPIC -O2 -o /tmp/libisoc23.so assets/bench/isoc23_shim.c
- *   LD_PRELOAD=/tmp/libisoc23.so /tmp/pyvcad/bin/python assets/bench/pyvcad_mesh.py cube 0.0464 1
+ *   PYVCAD_PRELOAD=/tmp/libisoc23.so PYVCAD_PYTHON=/tmp/pyvcad/bin/python \
+ *     python3 assets/bench/vs_pyvcad.py
  */
 #include <stdarg.h>
 #include <stdio.h>

@@ -119,15 +119,13 @@ impl CellLattice {
         self.dims
     }
 
-    /// The lower corner of cell `[0, 0, 0]` (for tests that rebuild the
-    /// centres a build used).
-    #[cfg(test)]
+    /// The lower corner of cell `[0, 0, 0]` (what the mesh-grid cache
+    /// stores, and tests rebuild centres from).
     pub(crate) fn origin(&self) -> DVec3 {
         self.min
     }
 
-    /// The size of a cell along each axis (for tests, as `origin`).
-    #[cfg(test)]
+    /// The size of a cell along each axis.
     pub(crate) fn cell(&self) -> DVec3 {
         self.cell
     }

@@ -80,19 +80,19 @@ struct Candidate {
 /// answer is the same).
 #[derive(Clone, Debug)]
 pub(crate) struct CandidateGrid {
-    cells: CellLattice,
-    records: Vec<u32>,
-    items: Vec<u32>,
-    slot_bits: u32,
+    pub(super) cells: CellLattice,
+    pub(super) records: Vec<u32>,
+    pub(super) items: Vec<u32>,
+    pub(super) slot_bits: u32,
     /// Bit position of `q` in an item.
-    q_shift: u32,
+    pub(super) q_shift: u32,
     /// The certificate bits a query point needs of an entry to skip it.
-    skips: Skips,
+    pub(super) skips: Skips,
     /// One over the length of one step of the packed distance (mm⁻¹),
     /// times `1 + 10⁻⁹`.
-    inv_unit: f64,
+    pub(super) inv_unit: f64,
     /// `1e-12` cell sizes: absolute slack on `|p − c|`.
-    tiny: f64,
+    pub(super) tiny: f64,
 }
 
 /// Fewest bits of `q` for which an item also keeps certificate bits:
@@ -101,6 +101,24 @@ pub(crate) struct CandidateGrid {
 /// leave 12 bits, 8 bits (steps of 1/256 of the longest reach, 11 µm)
 /// changed the bench by less than its noise.
 const MIN_Q_BITS: u32 = 8;
+
+/// Whether items with `slot_bits` of slot keep certificate bits.
+pub(super) fn certified(slot_bits: u32) -> bool {
+    slot_bits + certificate::BITS + MIN_Q_BITS <= 32
+}
+
+/// The constants that shape a built grid: a cached grid built with other
+/// values is not this build's grid (`super::grid_cache` keys on them).
+pub(super) const SHAPE: [f64; 8] = [
+    CELLS,
+    MAX_TOTAL,
+    FAR,
+    PAD,
+    MAX_BLOCK as f64,
+    MAX_LIST as f64,
+    MIN_Q_BITS as f64,
+    certificate::BITS as f64,
+];
 
 /// Bits of a cell record that hold the list's start.
 const START_BITS: u32 = 30;
@@ -236,7 +254,7 @@ impl CandidateGrid {
             return None; // (cannot happen below MAX_TOTAL · MAX_LIST)
         }
         let slot_bits = (usize::BITS - (mesh.tris.len().max(2) - 1).leading_zeros()).min(31);
-        let certified = slot_bits + certificate::BITS + MIN_Q_BITS <= 32;
+        let certified = certified(slot_bits);
         let q_shift = if certified {
             slot_bits + certificate::BITS
         } else {

@@ -21,15 +21,15 @@ const MAX_CELLS: f64 = 32.0;
 #[derive(Clone, Debug)]
 pub(crate) struct CoarseGrid {
     /// Centre of cell (0, 0, 0).
-    origin: DVec3,
+    pub(super) origin: DVec3,
     /// Cell side.
-    cell: f64,
+    pub(super) cell: f64,
     /// `1 / cell`.
-    inv_cell: f64,
+    pub(super) inv_cell: f64,
     /// Cells per axis.
-    dims: [usize; 3],
+    pub(super) dims: [usize; 3],
     /// Signed distance at each centre, x fastest.
-    d: Vec<f64>,
+    pub(super) d: Vec<f64>,
 }
 
 impl CoarseGrid {

@@ -27,6 +27,7 @@ mod coarse;
 mod distance;
 mod formats;
 mod gaps;
+mod grid_cache;
 mod topology;
 mod triangle;
 pub(crate) mod wide;
@@ -278,7 +279,17 @@ impl TriangleMesh {
     /// want them joined must do it first.
     pub fn from_triangles(
         vertices: Vec<DVec3>,
+        triangles: Vec<[u32; 3]>,
+    ) -> Result<TriangleMesh, MeshError> {
+        Self::from_triangles_cached(vertices, triangles, grid_cache::dir().as_deref())
+    }
+
+    /// [`TriangleMesh::from_triangles`] with the grid cache in `cache`
+    /// (none: always built).
+    pub(crate) fn from_triangles_cached(
+        vertices: Vec<DVec3>,
         mut triangles: Vec<[u32; 3]>,
+        cache: Option<&Path>,
     ) -> Result<TriangleMesh, MeshError> {
         if triangles.is_empty() {
             return Err(MeshError::NoTriangles);
@@ -363,9 +374,7 @@ impl TriangleMesh {
             bbox,
             warnings,
         };
-        mesh.coarse =
-            coarse::CoarseGrid::new(&bbox, mesh.triangles.len(), |p| mesh.signed_distance(p));
-        mesh.candidates = candidates::CandidateGrid::new(&mesh);
+        grid_cache::attach(&mut mesh, cache);
         Ok(mesh)
     }
 
