@@ -13,6 +13,7 @@ use glam::Vec3;
 use crate::bake::{MAX_CHANNELS, VolumeBake};
 use crate::settings::{ViewMode, ViewSettings};
 use crate::upscale::Upscaler;
+use crate::wgpu_parts::{sampler_entry, texture_entry};
 
 /// The ray-march shader (WGSL).
 pub const RENDER_SHADER: &str = include_str!("shaders/raymarch.wgsl");
@@ -515,58 +516,6 @@ impl Renderer {
         ];
         u
     }
-}
-
-/// A fragment-stage binding of a filterable float texture.
-pub(crate) fn texture_entry(
-    binding: u32,
-    view_dimension: wgpu::TextureViewDimension,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: true },
-            view_dimension,
-            multisampled: false,
-        },
-        count: None,
-    }
-}
-
-/// A fragment-stage filtering sampler binding.
-pub(crate) fn sampler_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-        count: None,
-    }
-}
-
-/// A 2D texture of `size` to draw into (offscreen target, reduced-resolution
-/// viewport).
-pub(crate) fn target_texture(
-    device: &wgpu::Device,
-    label: &str,
-    size: [u32; 2],
-    format: wgpu::TextureFormat,
-    usage: wgpu::TextureUsages,
-) -> wgpu::Texture {
-    device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d {
-            width: size[0],
-            height: size[1],
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage,
-        view_formats: &[],
-    })
 }
 
 #[cfg(test)]

@@ -58,6 +58,7 @@ mod redistance;
 mod settings;
 mod upscale;
 pub mod viewport;
+mod wgpu_parts;
 
 pub use bake::{BakeError, MAX_CHANNELS, VolumeBake, bake};
 pub use camera::{Camera, StandardView};

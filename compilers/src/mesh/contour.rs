@@ -43,7 +43,7 @@ use volcad_core::sampler::Grid;
 
 use super::flat::{FlatKey, FlatMemo, KeptCubes, Regions, SampleAt};
 use super::indexed::IndexedMesh;
-use super::interface::{Interface, cut_field, front_back};
+use super::interface::{Cube, Interface, cut_field, front_back};
 use super::layer_dist::LayerDist;
 use super::mixed::mixed_cubes;
 use super::vertex_keys::{BandMesh, KeyMap};
@@ -105,14 +105,6 @@ fn by_inclusion(a: u8, b: u8) -> (u8, u8) {
 fn edge(a: u8, b: u8) -> Pt {
     let (a, b) = by_inclusion(a, b);
     Pt::Edge(a, b)
-}
-
-/// The 8 samples of one cube.
-pub(super) struct Cube<'a> {
-    pub base: [usize; 3],
-    pub label: [u16; 8],
-    pub dist: [f32; 8],
-    pub value: [&'a [f32]; 8],
 }
 
 /// A band's flat cubes: row, column, key and the corners of the key's `x`

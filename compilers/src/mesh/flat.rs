@@ -41,9 +41,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 use volcad_core::fastmath::round_i32;
 
-use super::contour::Cube;
 use super::indexed::IndexedMesh;
-use super::interface::{Interface, cut_field, front_back};
+use super::interface::{Cube, Interface, cut_field, front_back};
 use super::outline::triangulate;
 use super::vertex_keys::{FastMap, Tri};
 
@@ -501,10 +500,10 @@ mod tests {
     use glam::DVec3;
     use volcad_core::sampler::Grid;
 
-    use super::super::contour::{Contourer, Cube, Plane};
+    use super::super::contour::{Contourer, Plane};
     use super::super::field::{border_void, contour_field};
     use super::super::indexed::{IndexedMesh, tri_set};
-    use super::super::interface::Interface;
+    use super::super::interface::{Cube, Interface};
     use super::{FlatKey, FlatMemo, KeptCubes, KeyId, Regions, flat_key};
 
     /// A 24³ grid of 0.5 mm voxels sampling `f`.

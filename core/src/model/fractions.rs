@@ -10,7 +10,8 @@ use glam::DVec3;
 
 use super::MAX_MATERIALS;
 use super::pnode::{
-    COORD_SLOTS, D_SLOT, Grade, NAry, PNode, SimGrade, Slot, coord_slots, tile_local,
+    COORD_SLOTS, D_SLOT, FixedFractions, Grade, NAry, PNode, SimGrade, Slot, coord_slots,
+    tile_local,
 };
 use super::union_index::{Candidates, Entry};
 
@@ -117,36 +118,6 @@ impl PNode {
             | PNode::Shape { m, .. }
             | PNode::Text { m, .. } => Some(*m),
             _ => None,
-        }
-    }
-}
-
-/// Fractions that are the same at every point of a node (a primitive, a
-/// moved primitive, an FGrade of constants: every strut of the bunny
-/// lattice). A union keeps one per child so the winning child's material
-/// is one table read, not a walk down the child's tree and its expression
-/// tapes (those pointer chases dominated random-order profiles).
-#[derive(Clone, Copy, Debug)]
-pub struct FixedFractions {
-    len: u8,
-    slots: [Slot; 4],
-    values: [f64; 4],
-}
-
-impl FixedFractions {
-    fn one(m: Slot) -> Self {
-        Self {
-            len: 1,
-            slots: [m, 0, 0, 0],
-            values: [1.0, 0.0, 0.0, 0.0],
-        }
-    }
-
-    /// Add the fractions into `out` (zero on entry), as `frac` would.
-    #[inline]
-    pub fn write(&self, out: &mut [f64]) {
-        for i in 0..self.len as usize {
-            out[self.slots[i] as usize] += self.values[i];
         }
     }
 }
