@@ -26,7 +26,6 @@
 
 pub mod aabb;
 pub mod bench;
-pub mod cells;
 pub mod expr;
 pub mod fastmath;
 pub mod heap;
@@ -36,10 +35,10 @@ pub mod material;
 pub mod model;
 pub mod names;
 pub mod node;
-pub mod order;
 pub mod sampler;
 pub mod script;
 pub mod simfield;
+pub mod spatial;
 pub mod text;
 pub mod trimesh;
 pub mod vcad;

@@ -8,7 +8,7 @@
 //! Why the bounds are the same: they are the least and greatest nodal
 //! values over the tetrahedra whose boxes meet the query box. Every
 //! tetrahedron below a tree node whose box lies within the query box meets
-//! it ([`crate::trimesh::wide::WideBvh::overlapping_nodes`]), so the same
+//! it ([`crate::spatial::wide::WideBvh::overlapping_nodes`]), so the same
 //! tetrahedra count, and a minimum or maximum does not depend on the order
 //! or grouping it is taken in. The count decides the same "too many" as
 //! before.
@@ -18,7 +18,7 @@
 //! tetrahedra each, at about 330 instructions per tetrahedron for its four
 //! nodal rows (callgrind).
 
-use crate::trimesh::wide::WideChild;
+use crate::spatial::wide::WideChild;
 
 use super::tet_bvh::TetLocator;
 

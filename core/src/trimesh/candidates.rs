@@ -31,7 +31,8 @@ use super::TriangleMesh;
 use super::certificate::{self, Skips};
 use super::triangle::Feature;
 use crate::aabb::Aabb;
-use crate::cells::CellLattice;
+use crate::spatial::cells::CellLattice;
+use crate::spatial::round::f32_down;
 
 /// Fewest cells along the longest side of the mesh box. On the bunny
 /// (3,674 triangles about 1.5 mm across, 62 mm box), 128 rather than 64
@@ -289,7 +290,7 @@ impl CandidateGrid {
         tasks.into_par_iter().for_each(|(cells, out)| {
             let mut k = 0;
             for (_, l) in cells {
-                l.sort_unstable_by_key(|c| crate::order::f32_then_index(c.dc, c.slot));
+                l.sort_unstable_by_key(|c| crate::spatial::order::f32_then_index(c.dc, c.slot));
                 let frame = l
                     .first()
                     .filter(|_| certified)
@@ -408,7 +409,7 @@ impl TriangleMesh {
         // Room for the most it returns: one allocation, no regrowth.
         let mut out = Vec::with_capacity(max);
         let reach2 = reach * reach;
-        let mut stack = [0u32; super::bvh::MAX_DEPTH + 2];
+        let mut stack = [0u32; crate::spatial::bvh::MAX_DEPTH + 2];
         let mut sp = 1usize;
         while sp > 0 {
             sp -= 1;
@@ -484,10 +485,4 @@ impl CandidateGrid {
     pub(crate) fn dims(&self) -> [usize; 3] {
         self.cells.dims()
     }
-}
-
-/// Largest `f32` not above `x` (keeps a stored distance a lower bound).
-fn f32_down(x: f64) -> f32 {
-    let f = x as f32;
-    if f as f64 > x { f.next_down() } else { f }
 }
