@@ -82,8 +82,7 @@ impl Shares {
 
     /// The first `K` bounds by value, for [`Shares::count`] with `K` known
     /// to the compiler: the loop unrolls and the bounds stay in registers
-    /// (with a run-time `k`, picking cost the graded bar's slice stack a
-    /// tenth of its instructions).
+    /// (with a run-time `k`, picking is a loop of unknown length per voxel).
     #[inline(always)]
     fn first<const K: usize>(&self) -> ([f64; K], [f64; K]) {
         (

@@ -342,8 +342,7 @@ fn write_stack(
 /// The code every inside voxel gets when the design has one material
 /// everywhere (fixed fractions with one non-zero entry): random picks and
 /// error diffusion both choose it whatever their numbers, so neither the
-/// fractions nor the picks are needed. Sampling signs alone made the BCC
-/// sphere's slice stack a fifth faster.
+/// fractions nor the picks are needed, and the signs alone are sampled.
 fn single_material_code(model: &Model) -> Option<u8> {
     let k = model.materials().len();
     let mut f = vec![0.0; k];

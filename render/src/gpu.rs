@@ -20,11 +20,10 @@ pub const RENDER_SHADER: &str = include_str!("shaders/raymarch.wgsl");
 
 /// The surface is drawn at `d = THIN_BIAS_VOXELS · voxel` (mm) instead of 0,
 /// so features thinner than a voxel still cross the level in the
-/// trilinearly interpolated distance field. Measured on the BCC sphere
-/// (0.35 mm struts, 64³ bake = 0.31 mm voxels, `cargo bench`): without the
-/// bias the struts break into beads; with 0.25 they are continuous and a
-/// little thick (disk coverage 26.6 % against 19.4 % at 256³ without bias);
-/// at 256³ the bias adds 0.02 mm.
+/// trilinearly interpolated distance field. On struts about a voxel
+/// across (the BCC sphere at a coarse bake) the struts break into beads
+/// without the bias; with 0.25 they are continuous and a little thick, and
+/// at fine bakes the bias is a small fraction of a voxel.
 pub const THIN_BIAS_VOXELS: f32 = 0.25;
 
 /// Volume mode: optical depth, at opacity 1, of the mean chord of the

@@ -156,9 +156,8 @@ pub struct Contourer {
     spare_list: Vec<(usize, u8)>,
     /// Per band of rows, the triangles and flat cubes it made in the last
     /// layer: the next layer's buffers start at that size (plus an eighth),
-    /// since growing them by doubling copied and faulted in their memory
-    /// again and again (kernel page handling was about 9 % of a graded-bar
-    /// export).
+    /// since growing them by doubling copies and faults in their memory
+    /// again and again.
     band_sizes: Vec<(usize, usize)>,
 }
 
@@ -677,8 +676,7 @@ fn two_label_cut((o, p, s, lo, rest): (u8, u8, u8, u16, u16)) -> [(u16, Pt, Pt);
 /// that [`Contourer::flat_layer`] joins or outlines: bit `2·axis + side`
 /// for the four faces across x and y and the one below (bit 4; the face
 /// above is settled with the next layer). A table, since every flat cube
-/// asks: the five tests in a loop were 8 % of the joining's instructions
-/// on the cube (13.4 of 161.5 M).
+/// asks, and the five tests in a loop cost more than one lookup.
 const CUT_FACES: [u8; 256] = {
     let mut t = [0u8; 256];
     let mut m = 0;

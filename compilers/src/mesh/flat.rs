@@ -135,8 +135,8 @@ pub(super) fn flat_key(voxel: DVec3, iface: Interface, cube: &Cube) -> Option<Fl
 /// those alone (the interface values are not read), and along a flat face
 /// neighbouring cubes repeat the same eight samples (a face parallel to a
 /// grid plane everywhere; a row crossing two opposite faces alternates
-/// between two). Two entries because of that alternation. On the cube's
-/// 10 M-voxel mesh export, flat_key ran about 400 instructions a cube.
+/// between two). Two entries because of that alternation; computing the
+/// key anew costs far more than comparing the samples.
 #[derive(Default)]
 pub(super) struct FlatMemo {
     seen: [Option<Remembered>; 2],
@@ -285,9 +285,8 @@ impl Regions {
     pub fn add_band(&mut self, keys: impl Iterator<Item = FlatKey>, kept: KeptCubes) -> u32 {
         let first = self.parent.len() as u32;
         // Runs of cubes share a key, and a row crosses few faces: the keys
-        // met last are looked up without hashing (with one remembered, the
-        // cube's side faces, met in turn along every row, hashed each cube:
-        // a seventh of the joining's instructions).
+        // met last are looked up without hashing (with one remembered, a
+        // cube's side faces, met in turn along every row, hash each cube).
         let mut recent: [Option<(FlatKey, KeyId)>; RECENT_KEYS] = [None; RECENT_KEYS];
         let mut next_slot = 0;
         for key in keys {

@@ -278,10 +278,8 @@ impl TetLocator {
     /// For a cell `b` the boundary crosses whose centre `c` is outside: a
     /// tetrahedron near `c` among those whose boxes meet `b`, or
     /// `NONE`. Points of such a cell inside the mesh then
-    /// walk a step or two from there instead of searching the BVH, which
-    /// was 7 % of the seat's band points' profile: `volcad bench` on the
-    /// seat, Z-ordered 11.3–11.6 → 11.8 M points/s, random order 2.5–4.3
-    /// → 5.6–5.7 M.
+    /// walk a step or two from there instead of searching the BVH
+    /// (measured with `volcad bench` on the bicycle seat).
     fn nearest_overlapping(&self, b: &Aabb, c: DVec3) -> u32 {
         let mut best = (f64::INFINITY, NONE);
         self.wide.overlapping(b, |slot| {

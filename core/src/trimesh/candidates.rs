@@ -34,12 +34,10 @@ use crate::aabb::Aabb;
 use crate::spatial::cells::CellLattice;
 use crate::spatial::round::f32_down;
 
-/// Fewest cells along the longest side of the mesh box. On the bunny
-/// (3,674 triangles about 1.5 mm across, 62 mm box), 128 rather than 64
-/// halves the lists (17 → 9 entries, 3.6 → 2.6 exact triangle tests per
-/// query) and evaluated points within 2 mm of the surface 13 to 23 % faster
-/// (`cargo bench -p volcad-core`), for 2 to 3 % more time in a bunny-lattice
-/// slice stack at 0.1 mm and the seat's 0.5 mm mesh export.
+/// Fewest cells along the longest side of the mesh box. Finer cells mean
+/// shorter lists (fewer exact triangle tests per query) for more build
+/// time; see docs/PERFORMANCE.md, "Mesh distance", for how the choice is
+/// measured.
 const CELLS: f64 = 128.0;
 /// Most cells in one grid (5 bytes each plus the lists).
 const MAX_TOTAL: f64 = 4.0e6;
@@ -62,11 +60,8 @@ struct Candidate {
     slot: u32,
 }
 
-/// The grid, packed: the lists of the bunny's 379 k surface cells are
-/// 30 MB as `Candidate`s and 15 MB packed, and the walk stops on an
-/// integer compare. Both together, on the bunny lattice (`cargo bench -p
-/// volcad-core`): random-order points 5.4 → 7.4 M/s, Z-ordered 14.1 →
-/// 15.8 M/s; the packing alone gave the Z-ordered ones 1 to 2 %.
+/// The grid, packed: a packed list is half the size of one of
+/// `Candidate`s, and the walk stops on an integer compare.
 ///
 /// `records[i]`: the start of cell `i`'s list in `items` (low 30 bits) and
 /// its side plus one (high 2 bits: 0 inside, 1 unknown, 2 outside; also
@@ -201,7 +196,7 @@ impl CandidateGrid {
                     let reach2 = slack(u + 2.0 * r).powi(2);
                     // Counted first, so a list is one allocation of its
                     // size (collected through the filter, the lists grew
-                    // by doubling: 6.5 % of the seat's load in `realloc`),
+                    // by doubling, reallocating again and again),
                     // and a list too long to keep none.
                     let kept = |d2: &f64| *d2 <= reach2;
                     let n = d2s.iter().filter(|d2| kept(d2)).count();
@@ -352,8 +347,7 @@ impl CandidateGrid {
             // Skipped entries first, even past the stop (skipping is always
             // sound): that test waits only for t₁'s region, while the stop
             // waits for its distance and a square root, and a mispredicted
-            // branch costs the whole wait. Bunny lattice, 2 M points,
-            // alternating binaries: 18.9 → 19.8 M points/s (8 of 8 pairs).
+            // branch costs the whole wait.
             if need != 0 && e & need == need {
                 continue;
             }

@@ -102,8 +102,7 @@ impl TriangleMesh {
     pub fn signed_distance(&self, p: DVec3) -> f64 {
         // The grid's cell lookup rejects non-finite points itself (its
         // range test is false for NaN and infinities), so the check waits
-        // for the fallback: 2.7 % fewer of the bunny lattice's instructions
-        // (callgrind; its wall time within noise).
+        // for the fallback, off the common path.
         if let Some(d) = self.signed_from_candidates(p) {
             return d;
         }
