@@ -132,7 +132,7 @@ const MAX_SLAB_LAYERS: usize = 16;
 /// table, a bad layer range, or buffers that do not fit in memory.
 ///
 /// The output size comes from a rule of thumb and from a few layers coded
-/// and encoded as the export does ([`sampled_bytes`]): what the CLI prints
+/// and encoded as the export does (`sampled_bytes`): what the CLI prints
 /// and checks the disk with, and the studio shows. The export job itself
 /// checks by the rule alone (the layers cost a few milliseconds, a sixth
 /// of the cube's 200³ stack).

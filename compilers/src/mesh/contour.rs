@@ -56,7 +56,7 @@ pub struct Plane {
     pub label: Vec<u16>,
     /// Signed distance (mm): a layer of the sampled slab's buffer.
     pub dist: LayerDist,
-    /// Interface values, [`Interface::stride`] per sample.
+    /// Interface values, `Interface::stride` per sample.
     pub value: Vec<f32>,
 }
 

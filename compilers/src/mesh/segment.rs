@@ -244,7 +244,7 @@ impl Classifier {
         self.plane_into(slab, &dist, l, dims, z, Plane::default())
     }
 
-    /// [`Self::plane`] into the buffers of a plane the caller no longer
+    /// `Self::plane` into the buffers of a plane the caller no longer
     /// needs (fresh buffers each layer cost page faults and zeroing by the
     /// kernel: a tenth of a cube export), with the slab's distances
     /// `slab_dist` shared rather than copied (`slab.dist` is not read).

@@ -1,5 +1,5 @@
 //! Spatial indexes shared across the core: the bounding-volume hierarchies
-//! over boxes (the binary SAH tree [`bvh`] and its 4-wide collapse [`wide`],
+//! over boxes (the binary SAH tree `bvh` and its 4-wide collapse `wide`,
 //! used by triangle meshes and the tetrahedron locator), the uniform cell
 //! lattice ([`cells`], under the union index and the mesh candidate grid),
 //! integer sort keys for `f32` bounds ([`order`]), the per-thread memory of
