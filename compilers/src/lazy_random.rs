@@ -11,9 +11,9 @@
 //! The sampler marks such regions with `NaN` fractions
 //! (`Sampler::with_lazy_fractions`).
 //!
-//! Exactness: the bounds are widened by [`crate::dither::BOUND_MARGIN`],
+//! Exactness: the bounds are widened by `crate::dither::BOUND_MARGIN`,
 //! which covers rounding the `f64` fractions to `f32` and the `f32` running
-//! sums and product that [`crate::dither::pick_random`] computes, so a
+//! sums and product that `crate::dither::pick_random` computes, so a
 //! decided pick equals the one computed from the evaluated fractions, and
 //! the slices are byte for byte those of evaluating every voxel (tested).
 
@@ -82,8 +82,7 @@ impl Shares {
 
     /// The first `K` bounds by value, for [`Shares::count`] with `K` known
     /// to the compiler: the loop unrolls and the bounds stay in registers
-    /// (with a run-time `k`, picking cost the graded bar's slice stack a
-    /// tenth of its instructions).
+    /// (with a run-time `k`, picking is a loop of unknown length per voxel).
     #[inline(always)]
     fn first<const K: usize>(&self) -> ([f64; K], [f64; K]) {
         (

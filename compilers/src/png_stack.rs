@@ -145,7 +145,7 @@ const MAX_SLAB_LAYERS: usize = 16;
 /// table, a bad layer range, or buffers that do not fit in memory.
 ///
 /// The output size comes from a rule of thumb and from a few layers coded
-/// and encoded as the export does ([`sampled_bytes`]): what the CLI prints
+/// and encoded as the export does (`sampled_bytes`): what the CLI prints
 /// and checks the disk with, and the studio shows. The export job itself
 /// checks by the rule alone (the layers cost a few milliseconds, a sixth
 /// of the cube's 200³ stack).
@@ -403,8 +403,7 @@ pub(crate) fn for_each_slab(
 /// The code every inside voxel gets when the design has one material
 /// everywhere (fixed fractions with one non-zero entry): random picks and
 /// error diffusion both choose it whatever their numbers, so neither the
-/// fractions nor the picks are needed. Sampling signs alone made the BCC
-/// sphere's slice stack a fifth faster.
+/// fractions nor the picks are needed, and the signs alone are sampled.
 fn single_material_code(model: &Model) -> Option<u8> {
     let k = model.materials().len();
     let mut f = vec![0.0; k];

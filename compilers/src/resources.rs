@@ -17,8 +17,8 @@ pub use volcad_core::heap::{available_memory, human_bytes};
 /// `statvfs` (what `df -P` calls "Available"), or `None` when unknown.
 ///
 /// A system call through rustix (already a dependency, safe code), not
-/// `df`: spawning `df` took 1.4 ms, and a mesh export asks twice, 5 % of
-/// the cube's whole 10 M-voxel export.
+/// `df`: spawning a process costs more than a small export, and a mesh
+/// export asks twice.
 #[cfg(unix)]
 pub fn available_disk(dir: &Path) -> Option<u64> {
     // A relative path's last ancestor is "", the current folder.

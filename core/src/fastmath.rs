@@ -1,9 +1,8 @@
 //! Inlined replacements for two C-library calls in hot loops, `sin_cos`
 //! and `floor`, and a cheaper `f64::min` for running minima. On the x86-64
 //! baseline (no SSE4.1 rounding instruction) `f64::floor` is a call, and
-//! `sin_cos` always is; both showed at the top of evaluation profiles
-//! (`cargo bench -p volcad-core --bench eval`): `sin_cos` was 43 % of the
-//! gyroid, `floor` 12 % of the tiled lattices.
+//! `sin_cos` always is; both show at the top of evaluation profiles
+//! (`cargo bench -p volcad-core --bench eval`) of TPMS and tiled lattices.
 //! Both give the same bits on every machine and thread count (plain IEEE
 //! operations, no FMA contraction), which the C library does not promise
 //! across platforms.
@@ -20,15 +19,14 @@
 //!
 //! # `min_plain`
 //! `f64::min` returns the other operand when either is NaN, which takes
-//! four more instructions than one `minsd`. A running minimum that starts
+//! more work than one `minsd`. A running minimum that starts
 //! at +∞ never holds a NaN, so it may use the single compare.
 //!
 //! # `floor`
 //! With SSE4.1 (the x86-64-v2 builds that `.cargo/config.toml` makes, and
 //! other architectures) `f64::floor` is one instruction (`roundsd`), used
-//! as it is: against the truncating version below, tiled lattices
-//! evaluated 26 to 28 % faster in Z-order and 58 to 71 % in random order,
-//! where that version's branches are unpredictable. Without SSE4.1:
+//! as it is: the truncating version below has branches that are
+//! unpredictable in random order. Without SSE4.1:
 //! truncation through an integer conversion (one SSE2 instruction each
 //! way), minus one where that rounded up; exactly `f64::floor`, signed
 //! zeros, infinities and NaN included (tested, both paths on every
@@ -147,7 +145,7 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
 
 /// `min(a, b)` for `a` never NaN: `b` when it is smaller, else `a` (a NaN
 /// `b` is ignored, as `f64::min` does). One `minsd`: `f64::min` also
-/// handles a NaN `a`, which costs four more instructions, on the path of
+/// handles a NaN `a`, which costs more, on the path of
 /// every strut a lattice point tests. A running minimum that starts at +∞
 /// never holds a NaN.
 #[inline(always)]

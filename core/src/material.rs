@@ -65,7 +65,7 @@ pub enum MaterialError {
     /// The JSON text is not a material table.
     #[error("material table {origin}: {message}")]
     Parse {
-        /// File path or "<built-in name>".
+        /// File path or `"<built-in name>"`.
         origin: String,
         /// What serde_json said, with line and column.
         message: String,
@@ -73,7 +73,7 @@ pub enum MaterialError {
     /// The table has more entries than ids fit in a byte.
     #[error("material table {origin}: {count} materials; at most 255 fit (ids are one byte)")]
     TooMany {
-        /// File path or "<built-in name>".
+        /// File path or `"<built-in name>"`.
         origin: String,
         /// Entries in the file.
         count: usize,

@@ -70,6 +70,16 @@ fn pyvcad_sphere() {
 }
 
 #[test]
+fn bunny_mesh_bench() {
+    // The bunny body alone: its box is the mesh's, its centre inside it.
+    let m = design("bench", "bunny_mesh.rhai");
+    let b = m.bbox();
+    assert!(b.size().min_element() > 10.0, "{b:?}");
+    assert!(m.distance(b.center()) < 0.0);
+    assert_eq!(frac(&m, b.center(), "clear"), 1.0);
+}
+
+#[test]
 fn hello_cube() {
     let m = example("hello_cube.rhai");
     assert_eq!(m.bbox().size(), DVec3::splat(10.0));

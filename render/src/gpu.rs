@@ -13,17 +13,17 @@ use glam::Vec3;
 use crate::bake::{MAX_CHANNELS, VolumeBake};
 use crate::settings::{ViewMode, ViewSettings};
 use crate::upscale::Upscaler;
+use crate::wgpu_parts::{sampler_entry, texture_entry};
 
 /// The ray-march shader (WGSL).
 pub const RENDER_SHADER: &str = include_str!("shaders/raymarch.wgsl");
 
 /// The surface is drawn at `d = THIN_BIAS_VOXELS · voxel` (mm) instead of 0,
 /// so features thinner than a voxel still cross the level in the
-/// trilinearly interpolated distance field. Measured on the BCC sphere
-/// (0.35 mm struts, 64³ bake = 0.31 mm voxels, `cargo bench`): without the
-/// bias the struts break into beads; with 0.25 they are continuous and a
-/// little thick (disk coverage 26.6 % against 19.4 % at 256³ without bias);
-/// at 256³ the bias adds 0.02 mm.
+/// trilinearly interpolated distance field. On struts about a voxel
+/// across (the BCC sphere at a coarse bake) the struts break into beads
+/// without the bias; with 0.25 they are continuous and a little thick, and
+/// at fine bakes the bias is a small fraction of a voxel.
 pub const THIN_BIAS_VOXELS: f32 = 0.25;
 
 /// Volume mode: optical depth, at opacity 1, of the mean chord of the
@@ -526,58 +526,6 @@ impl Renderer {
         ];
         u
     }
-}
-
-/// A fragment-stage binding of a filterable float texture.
-pub(crate) fn texture_entry(
-    binding: u32,
-    view_dimension: wgpu::TextureViewDimension,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: true },
-            view_dimension,
-            multisampled: false,
-        },
-        count: None,
-    }
-}
-
-/// A fragment-stage filtering sampler binding.
-pub(crate) fn sampler_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-        count: None,
-    }
-}
-
-/// A 2D texture of `size` to draw into (offscreen target, reduced-resolution
-/// viewport).
-pub(crate) fn target_texture(
-    device: &wgpu::Device,
-    label: &str,
-    size: [u32; 2],
-    format: wgpu::TextureFormat,
-    usage: wgpu::TextureUsages,
-) -> wgpu::Texture {
-    device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d {
-            width: size[0],
-            height: size[1],
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage,
-        view_formats: &[],
-    })
 }
 
 #[cfg(test)]

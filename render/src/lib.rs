@@ -44,8 +44,9 @@
 //! **Software renderers.** Mesa's lavapipe executes both sides of every
 //! branch, so the shader keeps loop bodies to one or two texture lookups and
 //! uses one pipeline per path (solid, region, volume; WGSL `override`
-//! constants). A 1280×800 Solid frame costs about 0.2-0.35 s on two CPU
-//! cores; set [`ViewSettings::render_scale`] to 0.5 there (about 4× faster).
+//! constants). On a software rasteriser (lavapipe) a full-size frame is
+//! slow; set [`ViewSettings::render_scale`] to 0.5 there (a quarter of the
+//! pixels).
 #![warn(missing_docs)]
 
 pub mod attribute_bake;
@@ -60,6 +61,7 @@ mod redistance;
 mod settings;
 mod upscale;
 pub mod viewport;
+mod wgpu_parts;
 
 pub use attribute_bake::AttributeShading;
 pub use bake::{BakeError, MAX_CHANNELS, VolumeBake, bake, bake_shaded};

@@ -66,7 +66,7 @@ impl Offscreen {
                 max,
             });
         }
-        let target = crate::gpu::target_texture(
+        let target = crate::wgpu_parts::target_texture(
             &device,
             "volcad offscreen target",
             size,

@@ -103,7 +103,7 @@ impl Drawn {
 /// Sphere-trace `model` along the camera ray through `ndc` (−1..1, y up)
 /// with the exact (lower-bound) distance, clipped by `cut` if given; a model
 /// whose value is not a distance bound is marched by its sign instead
-/// ([`sign_march`]). Every material counts as drawn. `None` when the ray
+/// (`sign_march`). Every material counts as drawn. `None` when the ray
 /// misses.
 pub fn pick(
     model: &Model,

@@ -29,8 +29,8 @@ impl Upscaler {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("volcad upscale"),
             entries: &[
-                crate::gpu::texture_entry(0, wgpu::TextureViewDimension::D2),
-                crate::gpu::sampler_entry(1),
+                crate::wgpu_parts::texture_entry(0, wgpu::TextureViewDimension::D2),
+                crate::wgpu_parts::sampler_entry(1),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -81,7 +81,7 @@ impl Upscaler {
     /// The render target of `size` (made again only when the size changes).
     pub(crate) fn target(&mut self, device: &wgpu::Device, size: [u32; 2]) -> &wgpu::TextureView {
         if self.target.as_ref().is_none_or(|t| t.size != size) {
-            let texture = crate::gpu::target_texture(
+            let texture = crate::wgpu_parts::target_texture(
                 device,
                 "volcad reduced resolution",
                 size,

@@ -151,10 +151,8 @@ fn cpu_model(cpuinfo: &str) -> Option<String> {
 }
 
 /// Export passes per figure: the median of up to three, as points/s takes
-/// the median of its passes. One 10 M-voxel export lasts about a tenth of
-/// a second here: a scheduling hiccup or a slow batch of page faults moved
-/// single passes of the same binary by a third (the cube's mesh 79 to 139
-/// M voxels/s in fifteen runs).
+/// the median of its passes. A short export's single pass moves with a
+/// scheduling hiccup or a slow batch of page faults; the median does not.
 const EXPORT_PASSES: usize = 3;
 /// Passes stop once this much time has gone into one figure (the slowest
 /// exports take seconds a pass).

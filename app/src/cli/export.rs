@@ -551,9 +551,9 @@ pub(super) fn follow(handle: job::JobHandle, interrupted: &AtomicBool) -> anyhow
     );
     let dest = handle.destination().to_path_buf();
     // Waits on the progress channel, which closes when the job ends: the
-    // command returns as soon as the export is done (sleeping 50 ms between
-    // polls added 25 ms on average to every export, a fifth of a small
-    // mesh's time), and Ctrl-C is still seen within 50 ms.
+    // command returns as soon as the export is done (sleeping between
+    // polls would add half a sleep on average to every export), and Ctrl-C
+    // is still seen within 50 ms.
     while !handle.is_finished() {
         if interrupted.load(Ordering::Relaxed) {
             handle.cancel();

@@ -46,7 +46,7 @@ use volcad_core::sampler::Grid;
 
 use super::flat::{FlatKey, FlatMemo, KeptCubes, Regions, SampleAt};
 use super::indexed::IndexedMesh;
-use super::interface::{Interface, cut_field, front_back};
+use super::interface::{Cube, Interface, cut_field, front_back};
 use super::layer_dist::LayerDist;
 use super::mixed::mixed_cubes;
 use super::vertex_keys::{BandMesh, KeyMap};
@@ -59,7 +59,7 @@ pub struct Plane {
     pub label: Vec<u16>,
     /// Signed distance (mm): a layer of the sampled slab's buffer.
     pub dist: LayerDist,
-    /// Interface values, [`Interface::stride`] per sample.
+    /// Interface values, `Interface::stride` per sample.
     pub value: Vec<f32>,
 }
 
@@ -114,14 +114,6 @@ fn edge(a: u8, b: u8) -> Pt {
     Pt::Edge(a, b)
 }
 
-/// The 8 samples of one cube.
-pub(super) struct Cube<'a> {
-    pub base: [usize; 3],
-    pub label: [u16; 8],
-    pub dist: [f32; 8],
-    pub value: [&'a [f32]; 8],
-}
-
 /// A band's flat cubes: row, column, key and the corners of the key's `x`
 /// label (bit mask), with their samples kept for the fallback.
 #[derive(Default)]
@@ -171,9 +163,8 @@ pub struct Contourer {
     spare_list: Vec<(usize, u8)>,
     /// Per band of rows, the triangles and flat cubes it made in the last
     /// layer: the next layer's buffers start at that size (plus an eighth),
-    /// since growing them by doubling copied and faulted in their memory
-    /// again and again (kernel page handling was about 9 % of a graded-bar
-    /// export).
+    /// since growing them by doubling copies and faults in their memory
+    /// again and again.
     band_sizes: Vec<(usize, usize)>,
 }
 
@@ -709,8 +700,7 @@ fn two_label_cut((o, p, s, lo, rest): (u8, u8, u8, u16, u16)) -> [(u16, Pt, Pt);
 /// that [`Contourer::flat_layer`] joins or outlines: bit `2·axis + side`
 /// for the four faces across x and y and the one below (bit 4; the face
 /// above is settled with the next layer). A table, since every flat cube
-/// asks: the five tests in a loop were 8 % of the joining's instructions
-/// on the cube (13.4 of 161.5 M).
+/// asks, and the five tests in a loop cost more than one lookup.
 const CUT_FACES: [u8; 256] = {
     let mut t = [0u8; 256];
     let mut m = 0;

@@ -41,9 +41,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 use volcad_core::fastmath::round_i32;
 
-use super::contour::Cube;
 use super::indexed::IndexedMesh;
-use super::interface::{Interface, cut_field, front_back};
+use super::interface::{Cube, Interface, cut_field, front_back};
 use super::outline::{ADDED, Triangulated, triangulate};
 use super::vertex_keys::{FastMap, Tri};
 
@@ -136,8 +135,8 @@ pub(super) fn flat_key(voxel: DVec3, iface: Interface, cube: &Cube) -> Option<Fl
 /// those alone (the interface values are not read), and along a flat face
 /// neighbouring cubes repeat the same eight samples (a face parallel to a
 /// grid plane everywhere; a row crossing two opposite faces alternates
-/// between two). Two entries because of that alternation. On the cube's
-/// 10 M-voxel mesh export, flat_key ran about 400 instructions a cube.
+/// between two). Two entries because of that alternation; computing the
+/// key anew costs far more than comparing the samples.
 #[derive(Default)]
 pub(super) struct FlatMemo {
     seen: [Option<Remembered>; 2],
@@ -286,9 +285,8 @@ impl Regions {
     pub fn add_band(&mut self, keys: impl Iterator<Item = FlatKey>, kept: KeptCubes) -> u32 {
         let first = self.parent.len() as u32;
         // Runs of cubes share a key, and a row crosses few faces: the keys
-        // met last are looked up without hashing (with one remembered, the
-        // cube's side faces, met in turn along every row, hashed each cube:
-        // a seventh of the joining's instructions).
+        // met last are looked up without hashing (with one remembered, a
+        // cube's side faces, met in turn along every row, hash each cube).
         let mut recent: [Option<(FlatKey, KeyId)>; RECENT_KEYS] = [None; RECENT_KEYS];
         let mut next_slot = 0;
         for key in keys {
@@ -511,10 +509,10 @@ mod tests {
     use glam::DVec3;
     use volcad_core::sampler::Grid;
 
-    use super::super::contour::{Contourer, Cube, Plane};
+    use super::super::contour::{Contourer, Plane};
     use super::super::field::{border_void, contour_field};
     use super::super::indexed::{IndexedMesh, tri_set};
-    use super::super::interface::Interface;
+    use super::super::interface::{Cube, Interface};
     use super::{FlatKey, FlatMemo, KeptCubes, KeyId, Regions, flat_key};
 
     /// A 24³ grid of 0.5 mm voxels sampling `f`.

@@ -2,6 +2,14 @@
 //! carry different labels (see [`super::contour`]'s method), and which of
 //! the two labels' meshes faces the other.
 
+/// The 8 samples of one cube.
+pub(super) struct Cube<'a> {
+    pub base: [usize; 3],
+    pub label: [u16; 8],
+    pub dist: [f32; 8],
+    pub value: [&'a [f32]; 8],
+}
+
 /// How an edge between two inside samples of different labels is cut.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Interface {

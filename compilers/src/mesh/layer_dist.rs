@@ -1,9 +1,8 @@
 //! A mesh plane's signed distances as a view into its slab's buffer.
 //!
 //! The sampler writes a slab's distances into one buffer, layer after
-//! layer; each plane used to copy its layer out (the cube's 10 M-voxel mesh
-//! export copied 41 MB that way, 42 M instructions, 4 % of its work). Now
-//! the buffer is shared: every plane of the slab holds it and its layer's
+//! layer; rather than each plane copying its layer out, the buffer is
+//! shared: every plane of the slab holds it and its layer's
 //! range, and the buffer goes back to the sampler once the contourer has
 //! retired all of them ([`DistPool`]). The contourer keeps the last plane
 //! of a slab while the next slab is contoured and the one after is sampled,

@@ -244,7 +244,7 @@ impl Classifier {
         self.plane_into(slab, &dist, l, dims, z, Plane::default())
     }
 
-    /// [`Self::plane`] into the buffers of a plane the caller no longer
+    /// `Self::plane` into the buffers of a plane the caller no longer
     /// needs (fresh buffers each layer cost page faults and zeroing by the
     /// kernel: a tenth of a cube export), with the slab's distances
     /// `slab_dist` shared rather than copied (`slab.dist` is not read).
@@ -282,9 +282,8 @@ impl Classifier {
         } else {
             value.chunks_mut(nx * stride).collect()
         };
-        // Each row's tallies, in one buffer per plane (two small vectors a
-        // row were 2 % of the cube's mesh export, in malloc and free), added
-        // up in row order as before.
+        // Each row's tallies, in one buffer per plane (not two small
+        // vectors a row, allocated and freed per row), added up in row order.
         let per_row = segments.max(1);
         let mut counts = vec![0u64; ny * per_row];
         let mut sums = vec![0.0f64; ny * per_row];
@@ -319,7 +318,7 @@ impl Classifier {
                     let v = &runs.values[sp.rect * stride..(sp.rect + 1) * stride];
                     labels[a..b].fill(lab);
                     // (Guarded here too: without values the call into
-                    // volcad-core per run cost the cube 2 % of its mesh.)
+                    // volcad-core per run would copy nothing.)
                     if stride > 0 {
                         fill_pattern(&mut values[a * stride..b * stride], v);
                     }
@@ -422,8 +421,7 @@ impl Classifier {
 /// Copies sample `from`'s `stride` values onto sample `to`'s (`from <
 /// to`), as fixed-size moves for the usual strides. Nothing for a plane
 /// without values (one segment): called once a voxel, and `fill_pattern`
-/// is a call into `volcad-core` (4 % of the cube's mesh instructions went
-/// to copying nothing).
+/// is a call into `volcad-core` that would copy nothing.
 #[inline]
 fn copy_value(values: &mut [f32], from: usize, to: usize, stride: usize) {
     if stride == 0 {

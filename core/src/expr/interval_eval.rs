@@ -21,8 +21,8 @@
 
 use std::f64::consts::PI;
 
-use super::functions;
 use super::ops::{DEG2RAD, Op, RAD2DEG};
+use super::scalar;
 use crate::interval::{Interval, corners, widen};
 
 /// Whether every point of `i` is truthy (`Some(true)`), none is (`Some(false)`), or
@@ -172,7 +172,7 @@ fn roundn(x: Interval, n: Interval) -> Interval {
     let mut out: Option<Interval> = None;
     let mut k = k0;
     while k <= k1 {
-        let i = Interval::new(functions::roundn(x.lo, k), functions::roundn(x.hi, k));
+        let i = Interval::new(scalar::roundn(x.lo, k), scalar::roundn(x.hi, k));
         out = Some(out.map_or(i, |o| o.union(i)));
         k += 1.0;
     }
@@ -188,7 +188,7 @@ fn root(x: Interval, n: Interval) -> Interval {
     let n = n.lo;
     let odd_integer = n == n.trunc() && n % 2.0 != 0.0;
     if x.lo >= 0.0 || odd_integer {
-        x.increasing(|v| functions::root(v, n))
+        x.increasing(|v| scalar::root(v, n))
     } else {
         Interval::EVERYTHING
     }
@@ -318,7 +318,7 @@ impl Op {
             Round => Interval::new(a.lo.round(), a.hi.round()),
             Trunc => Interval::new(a.lo.trunc(), a.hi.trunc()),
             Frac => frac(a),
-            Sgn => Interval::new(functions::sgn(a.lo), functions::sgn(a.hi)),
+            Sgn => Interval::new(scalar::sgn(a.lo), scalar::sgn(a.hi)),
             Exp => a.exp(),
             Expm1 => a.increasing(f64::exp_m1).clamp_to(-1.0, inf),
             Ln => a.ln(),
@@ -345,7 +345,7 @@ impl Op {
             Rad2Deg => a * RAD2DEG,
             Erf => a.increasing(libm::erf).clamp_to(-1.0, 1.0),
             Erfc => a.decreasing(libm::erfc).clamp_to(0.0, 2.0),
-            Ncdf => a.increasing(functions::ncdf).clamp_to(0.0, 1.0),
+            Ncdf => a.increasing(scalar::ncdf).clamp_to(0.0, 1.0),
             Add => a + b,
             Sub => a - b,
             Mul => a * b,

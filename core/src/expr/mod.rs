@@ -19,6 +19,7 @@ mod interval_eval;
 mod lexer;
 mod ops;
 mod parser;
+mod scalar;
 mod set;
 mod tape;
 #[cfg(test)]

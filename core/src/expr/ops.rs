@@ -4,7 +4,7 @@
 //! Folding and tape evaluation both call [`Op::apply`], so a folded constant is
 //! bit-identical to what the tape would have computed at run time.
 
-use super::functions;
+use super::scalar;
 
 /// `1.0` for true, `0.0` for false.
 #[inline(always)]
@@ -285,7 +285,7 @@ impl Op {
             Round => a.round(),
             Trunc => a.trunc(),
             Frac => a - a.trunc(),
-            Sgn => functions::sgn(a),
+            Sgn => scalar::sgn(a),
             Exp => a.exp(),
             Expm1 => a.exp_m1(),
             Ln => a.ln(),
@@ -307,12 +307,12 @@ impl Op {
             Sec => 1.0 / a.cos(),
             Csc => 1.0 / a.sin(),
             Cot => 1.0 / a.tan(),
-            Sinc => functions::sinc(a),
+            Sinc => scalar::sinc(a),
             Deg2Rad => a * DEG2RAD,
             Rad2Deg => a * RAD2DEG,
             Erf => libm::erf(a),
             Erfc => libm::erfc(a),
-            Ncdf => functions::ncdf(a),
+            Ncdf => scalar::ncdf(a),
             Add => a + b,
             Sub => a - b,
             Mul => a * b,
@@ -323,10 +323,10 @@ impl Op {
             Max => a.max(b),
             Atan2 => a.atan2(b),
             Hypot => a.hypot(b),
-            Root => functions::root(a, b),
+            Root => scalar::root(a, b),
             Logn => a.ln() / b.ln(),
-            Roundn => functions::roundn(a, b),
-            Equal => b2f(functions::equal(a, b)),
+            Roundn => scalar::roundn(a, b),
+            Equal => b2f(scalar::equal(a, b)),
             Eq => b2f(a == b),
             Ne => b2f(a != b),
             Lt => b2f(a < b),
@@ -346,8 +346,8 @@ impl Op {
                     c
                 }
             }
-            Clamp => functions::clamp(a, b, c),
-            IClamp => functions::iclamp(a, b, c),
+            Clamp => scalar::clamp(a, b, c),
+            IClamp => scalar::iclamp(a, b, c),
             InRange => b2f(a <= b && b <= c),
         }
     }

@@ -10,7 +10,8 @@ use glam::DVec3;
 
 use super::MAX_MATERIALS;
 use super::pnode::{
-    COORD_SLOTS, D_SLOT, Grade, NAry, PNode, SimGrade, Slot, coord_slots, tile_local,
+    COORD_SLOTS, D_SLOT, FixedFractions, Grade, NAry, PNode, SimGrade, Slot, coord_slots,
+    tile_local,
 };
 use super::union_index::{Candidates, Entry};
 
@@ -121,36 +122,6 @@ impl PNode {
     }
 }
 
-/// Fractions that are the same at every point of a node (a primitive, a
-/// moved primitive, an FGrade of constants: every strut of the bunny
-/// lattice). A union keeps one per child so the winning child's material
-/// is one table read, not a walk down the child's tree and its expression
-/// tapes (those pointer chases dominated random-order profiles).
-#[derive(Clone, Copy, Debug)]
-pub struct FixedFractions {
-    len: u8,
-    slots: [Slot; 4],
-    values: [f64; 4],
-}
-
-impl FixedFractions {
-    fn one(m: Slot) -> Self {
-        Self {
-            len: 1,
-            slots: [m, 0, 0, 0],
-            values: [1.0, 0.0, 0.0, 0.0],
-        }
-    }
-
-    /// Add the fractions into `out` (zero on entry), as `frac` would.
-    #[inline]
-    pub fn write(&self, out: &mut [f64]) {
-        for i in 0..self.len as usize {
-            out[self.slots[i] as usize] += self.values[i];
-        }
-    }
-}
-
 impl PNode {
     /// The node's fractions when they do not depend on the point; the
     /// values are computed exactly as `frac` computes them.
@@ -219,8 +190,8 @@ impl NAry {
         match &self.index {
             // The walk of `NAry::indexed_min`, also visiting every child that
             // can contain p (written out again: through a shared closure-taking
-            // walk, `best` and `first` left registers and the 3,286-strut
-            // benchmark lost 20 %).
+            // walk, `best` and `first` leave registers; see docs/PERFORMANCE.md,
+            // "Large unions").
             Some(index) => {
                 for &i in index.always() {
                     visit(i as usize, &mut best, &mut first);
@@ -284,8 +255,7 @@ impl NAry {
             // come first. Visit them in child order. A linear scan finds
             // their end: they are few (a bunny-lattice voxel has 1 to 5 of
             // a cell's hundred or so), they are all visited after, and a
-            // binary search's unpredictable branches cost more (it was
-            // 16 % of the bunny lattice's slice stack).
+            // binary search's branches are unpredictable.
             let slack = self.slack(index, p, centre);
             let may_contain = |e: &Entry| f64::from(e.lo) + slack <= 0.0;
             let n = entries
@@ -461,9 +431,8 @@ impl Grade {
 
 impl SimGrade {
     fn frac(&self, p: DVec3, out: &mut [f64]) {
-        // The seat's 13 slots in a 16-slot scratch array: zeroing 64 per
-        // sample was a 512-byte memset, 181 M of its mesh export's 30.2 G
-        // instructions.
+        // Few slots (the seat has 13) in a 16-slot scratch array: zeroing
+        // all 64 per sample is a 512-byte memset.
         if COORD_SLOTS + self.field.variable_count() <= 16 {
             self.frac_in::<16>(p, out)
         } else {
@@ -497,8 +466,7 @@ fn write_normalised(set: &ExprSet, mats: &[Slot], slots: &[f64], out: &mut [f64]
     }
 }
 
-// Inlined into each grade's caller: as a call it cost the graded bar's
-// slice stack 2 % more instructions.
+// Inlined into each grade's caller: it runs once per graded sample.
 #[inline(always)]
 fn normalised<const N: usize>(set: &ExprSet, mats: &[Slot], slots: &[f64], out: &mut [f64]) {
     let mut vals = [0.0; N];

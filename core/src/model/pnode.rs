@@ -11,6 +11,7 @@ use std::sync::Arc;
 use glam::{DMat3, DVec2, DVec3};
 
 use super::sdf;
+use super::shapes::Capsule;
 use super::strut_grid::StrutGrid;
 use super::tpms::Tpms;
 use super::union_index::{Candidates, UnionIndex};
@@ -20,42 +21,33 @@ use crate::expr::Expr;
 /// Dense material index within one model (position in `Model::materials`).
 pub type Slot = u16;
 
-/// A capsule with precomputed terms.
+/// Fractions that are the same at every point of a node (a primitive, a
+/// moved primitive, an FGrade of constants: every strut of the bunny
+/// lattice). A union keeps one per child so the winning child's material
+/// is one table read, not a walk down the child's tree and its expression
+/// tapes (those pointer chases dominated random-order profiles).
 #[derive(Clone, Copy, Debug)]
-pub struct Capsule {
-    pub a: DVec3,
-    pub ab: DVec3,
-    pub inv_ab2: f64,
-    pub r: f64,
+pub struct FixedFractions {
+    pub(super) len: u8,
+    pub(super) slots: [Slot; 4],
+    pub(super) values: [f64; 4],
 }
 
-impl Capsule {
-    pub fn new(a: DVec3, b: DVec3, r: f64) -> Self {
-        let ab = b - a;
-        let l2 = ab.length_squared();
+impl FixedFractions {
+    pub(super) fn one(m: Slot) -> Self {
         Self {
-            a,
-            ab,
-            inv_ab2: if l2 > 0.0 { 1.0 / l2 } else { 0.0 },
-            r,
+            len: 1,
+            slots: [m, 0, 0, 0],
+            values: [1.0, 0.0, 0.0, 0.0],
         }
     }
 
+    /// Add the fractions into `out` (zero on entry), as `frac` would.
     #[inline]
-    pub fn dist(&self, p: DVec3) -> f64 {
-        sdf::capsule(p, self.a, self.ab, self.inv_ab2, self.r)
-    }
-
-    /// Squared distance from `p` to the axis segment: `dist` is its square
-    /// root minus `r`, computed the same way.
-    #[inline]
-    pub fn axis_dist2(&self, p: DVec3) -> f64 {
-        sdf::segment_dist2(p, self.a, self.ab, self.inv_ab2)
-    }
-
-    pub fn bbox(&self) -> Aabb {
-        let b = self.a + self.ab;
-        Aabb::new(self.a.min(b), self.a.max(b)).expand(self.r)
+    pub fn write(&self, out: &mut [f64]) {
+        for i in 0..self.len as usize {
+            out[self.slots[i] as usize] += self.values[i];
+        }
     }
 }
 
@@ -246,7 +238,7 @@ pub struct NAry {
     /// Sharp, and every child 1-Lipschitz (see `PNode::is_lipschitz`).
     pub lipschitz: bool,
     /// Children whose fractions do not depend on the point.
-    pub fixed: Vec<Option<super::fractions::FixedFractions>>,
+    pub fixed: Vec<Option<FixedFractions>>,
 }
 
 /// FGrade: fractions from expressions over the child.

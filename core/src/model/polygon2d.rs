@@ -3,9 +3,9 @@
 //!
 //! * Distance: the exact Euclidean distance to the nearest edge. A grid of
 //!   about two cells per edge lists, per cell, every edge that can be
-//!   nearest to a point of it, sorted for an early stop ([`Cells`]); cells
+//!   nearest to a point of it, sorted for an early stop (`Cells`); cells
 //!   far from every edge, and points outside the grid, walk a
-//!   bounding-volume hierarchy over the edges (boxes of at most [`LEAF`]
+//!   bounding-volume hierarchy over the edges (boxes of at most `LEAF`
 //!   edges, nearer child first, pruned by the squared box distance).
 //! * Sign: the non-zero winding rule (TrueType's and CFF's fill rule), from
 //!   the crossings of one axis-parallel ray, half-open across it so a ray

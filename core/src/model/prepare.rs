@@ -9,7 +9,8 @@ use std::sync::Arc;
 use glam::{DMat3, DVec2, DVec3};
 
 use super::flatten::{self, Shape, compose_moves, rotation};
-use super::pnode::{Capsule, Grade, LineCapsule, NAry, PNode, Prism, SimGrade, Slot};
+use super::pnode::{Grade, LineCapsule, NAry, PNode, Prism, SimGrade, Slot};
+use super::shapes::Capsule;
 use super::strut_grid::StrutGrid;
 use super::tpms::Tpms;
 use super::union_index::UnionIndex;

@@ -5,7 +5,8 @@
 use glam::DVec3;
 
 use super::super::PrepareError;
-use super::super::pnode::{Capsule, PNode};
+use super::super::pnode::PNode;
+use super::super::shapes::Capsule;
 use super::super::shapes::{Beam, Cone, Revolve, Shape};
 use super::{Preparer, err};
 use crate::aabb::Aabb;

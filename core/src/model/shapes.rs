@@ -12,6 +12,45 @@ use super::sdf;
 use crate::aabb::Aabb;
 use crate::node::CapMode;
 
+/// A capsule with precomputed terms.
+#[derive(Clone, Copy, Debug)]
+pub struct Capsule {
+    pub a: DVec3,
+    pub ab: DVec3,
+    pub inv_ab2: f64,
+    pub r: f64,
+}
+
+impl Capsule {
+    pub fn new(a: DVec3, b: DVec3, r: f64) -> Self {
+        let ab = b - a;
+        let l2 = ab.length_squared();
+        Self {
+            a,
+            ab,
+            inv_ab2: if l2 > 0.0 { 1.0 / l2 } else { 0.0 },
+            r,
+        }
+    }
+
+    #[inline]
+    pub fn dist(&self, p: DVec3) -> f64 {
+        sdf::capsule(p, self.a, self.ab, self.inv_ab2, self.r)
+    }
+
+    /// Squared distance from `p` to the axis segment: `dist` is its square
+    /// root minus `r`, computed the same way.
+    #[inline]
+    pub fn axis_dist2(&self, p: DVec3) -> f64 {
+        sdf::segment_dist2(p, self.a, self.ab, self.inv_ab2)
+    }
+
+    pub fn bbox(&self) -> Aabb {
+        let b = self.a + self.ab;
+        Aabb::new(self.a.min(b), self.a.max(b)).expand(self.r)
+    }
+}
+
 /// One prepared primitive of this module.
 #[derive(Clone, Debug)]
 pub enum Shape {

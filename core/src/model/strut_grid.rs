@@ -17,7 +17,7 @@
 
 use glam::DVec3;
 
-use super::pnode::Capsule;
+use super::shapes::Capsule;
 use crate::fastmath::floor3;
 
 /// Sub-cells per axis.

@@ -139,8 +139,7 @@ impl Tpms {
 /// small direct-mapped table per axis keyed by its bits (1024 entries: a
 /// row of a fine grid fits). The y and z tables serve a sampler's short
 /// rows: it walks tiles a few voxels wide, so `(y, z)` changed every few
-/// voxels and the gyroid's slice stack spent 7 % of its instructions on
-/// recomputing sines it had computed before. The values are a pure
+/// voxels and the sines would be recomputed again and again. The values are a pure
 /// function of the bits, so they are exactly the ones a fresh computation
 /// gives.
 mod row {

@@ -19,7 +19,8 @@
 use glam::DVec3;
 
 use crate::aabb::Aabb;
-use crate::cells::CellLattice;
+use crate::spatial::cells::CellLattice;
+use crate::spatial::round::f32_down;
 
 /// Cell-list entries per child (on average) that the grid may hold before
 /// its cells are made coarser, within [`MIN_ENTRIES`, `MAX_ENTRIES`]
@@ -212,14 +213,10 @@ impl UnionIndex {
                                     for x in bx..=ex {
                                         let lo = lower_bound(i as usize, &cell_box(x, y, z));
                                         if lo < margin {
-                                            // f32 rounded toward -inf keeps it a lower bound.
-                                            let lo32 = lo as f32;
-                                            let lo32 = if (lo32 as f64) > lo {
-                                                lo32.next_down()
-                                            } else {
-                                                lo32
-                                            };
-                                            cells.push((lattice.index([x, y, z]) as u32, lo32));
+                                            cells.push((
+                                                lattice.index([x, y, z]) as u32,
+                                                f32_down(lo),
+                                            ));
                                         }
                                     }
                                 }
@@ -249,7 +246,7 @@ impl UnionIndex {
         }
         for c in 0..ncells {
             entries[offsets[c] as usize..offsets[c + 1] as usize]
-                .sort_unstable_by_key(|e| crate::order::f32_then_index(e.lo, e.child));
+                .sort_unstable_by_key(|e| crate::spatial::order::f32_then_index(e.lo, e.child));
         }
         let bvh = Bvh::build(boxes, &finite);
         Self {

@@ -452,8 +452,8 @@ impl<'a> Sampler<'a> {
         // fractions are averages (a `Blend`, 125 or 216 child samples a voxel) and
         // their bounds over the tile are narrow, the inside voxels of tiles
         // a surface crosses get `NaN` fractions too, and only their
-        // distance is evaluated (the csg_tour slice stack: 1.06 → 1.65 M
-        // voxels/s). For other designs the bound costs about what it saves.
+        // distance is evaluated (a large saving on the csg_tour slice
+        // stack). For other designs the bound costs about what it saves.
         let lazy = k > 0 && self.lazy_open && self.bounded(&b, k);
         // What an inside voxel gets without evaluating its fractions, once
         // known: `NaN` for the lazy consumer, or the shared fractions.
@@ -529,10 +529,8 @@ impl<'a> Sampler<'a> {
             // are not exact (Lipschitz, expressions) are never one number
             // over a box that is not a point. A layer through a face
             // parallel to it (the cube's top and bottom) is such a tile
-            // away from the other faces: the cube's layers within a voxel
-            // diagonal of them (47 thousand voxels each at 0.0464 mm) were
-            // evaluated voxel by voxel, 5 % of its mesh export's
-            // instructions (callgrind, one thread: 1,046.8 → 990.6 M).
+            // away from the other faces: without this, a cube's layers
+            // within a voxel diagonal of them are evaluated voxel by voxel.
             if iv.lo == iv.hi && iv.lo.is_finite() && b.min != b.max {
                 return Settled::Exact(iv.lo);
             }
@@ -570,8 +568,8 @@ impl<'a> Sampler<'a> {
     /// (`b` its voxel centres). The test costs an interval evaluation of
     /// the grading, which pays only where it sometimes succeeds (a lattice
     /// graded per cell); on a smooth grading (a gyroid graded by radius) it
-    /// never does, and asking every open tile added 1 % to the slice
-    /// stack's instructions. So it stops being asked once fewer than one in
+    /// never does, and asking every open tile is wasted work. So it stops
+    /// being asked once fewer than one in
     /// eight of its first 64 answers were yes.
     /// Which tiles ask it can depend on the threads' timing; what is
     /// written cannot (the shared fractions are the evaluated ones).

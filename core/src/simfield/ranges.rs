@@ -8,17 +8,15 @@
 //! Why the bounds are the same: they are the least and greatest nodal
 //! values over the tetrahedra whose boxes meet the query box. Every
 //! tetrahedron below a tree node whose box lies within the query box meets
-//! it ([`crate::trimesh::wide::WideBvh::overlapping_nodes`]), so the same
+//! it ([`crate::spatial::wide::WideBvh::overlapping_nodes`]), so the same
 //! tetrahedra count, and a minimum or maximum does not depend on the order
 //! or grouping it is taken in. The count decides the same "too many" as
 //! before.
 //!
-//! On the bicycle seat's 4-segment mesh at 0.5 mm, `SimField::bounds` was
-//! 11 % of the export's instructions: 302 thousand calls meeting 26
-//! tetrahedra each, at about 330 instructions per tetrahedron for its four
-//! nodal rows (callgrind).
+//! Why: a segmented mesh export of a simulation field asks `SimField::bounds`
+//! for every open tile, and each call meets tens of tetrahedra.
 
-use crate::trimesh::wide::WideChild;
+use crate::spatial::wide::WideChild;
 
 use super::tet_bvh::TetLocator;
 

@@ -23,7 +23,7 @@
 //!    near its centre;
 //! 3. when the walk leaves the mesh (a non-convex boundary between start and
 //!    `p`, or `p` outside) or exceeds its step limit: the BVH over the
-//!    tetrahedra's boxes (4-wide, [`crate::trimesh::wide`]), which tests every
+//!    tetrahedra's boxes (4-wide, [`crate::spatial::wide`]), which tests every
 //!    tetrahedron whose box contains `p`.
 //!
 //! A point on (or within the tolerance of) a face, edge or node is inside
@@ -38,9 +38,10 @@
 use glam::DVec3;
 
 use crate::aabb::Aabb;
+use crate::spatial::bvh;
+use crate::spatial::recent::RecentSlots;
+use crate::spatial::wide::{WideBvh, WideChild};
 use crate::trimesh::TriangleMesh;
-use crate::trimesh::bvh;
-use crate::trimesh::wide::{WideBvh, WideChild};
 
 /// Barycentric tolerance (dimensionless).
 const TOLERANCE: f64 = -1e-12;
@@ -277,10 +278,8 @@ impl TetLocator {
     /// For a cell `b` the boundary crosses whose centre `c` is outside: a
     /// tetrahedron near `c` among those whose boxes meet `b`, or
     /// `NONE`. Points of such a cell inside the mesh then
-    /// walk a step or two from there instead of searching the BVH, which
-    /// was 7 % of the seat's band points' profile: `volcad bench` on the
-    /// seat, Z-ordered 11.3–11.6 → 11.8 M points/s, random order 2.5–4.3
-    /// → 5.6–5.7 M.
+    /// walk a step or two from there instead of searching the BVH
+    /// (measured with `volcad bench` on the bicycle seat).
     fn nearest_overlapping(&self, b: &Aabb, c: DVec3) -> u32 {
         let mut best = (f64::INFINITY, NONE);
         self.wide.overlapping(b, |slot| {
@@ -351,14 +350,17 @@ impl TetLocator {
         }
         let key = self.data.as_ptr() as usize;
         let found = self.locate_slot(p, key)?;
-        last::set(key, found.0);
+        LAST.with(|r| r.set(key, found.0));
         let t = &self.data[found.0 as usize];
         Some((self.order[found.0 as usize], t.nodes, found.1))
     }
 
     #[inline]
     fn locate_slot(&self, p: DVec3, key: usize) -> Option<(u32, [f64; 4])> {
-        if let Some(s) = last::get(key).filter(|&s| (s as usize) < self.data.len()) {
+        if let Some(s) = LAST
+            .with(|r| r.get(key))
+            .filter(|&s| (s as usize) < self.data.len())
+        {
             let w = self.data[s as usize].weights(p);
             if least(&w) > NEAR {
                 return Some((s, w));
@@ -423,31 +425,8 @@ fn link_neighbours(data: &mut [TetData]) {
     }
 }
 
-/// Per-thread memory of the last tetrahedron found by the few most
-/// recently used locators (keyed by address; a stale key only costs one
-/// failed test).
-mod last {
-    use std::cell::Cell;
-
-    const WAYS: usize = 4;
-
-    thread_local! {
-        static LAST: Cell<[(usize, u32); WAYS]> = const { Cell::new([(0, 0); WAYS]) };
-    }
-
-    #[inline]
-    pub fn get(key: usize) -> Option<u32> {
-        LAST.with(|c| c.get().iter().find(|e| e.0 == key).map(|e| e.1))
-    }
-
-    #[inline]
-    pub fn set(key: usize, slot: u32) {
-        LAST.with(|c| {
-            let mut a = c.get();
-            let i = a.iter().position(|e| e.0 == key).unwrap_or(WAYS - 1);
-            a.copy_within(0..i, 1);
-            a[0] = (key, slot);
-            c.set(a);
-        })
-    }
+thread_local! {
+    /// The last tetrahedron found by the few most recently used locators
+    /// (keyed by address; a stale key only costs one failed test).
+    static LAST: RecentSlots = const { RecentSlots::new() };
 }

@@ -6,6 +6,7 @@ use super::TriangleMesh;
 use super::triangle::Feature;
 use crate::aabb::Aabb;
 use crate::interval::Interval;
+use crate::spatial::recent::RecentSlots;
 
 impl TriangleMesh {
     /// Nearest triangle slot and its squared distance, if one is closer than
@@ -24,7 +25,10 @@ impl TriangleMesh {
         let key = tris.as_ptr() as usize;
         let mut best = max_d2;
         let mut seed = None;
-        if let Some(s) = seed::get(key).filter(|&s| (s as usize) < tris.len()) {
+        if let Some(s) = SEED
+            .with(|r| r.get(key))
+            .filter(|&s| (s as usize) < tris.len())
+        {
             let d2 = tris[s as usize].distance_squared(p);
             if d2 < best {
                 best = d2;
@@ -44,7 +48,7 @@ impl TriangleMesh {
             })
             .or(seed);
         if let Some((s, _)) = found {
-            seed::set(key, s);
+            SEED.with(|r| r.set(key, s));
         }
         found.map(|(s, d2)| (s as usize, d2))
     }
@@ -98,8 +102,7 @@ impl TriangleMesh {
     pub fn signed_distance(&self, p: DVec3) -> f64 {
         // The grid's cell lookup rejects non-finite points itself (its
         // range test is false for NaN and infinities), so the check waits
-        // for the fallback: 2.7 % fewer of the bunny lattice's instructions
-        // (callgrind; its wall time within noise).
+        // for the fallback, off the common path.
         if let Some(d) = self.signed_from_candidates(p) {
             return d;
         }
@@ -265,33 +268,8 @@ fn signed(d2: f64, sign: impl FnOnce() -> f64) -> f64 {
     if d2 == 0.0 { 0.0 } else { d2.sqrt() * sign() }
 }
 
-/// Per-thread memory of the last nearest triangle of the few most recently
-/// queried meshes (keyed by the address of their triangle data). A stale key
-/// (a dropped mesh whose memory was reused) only gives a poor seed.
-mod seed {
-    use std::cell::Cell;
-
-    const WAYS: usize = 4;
-
-    thread_local! {
-        static LAST: Cell<[(usize, u32); WAYS]> = const { Cell::new([(0, 0); WAYS]) };
-    }
-
-    /// The remembered slot for mesh `key`.
-    #[inline]
-    pub fn get(key: usize) -> Option<u32> {
-        LAST.with(|c| c.get().iter().find(|e| e.0 == key).map(|e| e.1))
-    }
-
-    /// Remembers `slot` for mesh `key` (most recent first).
-    #[inline]
-    pub fn set(key: usize, slot: u32) {
-        LAST.with(|c| {
-            let mut a = c.get();
-            let i = a.iter().position(|e| e.0 == key).unwrap_or(WAYS - 1);
-            a.copy_within(0..i, 1);
-            a[0] = (key, slot);
-            c.set(a);
-        })
-    }
+thread_local! {
+    /// The last nearest triangle of the few most recently queried meshes
+    /// (keyed by the address of their triangle data).
+    static SEED: RecentSlots = const { RecentSlots::new() };
 }

@@ -27,7 +27,7 @@ use super::TriangleMesh;
 use super::candidates::{self, CandidateGrid};
 use super::certificate::Skips;
 use super::coarse::CoarseGrid;
-use crate::cells::CellLattice;
+use crate::spatial::cells::CellLattice;
 
 const MAGIC: &[u8; 8] = b"VCADGRID";
 /// Bumped whenever the file layout or what the grids mean changes.

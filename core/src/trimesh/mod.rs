@@ -20,7 +20,6 @@
 //! The result is a true Euclidean SDF (1-Lipschitz), so interval bounds over
 //! boxes follow from one evaluation at the centre.
 
-pub(crate) mod bvh;
 mod candidates;
 mod certificate;
 mod coarse;
@@ -30,7 +29,6 @@ mod gaps;
 mod grid_cache;
 mod topology;
 mod triangle;
-pub(crate) mod wide;
 mod winding;
 
 #[cfg(test)]
@@ -41,6 +39,7 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 
 use crate::aabb::Aabb;
+use crate::spatial::{bvh, wide};
 
 use self::topology::Topology;
 use self::triangle::Tri;

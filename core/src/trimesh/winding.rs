@@ -23,8 +23,8 @@
 
 use glam::DVec3;
 
-use super::bvh::{BvhNode, MAX_DEPTH};
 use super::triangle::{Tri, solid_angle};
+use crate::spatial::bvh::{BvhNode, MAX_DEPTH};
 
 /// Accuracy parameter `β` of Barill et al. (their default is 2).
 const BETA: f64 = 2.0;

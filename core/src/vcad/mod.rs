@@ -2,8 +2,8 @@
 //! `parse_vcad_text`), read into the same
 //! [`Design`] a Rhai script builds.
 //!
-//! The text is lexed ([`lexer`]), parsed into calls ([`parser`]) and
-//! translated straight into the node tree ([`translate`]), not into Rhai
+//! The text is lexed (`lexer`), parsed into calls (`parser`) and
+//! translated straight into the node tree (`translate`), not into Rhai
 //! source: every message then comes from code that holds the `.vcad`
 //! line and column itself (an unknown construct, a wrong argument, an
 //! error inside an expression string, and, through each node's origin, a

@@ -8,11 +8,8 @@
 //! ≥ 2⁶³ cases), three of them per query. Here the range test is done in
 //! floating point first (`0 ≤ g < dims`, false for NaN), after which the
 //! casts cannot saturate, and are unchecked: a checked `as u32` still
-//! clamps (`maxsd`, `minsd`, eight cycles on the path from the point to
-//! its cell's list, twice a point on the bunny lattice). On a Xeon (Intel
-//! family 6 model 167, `volcad bench`, alternating binaries) that clamp
-//! cost the bunny lattice 9 to 13 % of its Z-ordered points/s; on a Zen 4
-//! it cost nothing measurable.
+//! clamps (`maxsd`, `minsd` on the path from the point to its cell's
+//! list, twice a point on a mesh lattice).
 //!
 //! Why blocks: a cell's linear index puts the 4³ cells of a block side by
 //! side (x fastest within the block, blocks x fastest), so the per-cell
@@ -20,9 +17,7 @@
 //! stretch of memory. Queries come in space-filling order (samplers sweep
 //! small boxes, the bench and the baker go in Z-order), and with rows
 //! (`x + nx·(y + ny·z)`) a walk around a point's neighbourhood touched a new
-//! cache line for every step in y or z. See [`CellLattice::index`]. On the
-//! bunny lattice (`volcad bench`, Z-ordered points, four alternating pairs)
-//! 16.8–16.9 → 17.0–17.2 M points/s; other designs within noise.
+//! cache line for every step in y or z. See [`CellLattice::index`].
 
 use glam::DVec3;
 

@@ -2,8 +2,7 @@
 //!
 //! Why: the candidate grid and the union index sort hundreds of thousands
 //! of short lists by an `f32` bound, ties broken by an index. Through
-//! `total_cmp(..).then(..)` a comparison is a dozen instructions with two
-//! branches; one `u64` key per entry (the bound's order-preserving bits
+//! `total_cmp(..).then(..)` a comparison takes two branches; one `u64` key per entry (the bound's order-preserving bits
 //! above the index) makes it one compare, and the same order.
 //!
 //! The map is `total_cmp`'s own: flip the low 31 bits of a negative

@@ -20,6 +20,7 @@ use glam::{BVec4A, DVec3, Vec4};
 use crate::aabb::Aabb;
 
 use super::bvh::Bvh;
+use super::round::{f32_down, f32_up};
 
 /// Marks a child slot that holds a primitive (its slot number in the low bits).
 const PRIM: u32 = 1 << 31;
@@ -53,22 +54,10 @@ pub(crate) struct WideBvh {
     nodes: Vec<Node4>,
 }
 
-/// Largest `f32` not above `x`.
-fn down(x: f64) -> f32 {
-    let f = x as f32;
-    if f as f64 > x { f.next_down() } else { f }
-}
-
-/// Smallest `f32` not below `x`.
-fn up(x: f64) -> f32 {
-    let f = x as f32;
-    if (f as f64) < x { f.next_up() } else { f }
-}
-
 /// Squared `f32` bound that is at least `d2` (so pruning stays conservative).
 #[inline(always)]
 fn bound(d2: f64) -> f32 {
-    up(d2 * (1.0 + 1e-5))
+    f32_up(d2 * (1.0 + 1e-5))
 }
 
 impl WideBvh {
@@ -111,8 +100,8 @@ impl WideBvh {
             for (lane, &it) in items.iter().enumerate() {
                 let n = &bvh.nodes[it];
                 for a in 0..3 {
-                    nodes[wi].lo[a][lane] = down(n.min[a] - margin);
-                    nodes[wi].hi[a][lane] = up(n.max[a] + margin);
+                    nodes[wi].lo[a][lane] = f32_down(n.min[a] - margin);
+                    nodes[wi].hi[a][lane] = f32_up(n.max[a] + margin);
                 }
                 nodes[wi].child[lane] = if n.is_leaf() {
                     PRIM | n.first
@@ -334,8 +323,8 @@ struct RoundedBox {
 impl RoundedBox {
     fn new(b: &Aabb) -> RoundedBox {
         RoundedBox {
-            lo: [b.min.x, b.min.y, b.min.z].map(|v| Vec4::splat(down(v))),
-            hi: [b.max.x, b.max.y, b.max.z].map(|v| Vec4::splat(up(v))),
+            lo: [b.min.x, b.min.y, b.min.z].map(|v| Vec4::splat(f32_down(v))),
+            hi: [b.max.x, b.max.y, b.max.z].map(|v| Vec4::splat(f32_up(v))),
         }
     }
 
