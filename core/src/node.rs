@@ -415,7 +415,7 @@ impl Node {
     }
 
     /// The attributes for `set_attribute` to change (copy on write, as
-    /// [`Node::kind_mut`]).
+    /// `Node::kind_mut`).
     pub fn attributes_mut(&mut self) -> &mut crate::attribute::NodeAttributes {
         Arc::make_mut(self.attrs.get_or_insert_with(Default::default))
     }

@@ -332,12 +332,14 @@ fn png_export_cancels_cleanly_and_completes_with_a_manifest() {
     let dir = scratch.path();
     wait_idle(&mut h);
 
-    // A long export (94 million voxels), cancelled once it reports progress.
+    // A long export (384 million voxels: a debug build takes about a
+    // minute), cancelled once it reports progress; a shorter one could
+    // finish while the harness renders the frames below.
     let cancelled = dir.join("cancelled");
     set_output_folder(&mut h, &cancelled);
-    set_png_voxel(&mut h, 0.02);
+    set_png_voxel(&mut h, 0.0125);
     let est = wait_label(&mut h, "Estimate:");
-    assert!(est.contains("750 × 500 × 250 voxels"), "{est}");
+    assert!(est.contains("1200 × 800 × 400 voxels"), "{est}");
     h.get_by_label("Export PNG stack").click();
     wait_for(&mut h, "progress", |a| job_state(a) == Some("running"));
     h.get_by_role(Role::ProgressIndicator);

@@ -567,7 +567,7 @@ impl StudioApp {
             .show(ui, |ui| {
                 // A fixed height, so the panels below do not jump as the
                 // read-out under the cursor changes length.
-                let lines = 9 + self.model().map_or(0, |m| m.attributes().len());
+                let lines = 8 + self.model().map_or(0, |m| m.attributes().len());
                 let h = ui.text_style_height(&egui::TextStyle::Monospace) * lines as f32;
                 egui::ScrollArea::vertical()
                     .id_salt("probe-scroll")
@@ -584,6 +584,12 @@ impl StudioApp {
                     .good
                     .as_ref()
                     .map(|g| (g.model.clone(), g.source.clone()));
+                // Running and finished exports first, under the heading:
+                // their progress and Cancel stay in view however tall the
+                // panels above grow.
+                for note in self.jobs.ui(ui) {
+                    self.bottom.log(note);
+                }
                 let ctx = ui.ctx().clone();
                 let place = export_panel::Place::of(&self.doc, self.opts.documents_dir.as_deref());
                 let action = self.exports.ui(
@@ -601,9 +607,6 @@ impl StudioApp {
                     }
                     export_panel::Action::Log(l) => self.bottom.log(l),
                     export_panel::Action::Ask(q) => self.modal = Some(Modal::ConfirmExport(q)),
-                }
-                for note in self.jobs.ui(ui) {
-                    self.bottom.log(note);
                 }
             });
     }

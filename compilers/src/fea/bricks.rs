@@ -14,7 +14,7 @@
 //!   `k − 1` and `k`), in `(j, i)` order.
 //!
 //! The boundary faces and connected pieces are found on the way, from the
-//! masks of the layers beside each brick ([`GridFaces`]).
+//! masks of the layers beside each brick (`GridFaces`).
 //!
 //! Node order per brick is CalculiX's: bottom face counter-clockwise seen
 //! from +z, then the top face in the same order.

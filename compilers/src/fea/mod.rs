@@ -544,7 +544,6 @@ pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summ
     if mesh.is_empty() {
         return Err(ExportError::Other("the mesh has no elements: the design is empty at this element size (try a smaller --voxel or --max-cell)".into()));
     }
-    let mut mesh = mesh;
     let used: Vec<MatOut> = match property_bins::element_props(model, &mesh)? {
         Some(props) => {
             let bins = p.property_bins.unwrap_or(property_bins::DEFAULT_BINS);

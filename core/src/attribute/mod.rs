@@ -4,7 +4,7 @@
 //!
 //! `node.set_attribute(name, value)` stores a [`AttrDef`] on the script's
 //! node ([`NodeAttributes`]); [`crate::Model::prepare`] builds a separate
-//! evaluator ([`prepared`]) only when some node carries one, so the
+//! evaluator (`prepared`) only when some node carries one, so the
 //! distance and fraction paths of a design without attributes do not change.
 //! The rules (pyvcad 3's getting-started, lesson 7): the topmost node on a
 //! point's path that sets an attribute decides it (a parent overrides its
