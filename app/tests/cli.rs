@@ -649,4 +649,21 @@ fn a_finished_export_is_replaced_only_with_force_and_other_folders_never() {
         );
         assert_eq!(files_in(&mine), ["notes.txt", "photo.jpg"]);
     }
+    // A GrabCAD package is one file: the same rule.
+    let gcvf = d.join("bar.gcvf");
+    let package = |extra: &[&str]| {
+        let mut args = vec!["export", "gcvf", &bar, "--out", gcvf.to_str().unwrap()];
+        args.extend(["--voxel", "1", "--map", "red=VeroMgnt,blue=VeroCyan"]);
+        args.extend(extra);
+        volcad(&args)
+    };
+    ok(&package(&[]));
+    let first = std::fs::read(&gcvf).unwrap();
+    let err = fails(&package(&["--seed", "7"]));
+    assert!(
+        err.contains("is already there; add --force to replace it"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(&gcvf).unwrap(), first, "the package is kept");
+    ok(&package(&["--seed", "7", "--force"]));
 }

@@ -55,6 +55,18 @@ pub(super) fn start(
             dest.display()
         ),
     };
+    // As for export folders: a finished package is replaced only with
+    // --force (the job itself refuses anything that is not a regular file).
+    if !a.force
+        && let Ok(m) = std::fs::metadata(&dest)
+        && m.is_file()
+    {
+        bail!(
+            "--out {}: a file of {:.1} MB is already there; add --force to replace it, or give another name",
+            dest.display(),
+            m.len() as f64 / 1e6
+        );
+    }
     let file_name = dest
         .file_name()
         .map(|n| n.to_string_lossy().to_string())

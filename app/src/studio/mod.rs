@@ -584,12 +584,6 @@ impl StudioApp {
                     .good
                     .as_ref()
                     .map(|g| (g.model.clone(), g.source.clone()));
-                // Running and finished exports first, under the heading:
-                // their progress and Cancel stay in view however tall the
-                // panels above grow.
-                for note in self.jobs.ui(ui) {
-                    self.bottom.log(note);
-                }
                 let ctx = ui.ctx().clone();
                 let place = export_panel::Place::of(&self.doc, self.opts.documents_dir.as_deref());
                 let action = self.exports.ui(
@@ -607,6 +601,9 @@ impl StudioApp {
                     }
                     export_panel::Action::Log(l) => self.bottom.log(l),
                     export_panel::Action::Ask(q) => self.modal = Some(Modal::ConfirmExport(q)),
+                }
+                for note in self.jobs.ui(ui) {
+                    self.bottom.log(note);
                 }
             });
     }

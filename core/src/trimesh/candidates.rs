@@ -39,6 +39,8 @@ use crate::spatial::round::f32_down;
 /// time; see docs/PERFORMANCE.md, "Mesh distance", for how the choice is
 /// measured.
 const CELLS: f64 = 128.0;
+/// Fewest triangles for which a grid is built (see [`CandidateGrid::new`]).
+const MIN_TRIANGLES: usize = 64;
 /// Most cells in one grid (5 bytes each plus the lists).
 const MAX_TOTAL: f64 = 4.0e6;
 /// Cells farther than this many cell sizes from the surface keep no list.
@@ -341,6 +343,12 @@ impl CandidateGrid {
     /// Builds the grid over the mesh box padded by two cells. `mesh` must
     /// answer exact queries through its BVH (this grid is not yet attached).
     pub fn new(mesh: &TriangleMesh) -> Option<CandidateGrid> {
+        // A handful of triangles: the BVH answers as fast as a list would,
+        // while the grid's build grows with its cells (up to `MAX_TOTAL`),
+        // not with the triangles.
+        if mesh.triangles.len() < MIN_TRIANGLES {
+            return None;
+        }
         let b = mesh.bbox;
         let extent = b.size().max_element();
         if !(extent > 0.0 && extent.is_finite()) {
