@@ -645,10 +645,28 @@ fn frame_times_while_the_bunny_lattice_bakes() {
     let mut model_at = None;
     let mut levels = Vec::new();
     let mut last_bakes = 0;
+    // Once the design is on screen, a key every sixth frame (about ten a
+    // second) for 40 keys, typed at the end of the script while it bakes.
+    let mut typed = 0;
+    let mut typing_ms = Vec::new();
     for frame in 0.. {
+        let typing = model_at.is_some() && typed < 40 && frame % 6 == 0;
+        if typing {
+            if typed == 0 {
+                h.get_by_role(Role::MultilineTextInput).focus();
+                h.step();
+                h.key_press_modifiers(egui::Modifiers::CTRL, egui::Key::End);
+                h.step();
+            }
+            h.get_by_role(Role::MultilineTextInput).type_text(" ");
+            typed += 1;
+        }
         let t = Instant::now();
         h.step();
         ui_ms.push(t.elapsed().as_secs_f64() * 1e3);
+        if typing {
+            typing_ms.push(t.elapsed().as_secs_f64() * 1e3);
+        }
         if frame % 30 == 0 {
             let t = Instant::now();
             h.render().expect("render");
@@ -695,6 +713,10 @@ fn frame_times_while_the_bunny_lattice_bakes() {
     println!(
         "  UI thread per frame (App::logic + App::ui + egui): {}",
         stats(&ui_ms)
+    );
+    println!(
+        "  frames that took a key typed during the bake: {}",
+        stats(&typing_ms)
     );
     println!(
         "  render of the 1280x800 window on this adapter: {}",
