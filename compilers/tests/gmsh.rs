@@ -6,6 +6,8 @@
 //! A missing gmsh fails the test, as a missing `ccx` does, unless
 //! `VOLCAD_SKIP_CONFORMANCE=1`.
 
+mod common;
+
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -111,12 +113,7 @@ fn check_shared(segs: &[SegmentMesh]) -> usize {
     let key = |v: [f32; 3]| v.map(f32::to_bits);
     let mut seen: HashMap<[u32; 3], u32> = HashMap::new();
     for (s, seg) in segs.iter().enumerate() {
-        assert!(
-            seg.mesh.is_empty() || seg.mesh.is_watertight(),
-            "{}: {:?}",
-            seg.name,
-            seg.mesh.edge_report()
-        );
+        common::assert_closed(seg);
         for v in &seg.mesh.vertices {
             *seen.entry(key(*v)).or_default() |= 1 << s;
         }

@@ -113,12 +113,7 @@ fn positions(m: &IndexedMesh, t: usize) -> [[f32; 3]; 3] {
 fn check_cover(segs: &[SegmentMesh]) -> f64 {
     let mut owner: HashMap<[u32; 9], usize> = HashMap::new();
     for (s, seg) in segs.iter().enumerate() {
-        assert!(
-            seg.mesh.is_empty() || seg.mesh.is_watertight(),
-            "{}: {:?}",
-            seg.name,
-            seg.mesh.edge_report()
-        );
+        common::assert_closed(seg);
         for t in 0..seg.mesh.triangles.len() {
             assert!(
                 owner.insert(tri_key(positions(&seg.mesh, t)), s).is_none(),

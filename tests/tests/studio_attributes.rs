@@ -4,8 +4,7 @@
 //! it, the legend shows its name, unit and range, and the probe lists every
 //! attribute under the cursor. Also renders `docs/images/attribute_mode.png`.
 
-use std::path::Path;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use egui::accesskit::Role;
 use egui_kittest::Harness;
@@ -13,23 +12,13 @@ use egui_kittest::kittest::{NodeT as _, Queryable};
 use volcad_studio::studio::egui;
 use volcad_studio::studio::{StudioApp, StudioOptions};
 
+mod common;
+use common::{harness, save_doc_image, wait_within};
+
 /// Step frames until `cond` holds (90 s at most).
 #[track_caller]
 fn wait_for(h: &mut Harness<'static, StudioApp>, what: &str, cond: impl Fn(&StudioApp) -> bool) {
-    let t = Instant::now();
-    loop {
-        h.step();
-        if cond(h.state()) {
-            h.step();
-            return;
-        }
-        assert!(
-            t.elapsed() < Duration::from_secs(90),
-            "timed out waiting for {what}; problems: {:?}",
-            h.state().problems()
-        );
-        std::thread::sleep(Duration::from_millis(5));
-    }
+    wait_within(h, what, Duration::from_secs(90), cond);
 }
 
 /// True once every bake level of the current shading has arrived.
@@ -47,10 +36,7 @@ fn attribute_mode_shades_by_shore_hardness_with_legend_and_probe() {
     opts.initial_text = None;
     opts.example = Some("shore_grip".into());
     opts.bake_levels = vec![48, 96];
-    let mut h = Harness::builder()
-        .with_size(egui::vec2(1280.0, 800.0))
-        .wgpu()
-        .build_eframe(move |cc| StudioApp::new(cc, opts));
+    let mut h = harness(opts);
     wait_for(&mut h, "the grip's bake", baked);
     assert_eq!(h.state().viewport().bake().unwrap().attribute_range, None);
 
@@ -107,9 +93,7 @@ fn attribute_mode_shades_by_shore_hardness_with_legend_and_probe() {
     assert!(probe.attributes[1].text().ends_with(" Shore"));
 
     let img = h.render().expect("render");
-    let out = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/images/attribute_mode.png");
-    std::fs::create_dir_all(out.parent().unwrap()).unwrap();
-    img.save(&out).expect("writing attribute_mode.png");
+    save_doc_image(&img, "attribute_mode.png");
     // Viridis' yellow-green top end (the firm middle) fills the picture
     // (x 440-965, y 80-615 of the window); the grip's clear resins would
     // draw it white.

@@ -15,6 +15,9 @@ use egui_kittest::kittest::{NodeT as _, Queryable};
 use volcad_studio::studio::egui;
 use volcad_studio::studio::{Modal, StudioApp, StudioOptions};
 
+mod common;
+use common::{harness, save_doc_image, wait_within};
+
 /// The graded bar on 4 lines (errors are asserted by line).
 const BAR: &str = r#"let m = default_materials();
 let bar = RectPrism(Vec3(0, 0, 0), Vec3(15, 10, 5), m.id("gray"));
@@ -30,13 +33,6 @@ fn temp_dir(name: &str) -> tempfile::TempDir {
         .expect("temp dir")
 }
 
-fn harness(opts: StudioOptions) -> Harness<'static, StudioApp> {
-    Harness::builder()
-        .with_size(egui::vec2(1280.0, 800.0))
-        .wgpu()
-        .build_eframe(move |cc| StudioApp::new(cc, opts))
-}
-
 /// The scratch folder comes first: bound as `let (dir, h)`, the studio is
 /// dropped first (waiting for its autosave), then the folder is removed.
 fn studio(text: &str, name: &str) -> (tempfile::TempDir, Harness<'static, StudioApp>) {
@@ -48,24 +44,7 @@ fn studio(text: &str, name: &str) -> (tempfile::TempDir, Harness<'static, Studio
 /// Step frames until `cond` holds (60 s at most).
 #[track_caller]
 fn wait_for(h: &mut Harness<'static, StudioApp>, what: &str, cond: impl Fn(&StudioApp) -> bool) {
-    let t = Instant::now();
-    loop {
-        h.step();
-        if cond(h.state()) {
-            // One more frame so the UI shows the new state.
-            h.step();
-            return;
-        }
-        let a = h.state();
-        assert!(
-            t.elapsed() < Duration::from_secs(60),
-            "timed out waiting for {what}; text:\n{}\nproblems: {:?}\nidle: {}",
-            a.text(),
-            a.problems(),
-            a.is_idle()
-        );
-        std::thread::sleep(Duration::from_millis(5));
-    }
+    wait_within(h, what, Duration::from_secs(60), cond);
 }
 
 fn wait_idle(h: &mut Harness<'static, StudioApp>) {
@@ -264,9 +243,7 @@ fn screenshot_for_the_docs() {
     h.state_mut().reference.query = "lattice".into();
     h.run_steps(3);
     let img = h.render().expect("render");
-    let out = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/images/studio.png");
-    std::fs::create_dir_all(out.parent().unwrap()).unwrap();
-    img.save(&out).expect("writing studio.png");
+    save_doc_image(&img, "studio.png");
     // The viewport shows the lattice: many strongly coloured (yellow or
     // magenta) pixels, which nothing else in the window has.
     let coloured = img
@@ -851,6 +828,15 @@ fn the_language_reference_opens_and_searches() {
     );
 }
 
+/// The labels the editor's completion list offers now.
+fn completion_labels(h: &Harness<'static, StudioApp>) -> Vec<String> {
+    h.state()
+        .editor_completion()
+        .iter()
+        .map(|i| i.label.clone())
+        .collect()
+}
+
 /// Typing two letters of a node name lists it; Enter inserts the
 /// skeleton. Inside `id("…")` the design's material names are offered.
 #[test]
@@ -859,12 +845,7 @@ fn completion_inserts_node_skeletons_and_material_names() {
     wait_idle(&mut h);
     type_at_end(&mut h, ";\nlet s = Sph");
     h.run_steps(2);
-    let items: Vec<String> = h
-        .state()
-        .editor_completion()
-        .iter()
-        .map(|i| i.label.clone())
-        .collect();
+    let items = completion_labels(&h);
     assert_eq!(
         items.first().map(String::as_str),
         Some("Sphere"),
@@ -881,12 +862,7 @@ fn completion_inserts_node_skeletons_and_material_names() {
     );
     type_at_end(&mut h, ";\nm.id(\"bl");
     h.run_steps(2);
-    let items: Vec<String> = h
-        .state()
-        .editor_completion()
-        .iter()
-        .map(|i| i.label.clone())
-        .collect();
+    let items = completion_labels(&h);
     assert!(items.iter().any(|i| i == "blue"), "{items:?}");
 }
 

@@ -359,23 +359,22 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
     if let Some(t) = a.threads {
         volcad_compilers::resources::check_threads(t)?;
     }
-    // A GrabCAD package is one file, not a folder of ours: it has its own
-    // checks and job (`gcvf.rs`).
-    if a.kind == Kind::Gcvf {
-        let interrupted = interrupt_flag();
-        let handle = super::gcvf::start(a, model, voxel, hash, a.out.clone())?;
-        return follow(handle, &interrupted);
-    }
-    // `--preset j750` relabels the design with the printer's resins.
-    let model = if a.kind == Kind::Png {
-        super::gcvf::printer_model(a, model)?
-    } else {
-        model
-    };
     let params = match a.kind {
-        Kind::Gcvf | Kind::Png => ExportParams::Png(png_params(a, voxel)?),
+        // A GrabCAD package is one file, not a folder of ours: it has its
+        // own checks and job (`gcvf.rs`).
+        Kind::Gcvf => {
+            let interrupted = interrupt_flag();
+            let handle = super::gcvf::start(a, model, voxel, hash, a.out.clone())?;
+            return follow(handle, &interrupted);
+        }
+        Kind::Png => ExportParams::Png(png_params(a, voxel)?),
         Kind::Mesh => ExportParams::Mesh(mesh_params(a, voxel, &model)?),
         Kind::Fea => ExportParams::Fea(fea_params(a, voxel, &model)?),
+    };
+    // `--preset j750` relabels the design with the printer's resins.
+    let model = match params {
+        ExportParams::Png(_) => super::gcvf::printer_model(a, model)?,
+        _ => model,
     };
     let verdicts = preflight(&params, &model, &a.out)?;
     for v in verdicts.iter().filter(|v| v.severity == Severity::Warn) {

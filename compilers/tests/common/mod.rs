@@ -168,3 +168,14 @@ pub fn reaction(dat: &Path) -> Option<[f64; 3]> {
     }
     None
 }
+
+/// A segment mesh is empty or closed (every edge shared by two triangles);
+/// the message gives the edge report.
+pub fn assert_closed(seg: &volcad_compilers::mesh::SegmentMesh) {
+    assert!(
+        seg.mesh.is_empty() || seg.mesh.is_watertight(),
+        "{}: {:?}",
+        seg.name,
+        seg.mesh.edge_report()
+    );
+}
