@@ -42,30 +42,9 @@ impl Table {
         })
     }
 
-    /// Rows from CSV text: two numeric columns; a first line that is not
-    /// numeric is a header, and lines starting with `#` (the source of the
-    /// numbers) are skipped.
+    /// Rows from CSV text (see [`csv_rows`]).
     pub fn parse_csv(text: &str, what: &str) -> Result<Table, String> {
-        let mut rows = Vec::new();
-        for (n, line) in text.lines().enumerate() {
-            let line = line.trim();
-            if line.is_empty() || line.starts_with('#') {
-                continue;
-            }
-            let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-            let nums: Option<Vec<f64>> = cells.iter().map(|c| c.parse::<f64>().ok()).collect();
-            match nums {
-                Some(v) if v.len() == 2 => rows.push((v[0], v[1])),
-                None if rows.is_empty() => {} // the header
-                _ => {
-                    return Err(format!(
-                        "{what}:{}: expected two numbers `input,output`, got {line:?}",
-                        n + 1
-                    ));
-                }
-            }
-        }
-        Table::new(&rows, what)
+        Table::new(&csv_rows(text, what)?, what)
     }
 
     /// The output at `x`, and whether `x` was outside the inputs (then the
@@ -98,6 +77,35 @@ impl Table {
     pub fn input_range(&self) -> (f64, f64) {
         (self.xs[0], self.xs[self.xs.len() - 1])
     }
+}
+
+/// Rows of two numeric columns from CSV text: a byte-order mark is
+/// skipped, a first line that is not numeric is a header, and lines
+/// starting with `#` (the source of the numbers) are skipped; `what`
+/// names the file in errors, with the 1-based line.
+pub fn csv_rows(text: &str, what: &str) -> Result<Vec<(f64, f64)>, String> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut rows = Vec::new();
+    let mut header = false;
+    for (n, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        let nums: Option<Vec<f64>> = cells.iter().map(|c| c.parse::<f64>().ok()).collect();
+        match nums {
+            Some(v) if v.len() == 2 => rows.push((v[0], v[1])),
+            None if rows.is_empty() && !header => header = true,
+            _ => {
+                return Err(format!(
+                    "{what}:{}: expected two numbers `input,output`, got {line:?}",
+                    n + 1
+                ));
+            }
+        }
+    }
+    Ok(rows)
 }
 
 /// How a conversion maps its input.

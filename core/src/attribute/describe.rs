@@ -24,6 +24,16 @@ pub fn describe_tree(root: &Node) -> Vec<String> {
                     n.describe()
                 ));
             }
+            if let Some(c) = &a.to_fractions {
+                let (lo, hi) = c.table.value_range();
+                out.push(format!(
+                    "fractions = materials {} and {} mixed for \"{}\" through a mix table over {lo}..{hi} on {}",
+                    c.materials[0],
+                    c.materials[1],
+                    c.from,
+                    n.describe()
+                ));
+            }
             for (name, r, _) in &a.resolvers {
                 out.push(format!(
                     "{name}: overlaps resolved by {} on {}",

@@ -481,6 +481,7 @@ impl Model {
             if !seen.insert(std::sync::Arc::as_ptr(n)) {
                 continue;
             }
+            out.extend(n.grade.as_ref().and_then(|g| g.warning()));
             for o in &n.own {
                 if let OwnSrc::Convert {
                     from,

@@ -109,6 +109,8 @@ pub(super) struct ANode {
     pub defines: Vec<bool>,
     pub resolvers: Vec<(usize, Resolver)>,
     pub dist: SubDistance,
+    /// The node's scalar -> fractions conversion (for its warning).
+    pub grade: Option<Arc<super::FractionSource>>,
     pub op: Op,
     depth: u32,
 }
@@ -324,13 +326,15 @@ impl Builder<'_> {
             })
             .unwrap_or_default();
         debug_assert_eq!(defines.len(), count);
+        let dist = self.sub.distance(n)?;
         Ok(Some(Arc::new(ANode {
+            grade: dist.fraction_source(),
             describe: n.describe(),
             own,
             own_of,
             defines,
             resolvers,
-            dist: self.sub.distance(n)?,
+            dist,
             op,
             depth,
         })))

@@ -73,6 +73,11 @@ impl PNode {
             PNode::Offset { child, .. } | PNode::Shell { child, .. } => child.frac(p, out),
             PNode::Tile { cell, child } => child.frac(tile_local(p, *cell), out),
             PNode::FGrade(g) => g.frac(p, out),
+            PNode::AttrGrade { child, src } => {
+                if !src.frac(p, out) {
+                    child.frac(p, out);
+                }
+            }
             PNode::Blend { r, child } => blend_frac(child, *r, p, out),
             PNode::SimField(s) => s.frac(p, out),
             // pyvcad: the first child containing p, whatever the sum.

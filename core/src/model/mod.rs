@@ -107,6 +107,14 @@ impl SubDistance {
         self.node.interval(b)
     }
 
+    /// The scalar -> fractions conversion of the subtree's top node.
+    pub(crate) fn fraction_source(&self) -> Option<Arc<crate::attribute::FractionSource>> {
+        match &*self.node {
+            PNode::AttrGrade { src, .. } => Some(src.clone()),
+            _ => None,
+        }
+    }
+
     /// Fractions at `p` into `out` (the design's materials, dense).
     pub(crate) fn fractions(&self, p: DVec3, out: &mut [f64]) {
         out.fill(0.0);

@@ -4,7 +4,10 @@
 
 use glam::DVec3;
 
-use super::super::PrepareError;
+use std::sync::Arc;
+
+use super::super::{PrepareError, SubPreparer};
+use crate::attribute::FractionSource;
 use super::super::pnode::PNode;
 use super::super::shapes::Capsule;
 use super::super::shapes::{Beam, Cone, Revolve, Shape};
@@ -144,7 +147,9 @@ impl Preparer {
                     Aabb::new(DVec3::new(lo.x, lo.y, -hz), DVec3::new(hi.x, hi.y, hz)),
                 )
             }
-            // Identity with a child is read as its child (`flatten::shape`).
+            // Identity with a child is read as its child (`flatten::shape`)
+            // unless it converts a scalar to fractions.
+            NodeKind::Identity { child: Some(c) } => self.attr_grade(n, c)?,
             NodeKind::Identity { child: None } => {
                 return Err(err(
                     n,
@@ -153,5 +158,33 @@ impl Preparer {
             }
             _ => return Err(err(n, "is not a leaf (a bug in volcad)")),
         })
+    }
+}
+
+impl Preparer {
+    /// `Convert(child, from, fractions([a, b]), table)`: the child's
+    /// distance, fractions from its attribute `from` (an attribute
+    /// evaluator of the child's subtree, whose distances come from this
+    /// preparer's cache: the child is prepared already).
+    fn attr_grade(&self, n: &Node, c: &Node) -> Result<(PNode, Aabb), PrepareError> {
+        let Some(conv) = n.attributes().and_then(|a| a.to_fractions.as_ref()) else {
+            return Err(err(n, "was not read as its child (a bug in volcad)"));
+        };
+        let child = self.get(c)?.clone();
+        let mut materials: Vec<(MaterialId, u16)> =
+            self.slots.iter().map(|(m, s)| (*m, *s)).collect();
+        materials.sort_by_key(|(_, s)| *s);
+        let materials: Vec<MaterialId> = materials.into_iter().map(|(m, _)| m).collect();
+        let sub = SubPreparer(Preparer {
+            slots: self.slots.clone(),
+            cache: self.cache.clone(),
+        });
+        let slots = conv.materials.map(|m| self.slot(m));
+        let src = FractionSource::build(n, conv, c, &materials, slots, sub)?;
+        let node = PNode::AttrGrade {
+            child: child.node,
+            src: Arc::new(src),
+        };
+        Ok((node, child.bbox))
     }
 }

@@ -90,6 +90,7 @@ impl Model {
                 | PNode::Tile { child, .. }
                 | PNode::Blend { child, .. } => stack.push((child, k, off)),
                 PNode::FGrade(g) => stack.push((&g.child, k, off)),
+                PNode::AttrGrade { child, .. } => stack.push((child, k, off)),
                 PNode::Scale { k: s, child, .. } => stack.push((child, k * s, off / s)),
                 // A composed chain of moves scales by at least `a.k`.
                 PNode::Affine(a) => stack.push((&a.child, k * a.k, off / a.k)),

@@ -11,6 +11,7 @@
 
 mod arith;
 mod attribute_api;
+mod fractions_api;
 mod bulk;
 mod file_cache;
 mod files_api;
@@ -35,6 +36,7 @@ use rhai::{Dynamic, Engine, EvalAltResult, NativeCallContext as Ctx, Position, S
 use crate::material::MaterialTable;
 use crate::node::{LatticeType, Node};
 pub use attribute_api::Vec4;
+pub use fractions_api::FractionsTarget;
 pub use values::Vec3;
 use values::{RResult, fail};
 
@@ -559,6 +561,7 @@ fn build_engine(ctx: &RunContext, opts: &ScriptOptions) -> Engine {
     shapes_api::register_shapes(&mut engine);
     nodes_api::register_methods(&mut engine);
     attribute_api::register(&mut engine, ctx);
+    fractions_api::register(&mut engine, ctx);
     files_api::register(&mut engine, ctx);
     query_api::register(&mut engine, ctx);
     text_api::register(&mut engine, ctx);
