@@ -81,6 +81,11 @@ fn source_text(s: &AttrSource) -> String {
             "column \"{column_name}\" of a SimulationField ({} nodes)",
             field.node_count()
         ),
+        AttrSource::Points { cloud, column } => format!(
+            "column \"{}\" of {} points, inverse-distance weighted",
+            cloud.names()[*column],
+            cloud.len()
+        ),
     }
 }
 

@@ -166,6 +166,7 @@ impl ANode {
                     f64::NAN
                 };
             }
+            OwnSrc::Points { cloud, column } => out[0] = cloud.sample(q, *column),
             OwnSrc::Convert {
                 from,
                 from_own,
@@ -304,6 +305,11 @@ impl ANode {
             },
             // Linear interpolation in a tetrahedron stays within its nodes'
             // values; outside the mesh the value is NaN (no sample).
+            // Inverse-distance weights are positive: a convex combination.
+            OwnSrc::Points { cloud, column } => {
+                let (lo, hi) = cloud.range(*column);
+                Interval::new(lo, hi)
+            }
             OwnSrc::Data { field, column } => match field.variable_range(*column) {
                 Some((lo, hi)) => Interval::new(lo, hi),
                 None => Interval::EVERYTHING,

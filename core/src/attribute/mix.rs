@@ -13,7 +13,7 @@
 //! the mix would follow the path through them; two materials need only
 //! the share.
 
-use super::convert::{Table, csv_rows};
+use super::convert::{Table, check_pairs, csv_rows};
 
 /// A two-material mix table, inverted for lookups by value.
 #[derive(Clone, Debug, PartialEq)]
@@ -26,19 +26,8 @@ impl MixTable {
     /// A table of `(share of the second material, value)` rows; `what`
     /// names it in errors.
     pub fn new(rows: &[(f64, f64)], what: &str) -> Result<MixTable, String> {
-        if rows.len() < 2 {
-            return Err(format!(
-                "{what} has {} rows; a mix table needs at least 2 (share, value) rows",
-                rows.len()
-            ));
-        }
-        for (i, (s, v)) in rows.iter().enumerate() {
-            if !s.is_finite() || !v.is_finite() {
-                return Err(format!(
-                    "{what}: row {} ({s}, {v}) is not a pair of finite numbers",
-                    i + 1
-                ));
-            }
+        check_pairs(rows, what, "a mix table", "(share, value)")?;
+        for (i, (s, _)) in rows.iter().enumerate() {
             if !(0.0..=1.0).contains(s) {
                 return Err(format!(
                     "{what}: row {} has share {s}; the first column is the second material's share, 0 (pure first material) to 1 (pure second)",
@@ -137,9 +126,15 @@ mod tests {
 
     #[test]
     fn refuses_tables_it_cannot_invert() {
-        let e = MixTable::new(&[(0.0, 30.0), (0.4, 60.0), (0.7, 55.0), (1.0, 95.0)], "mix.csv")
-            .unwrap_err();
-        assert!(e.contains("mix.csv: rows 2 and 3 (values 60 then 55)"), "{e}");
+        let e = MixTable::new(
+            &[(0.0, 30.0), (0.4, 60.0), (0.7, 55.0), (1.0, 95.0)],
+            "mix.csv",
+        )
+        .unwrap_err();
+        assert!(
+            e.contains("mix.csv: rows 2 and 3 (values 60 then 55)"),
+            "{e}"
+        );
         assert!(e.contains("must rise strictly"), "{e}");
         let e = MixTable::new(&[(0.0, 30.0), (0.5, 30.0)], "t").unwrap_err();
         assert!(e.contains("rows 1 and 2"), "{e}");

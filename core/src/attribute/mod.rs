@@ -20,16 +20,18 @@ mod mix;
 mod moves;
 mod names;
 mod order;
+mod points;
 mod prepared;
 mod resolve;
 mod to_fractions;
 
 use std::sync::Arc;
 
-pub use convert::{ConvMap, FRACTIONS, Table, csv_rows};
-pub use mix::MixTable;
+pub use convert::{ConvMap, FRACTIONS, Table, csv_cells, csv_rows};
 pub use describe::{column_names, describe_tree, value_text};
+pub use mix::MixTable;
 pub use names::{COMMON, Common, check_kind, range, range_text};
+pub use points::{NEIGHBOURS, PointCloud};
 pub use prepared::Evaluator;
 pub use resolve::Resolver;
 pub(crate) use to_fractions::{FractionSource, fraction_materials};
@@ -113,6 +115,14 @@ pub enum AttrSource {
         /// The column's name, for messages.
         column_name: String,
     },
+    /// A value column of scattered points (`PointsField`), interpolated by
+    /// inverse-distance weighting of the nearest points.
+    Points {
+        /// The points.
+        cloud: Arc<PointCloud>,
+        /// The column's index in [`PointCloud::names`].
+        column: usize,
+    },
     /// Another scalar attribute mapped by a table or a math string
     /// (`Convert`): the node's own value of `from`, else the one below it.
     Convert {
@@ -188,3 +198,5 @@ impl NodeAttributes {
 mod tests;
 #[cfg(test)]
 mod tests_fractions;
+#[cfg(test)]
+mod tests_points;

@@ -49,6 +49,10 @@ pub(super) enum OwnSrc {
         field: Arc<crate::simfield::SimField>,
         column: usize,
     },
+    Points {
+        cloud: Arc<super::PointCloud>,
+        column: usize,
+    },
     Convert {
         /// Design index of the input attribute.
         from: usize,
@@ -448,6 +452,10 @@ impl Builder<'_> {
                 ),
                 AttrSource::Data { field, column, .. } => OwnSrc::Data {
                     field: field.clone(),
+                    column: *column,
+                },
+                AttrSource::Points { cloud, column } => OwnSrc::Points {
+                    cloud: cloud.clone(),
                     column: *column,
                 },
                 AttrSource::Convert { from, map } => self.convert(n, a, d, from, map)?,

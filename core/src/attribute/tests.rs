@@ -7,12 +7,12 @@ use crate::aabb::Aabb;
 use crate::model::Points;
 use crate::script::{ScriptOptions, model_of};
 
-fn try_model(src: &str) -> Result<Model, String> {
+pub(super) fn try_model(src: &str) -> Result<Model, String> {
     let src = format!("let m = default_materials();\n{src}");
     model_of(&src, "t.rhai", &ScriptOptions::default()).map_err(|e| e.to_string())
 }
 
-fn model(src: &str) -> Model {
+pub(super) fn model(src: &str) -> Model {
     try_model(src).unwrap_or_else(|e| panic!("{e}"))
 }
 

@@ -3,25 +3,19 @@
 
 use glam::DVec3;
 
+use super::tests::{model, try_model};
 use crate::Model;
 use crate::model::Points;
-use crate::script::{ScriptOptions, model_of};
-
-fn try_model(src: &str) -> Result<Model, String> {
-    let src = format!("let m = default_materials();\n{src}");
-    model_of(&src, "t.rhai", &ScriptOptions::default()).map_err(|e| e.to_string())
-}
-
-fn model(src: &str) -> Model {
-    try_model(src).unwrap_or_else(|e| panic!("{e}"))
-}
 
 /// The fraction of material `name` at p.
 fn frac(m: &Model, name: &str, p: [f64; 3]) -> f64 {
     let id = m.table().id(name).unwrap();
     let (d, pairs) = m.eval_point(DVec3::from_array(p));
     assert!(d <= 0.0, "{p:?} is outside");
-    pairs.iter().find(|(i, _)| *i == id).map_or(0.0, |(_, f)| *f)
+    pairs
+        .iter()
+        .find(|(i, _)| *i == id)
+        .map_or(0.0, |(_, f)| *f)
 }
 
 /// A 20 mm bar along x (x in −10..10) whose hardness rises 30 + 4(x + 10)

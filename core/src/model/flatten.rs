@@ -119,7 +119,9 @@ pub(super) fn shape(n: &Node) -> Shape<'_> {
         NodeKind::Offset { child: Some(_), .. } => offsets(n),
         // Identity only marks a frame in the script's tree, unless it
         // converts a scalar to fractions (then it is built as written).
-        NodeKind::Identity { child: Some(c) } if crate::attribute::fraction_materials(n).is_empty() => {
+        NodeKind::Identity { child: Some(c) }
+            if crate::attribute::fraction_materials(n).is_empty() =>
+        {
             Shape::Same(c)
         }
         NodeKind::Difference {

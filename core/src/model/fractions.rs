@@ -74,7 +74,9 @@ impl PNode {
             PNode::Tile { cell, child } => child.frac(tile_local(p, *cell), out),
             PNode::FGrade(g) => g.frac(p, out),
             PNode::AttrGrade { child, src } => {
-                if !src.frac(p, out) {
+                // Where the attribute has no value, the child's own.
+                let converted = src.frac(p, out);
+                if !converted {
                     child.frac(p, out);
                 }
             }

@@ -6,13 +6,13 @@ use glam::DVec3;
 
 use std::sync::Arc;
 
-use super::super::{PrepareError, SubPreparer};
-use crate::attribute::FractionSource;
 use super::super::pnode::PNode;
 use super::super::shapes::Capsule;
 use super::super::shapes::{Beam, Cone, Revolve, Shape};
+use super::super::{PrepareError, SubPreparer};
 use super::{Preparer, err};
 use crate::aabb::Aabb;
+use crate::attribute::FractionSource;
 use crate::material::MaterialId;
 use crate::node::{CapMode, Node, NodeKind};
 

@@ -73,8 +73,18 @@ fn mix_table(c: &super::RunContext, what: &str, table: &Dynamic, p: Position) ->
         for (i, r) in rows.iter().enumerate() {
             let row = format!("{what}: table row {}", i + 1);
             match r.clone().try_cast::<rhai::Array>() {
-                Some(v) if v.len() == 2 => pairs.push((finite(&v[0], &row, p)?, finite(&v[1], &row, p)?)),
-                _ => return fail(p, format!("{row} must be a pair [share of the second material, value], got {}", described(r))),
+                Some(v) if v.len() == 2 => {
+                    pairs.push((finite(&v[0], &row, p)?, finite(&v[1], &row, p)?))
+                }
+                _ => {
+                    return fail(
+                        p,
+                        format!(
+                            "{row} must be a pair [share of the second material, value], got {}",
+                            described(r)
+                        ),
+                    );
+                }
             }
         }
         return MixTable::new(&pairs, what).or_else(|m| fail(p, m));

@@ -11,13 +11,14 @@
 
 mod arith;
 mod attribute_api;
-mod fractions_api;
 mod bulk;
 mod file_cache;
 mod files_api;
+mod fractions_api;
 mod leaves_api;
 mod nodes_api;
 pub mod param_sets;
+mod points_api;
 mod query_api;
 pub mod read_policy;
 pub mod reference;
@@ -37,6 +38,7 @@ use crate::material::MaterialTable;
 use crate::node::{LatticeType, Node};
 pub use attribute_api::Vec4;
 pub use fractions_api::FractionsTarget;
+pub use points_api::PointsValue;
 pub use values::Vec3;
 use values::{RResult, fail};
 
@@ -562,6 +564,7 @@ fn build_engine(ctx: &RunContext, opts: &ScriptOptions) -> Engine {
     nodes_api::register_methods(&mut engine);
     attribute_api::register(&mut engine, ctx);
     fractions_api::register(&mut engine, ctx);
+    points_api::register(&mut engine, ctx);
     files_api::register(&mut engine, ctx);
     query_api::register(&mut engine, ctx);
     text_api::register(&mut engine, ctx);
