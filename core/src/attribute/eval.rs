@@ -41,10 +41,12 @@ impl ANode {
         match &self.op {
             Op::Leaf => Ok(false),
             Op::Map(m, c) => c.eval(idx, m.apply(q), pw, out),
-            Op::Pick { children, smooth } if *smooth > 0.0 => {
-                blend_children(children, *smooth, idx, q, pw, out)
+            Op::Pick {
+                children, smooth, ..
+            } if *smooth > 0.0 => blend_children(children, *smooth, idx, q, pw, out),
+            Op::Pick { children, grid, .. } => {
+                self.pick_children(children, grid.as_ref(), idx, q, pw, out)
             }
-            Op::Pick { children, .. } => self.pick_children(children, idx, q, pw, out),
         }
     }
 
@@ -54,6 +56,7 @@ impl ANode {
     fn pick_children(
         &self,
         children: &[std::sync::Arc<ANode>],
+        grid: Option<&super::pick_grid::PickGrid>,
         idx: usize,
         q: DVec3,
         pw: DVec3,
@@ -64,7 +67,13 @@ impl ANode {
         let mut tmp = [0.0; MAX_WIDTH];
         let tmp = &mut tmp[..out.len()];
         let mut found = false;
-        for c in children.iter().filter(|c| c.defines[idx]) {
+        // The children near q (a grid's list), else all, in child order.
+        let near = grid.map(|g| g.candidates(q));
+        for k in 0..near.map_or(children.len(), <[u32]>::len) {
+            let c = &children[near.map_or(k, |l| l[k] as usize)];
+            if !c.defines[idx] {
+                continue;
+            }
             if !c.dist.contains(q) {
                 continue;
             }
@@ -230,7 +239,9 @@ impl ANode {
         match &self.op {
             Op::Leaf => None,
             Op::Map(m, c) => c.interval(idx, &m.apply_box(b)),
-            Op::Pick { children, smooth } => {
+            Op::Pick {
+                children, smooth, ..
+            } => {
                 let r = self.resolver(idx);
                 let mut acc: Option<Interval> = None;
                 for c in children.iter().filter(|c| c.defines[idx]) {
@@ -423,7 +434,20 @@ impl Model {
         out: &mut [f64],
     ) -> Result<(), AttributeError> {
         self.attribute_checked(index, out.len(), 1)?;
-        self.attribute_unchecked(index, p, out)
+        self.attribute_unchecked(index, p, out, false)
+    }
+
+    /// [`Model::attribute_at`] at a point the caller knows is inside the
+    /// part (its distance from [`Model::eval_into`] is ≤ 0): skips the
+    /// inside test, a second distance evaluation.
+    pub fn attribute_inside(
+        &self,
+        index: usize,
+        p: DVec3,
+        out: &mut [f64],
+    ) -> Result<(), AttributeError> {
+        self.attribute_checked(index, out.len(), 1)?;
+        self.attribute_unchecked(index, p, out, true)
     }
 
     #[inline]
@@ -432,11 +456,12 @@ impl Model {
         index: usize,
         p: DVec3,
         out: &mut [f64],
+        inside: bool,
     ) -> Result<(), AttributeError> {
         let Some(a) = &self.attrs else {
             return Ok(());
         };
-        if self.root.contains(p) && a.root.eval(index, p, p, out)? {
+        if (inside || self.root.contains(p)) && a.root.eval(index, p, p, out)? {
             return Ok(());
         }
         out.fill(f64::NAN);
@@ -454,7 +479,7 @@ impl Model {
         self.attribute_checked(index, out.len(), pts.len())?;
         let w = self.attributes()[index].kind.width();
         for (i, o) in out.chunks_exact_mut(w).enumerate() {
-            self.attribute_unchecked(index, pts.get(i), o)?;
+            self.attribute_unchecked(index, pts.get(i), o, false)?;
         }
         Ok(())
     }

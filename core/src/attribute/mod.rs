@@ -20,6 +20,7 @@ mod mix;
 mod moves;
 mod names;
 mod order;
+mod pick_grid;
 mod points;
 mod prepared;
 mod resolve;

@@ -100,6 +100,8 @@ pub(super) enum Op {
     Pick {
         children: Vec<Arc<ANode>>,
         smooth: f64,
+        /// Which children may hold a point (sharp unions of many).
+        grid: Option<super::pick_grid::PickGrid>,
     },
 }
 
@@ -410,7 +412,13 @@ impl Builder<'_> {
         if children.is_empty() {
             Op::Leaf
         } else {
-            Op::Pick { children, smooth }
+            Op::Pick {
+                grid: (smooth <= 0.0)
+                    .then(|| super::pick_grid::PickGrid::build(&children))
+                    .flatten(),
+                children,
+                smooth,
+            }
         }
     }
 
