@@ -519,7 +519,8 @@ pub static FUNCTIONS: &[FnDoc] = &[
         Method,
         [
             "node.set_attribute(name: string, value: float | string | Vec3 | Vec4 | array)",
-            "node.set_attribute(name: string, field: SimulationField, column: string)"
+            "node.set_attribute(name: string, field: SimulationField, column: string)",
+            "node.set_attribute(name: string, points: PointsField)"
         ],
         "Sets a property field (modulus MPa, poissons_ratio, density g/cm^3, shore_hardness, infill_density %, temperature, color Vec4, or any name): a number, a math string of x y z rho phic r theta phis d and the node's other attributes, a vector, or an FEA column; a parent's overrides its children's.",
         "n.set_attribute(\"modulus\", 2850.0)",
@@ -530,11 +531,28 @@ pub static FUNCTIONS: &[FnDoc] = &[
         Material,
         [
             "Convert(child: Node, from: string, to: string, table: [[float, float]] | string)",
-            "Convert(child: Node, \"fractions\", to: string, rule: \"voigt\" | \"reuss\", values: [[int, float]])"
+            "Convert(child: Node, \"fractions\", to: string, rule: \"voigt\" | \"reuss\", values: [[int, float]])",
+            "Convert(child: Node, from: string, to: Fractions, table: [[float, float]] | string)"
         ],
         "Sets attribute `to` from `from` below it (pyvcad 3's AttributeModifier): a piecewise-linear table of [input, output] rows (inline or a two-column .csv; inputs rising; clamped at the ends, counted in a warning) or a math string of x y z ... d and `from`; from \"fractions\", a Voigt or Reuss mix of one value per material.",
         "Convert(part, \"shore_hardness\", \"modulus\", [[30, 1.0], [85, 20.0]])",
         "let m = default_materials(); let s = Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\")); s.set_attribute(\"shore_hardness\", \"60 + 4*x\"); Convert(s, \"shore_hardness\", \"modulus\", [[30, 1.0], [85, 20.0]])"
+    ),
+    f!(
+        "fractions",
+        Material,
+        ["fractions(materials: [int, int]) -> Fractions"],
+        "The two materials a Convert to fractions mixes: its table's rows are [share of the second material 0..1, value], inverted for the child's value of `from`; these fractions replace the child's.",
+        "fractions([m.id(\"a\"), m.id(\"b\")])",
+        "let m = default_materials(); let s = Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\")); s.set_attribute(\"shore_hardness\", \"60 + 4*x\"); Convert(s, \"shore_hardness\", fractions([m.id(\"red\"), m.id(\"blue\")]), [[0, 30], [1, 95]])"
+    ),
+    f!(
+        "PointsField",
+        Data,
+        ["PointsField(csv: string, column: string) -> PointsField"],
+        "A value column of scattered points (CSV columns x, y, z and named values) for set_attribute: inverse-distance weighting of the 8 nearest points.",
+        "PointsField(\"points.csv\", \"temperature\")",
+        ""
     ),
     f!(
         "set_attribute_conflict_resolver",
