@@ -12,6 +12,14 @@ use crate::model::{Model, Points, sdf};
 /// Most numbers of one value (a Vec4).
 const MAX_WIDTH: usize = 4;
 
+/// The children of a sharp pick, their grid, and whether the point is
+/// known to be inside the picking node.
+struct Near<'a> {
+    children: &'a [std::sync::Arc<ANode>],
+    grid: Option<&'a super::pick_grid::PickGrid>,
+    inside: bool,
+}
+
 impl ANode {
     /// Attribute `idx` at `q` (this node's frame; `pw` the design point for
     /// messages) into `out`; false when nothing on or below this node
@@ -27,16 +35,34 @@ impl ANode {
             self.own_value(pos as usize, q, pw, out)?;
             return Ok(true);
         }
-        self.eval_below(idx, q, pw, out)
+        self.eval_below(idx, q, pw, out, false)
     }
 
-    /// Attribute `idx` as the children below this node give it.
+    /// [`ANode::eval`] at a point known to be inside this node: a union
+    /// here need not test that again (its whole distance) where no child
+    /// with the attribute holds the point.
+    pub(super) fn eval_inside(
+        &self,
+        idx: usize,
+        q: DVec3,
+        out: &mut [f64],
+    ) -> Result<bool, AttributeError> {
+        if let Some(pos) = self.own_of[idx] {
+            self.own_value(pos as usize, q, q, out)?;
+            return Ok(true);
+        }
+        self.eval_below(idx, q, q, out, true)
+    }
+
+    /// Attribute `idx` as the children below this node give it (`inside`:
+    /// q is known to be inside this node).
     fn eval_below(
         &self,
         idx: usize,
         q: DVec3,
         pw: DVec3,
         out: &mut [f64],
+        inside: bool,
     ) -> Result<bool, AttributeError> {
         match &self.op {
             Op::Leaf => Ok(false),
@@ -45,7 +71,12 @@ impl ANode {
                 children, smooth, ..
             } if *smooth > 0.0 => blend_children(children, *smooth, idx, q, pw, out),
             Op::Pick { children, grid, .. } => {
-                self.pick_children(children, grid.as_ref(), idx, q, pw, out)
+                let near = Near {
+                    children,
+                    grid: grid.as_ref(),
+                    inside,
+                };
+                self.pick_children(&near, idx, q, pw, out)
             }
         }
     }
@@ -55,22 +86,22 @@ impl ANode {
     /// parent's fillet, or on a seam within rounding), the nearest child.
     fn pick_children(
         &self,
-        children: &[std::sync::Arc<ANode>],
-        grid: Option<&super::pick_grid::PickGrid>,
+        near: &Near<'_>,
         idx: usize,
         q: DVec3,
         pw: DVec3,
         out: &mut [f64],
     ) -> Result<bool, AttributeError> {
+        let (children, grid) = (near.children, near.grid);
         let r = self.resolver(idx);
         let first_only = matches!(r, super::Resolver::First);
         let mut tmp = [0.0; MAX_WIDTH];
         let tmp = &mut tmp[..out.len()];
         let mut found = false;
         // The children near q (a grid's list), else all, in child order.
-        let near = grid.map(|g| g.candidates(q));
-        for k in 0..near.map_or(children.len(), <[u32]>::len) {
-            let c = &children[near.map_or(k, |l| l[k] as usize)];
+        let list = grid.map(|g| g.candidates(q));
+        for k in 0..list.map_or(children.len(), <[u32]>::len) {
+            let c = &children[list.map_or(k, |l| l[k] as usize)];
             if !c.defines[idx] {
                 continue;
             }
@@ -87,7 +118,7 @@ impl ANode {
             }
         }
         // Inside this node, a child without the attribute holds the point.
-        if found || self.dist.contains(q) {
+        if found || near.inside || self.dist.contains(q) {
             return Ok(found);
         }
         let nearest = children
@@ -202,7 +233,7 @@ impl ANode {
                 match from_own {
                     Some(j) => x[0] = slots[COORD_SLOTS + j],
                     None => {
-                        self.eval_below(*from, q, pw, &mut x)?;
+                        self.eval_below(*from, q, pw, &mut x, false)?;
                     }
                 }
                 out[0] = match map {
@@ -461,7 +492,12 @@ impl Model {
         let Some(a) = &self.attrs else {
             return Ok(());
         };
-        if (inside || self.root.contains(p)) && a.root.eval(index, p, p, out)? {
+        let found = if inside {
+            a.root.eval_inside(index, p, out)?
+        } else {
+            self.root.contains(p) && a.root.eval(index, p, p, out)?
+        };
+        if found {
             return Ok(());
         }
         out.fill(f64::NAN);
