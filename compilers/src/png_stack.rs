@@ -272,10 +272,55 @@ fn bitmap_folders(model: &Model) -> Vec<BitmapFolder> {
     out
 }
 
-/// What writing one layer produced.
-struct LayerOut {
-    files: Vec<String>,
-    counts: Vec<u64>,
+/// What writing one layer (or a whole stack) produced.
+pub(crate) struct LayerOut {
+    /// Files written, relative to the output folder.
+    pub files: Vec<String>,
+    /// Voxels per count slot (material or vat).
+    pub counts: Vec<u64>,
+}
+
+/// Run `write` on every layer of the stack (its global index and material
+/// codes, see [`for_each_slab`]), the layers of a slab in parallel, and
+/// gather their files in layer order and their `slots` counts.
+pub(crate) fn write_layers(
+    model: &Model,
+    p: &PngParams,
+    est: &Estimate,
+    ctx: &JobContext,
+    slots: usize,
+    write: impl Fn(usize, &[u8]) -> Result<LayerOut, ExportError> + Sync,
+) -> Result<LayerOut, ExportError> {
+    let [nx, ny, _] = est.grid.dims;
+    let layer = nx * ny;
+    let mut all = LayerOut {
+        files: Vec::new(),
+        counts: vec![0; slots],
+    };
+    let written = AtomicU64::new(0);
+    for_each_slab(model, p, est, ctx, |zs, codes| {
+        let outs: Vec<LayerOut> = zs
+            .clone()
+            .into_par_iter()
+            .map(|z| {
+                let i = z - zs.start;
+                let out = write(z, &codes[i * layer..(i + 1) * layer])?;
+                // Per layer, in whatever order layers finish (reports are snapshots).
+                let n = written.fetch_add(1, Ordering::Relaxed) + 1;
+                let total = est.layers.len() as u64;
+                ctx.progress("slicing", n, total, "layers", n as f64 / total as f64);
+                Ok(out)
+            })
+            .collect::<Result<_, ExportError>>()?;
+        for o in outs {
+            all.files.extend(o.files);
+            for (t, c) in all.counts.iter_mut().zip(o.counts) {
+                *t += c;
+            }
+        }
+        Ok(())
+    })?;
+    Ok(all)
 }
 
 fn write_stack(
@@ -297,34 +342,11 @@ fn write_stack(
         let dir = ctx.staging().join(&f.dir);
         std::fs::create_dir_all(&dir).map_err(|e| ExportError::io(&dir, e))?;
     }
-    let mut files = Vec::new();
-    let mut counts = vec![0u64; k];
-    let written = AtomicU64::new(0);
-    let layer = nx * ny;
     let style = top_view(est.grid.voxel);
-    for_each_slab(model, p, est, ctx, |zs, codes| {
-        let outs: Vec<LayerOut> = zs
-            .clone()
-            .into_par_iter()
-            .map(|z| {
-                let i = z - zs.start;
-                let c = &codes[i * layer..(i + 1) * layer];
-                let out = write_layer(ctx, [nx, ny], z, digits, c, &pal, &folders, style)?;
-                // Per layer, in whatever order layers finish (reports are snapshots).
-                let n = written.fetch_add(1, Ordering::Relaxed) + 1;
-                let total = est.layers.len() as u64;
-                ctx.progress("slicing", n, total, "layers", n as f64 / total as f64);
-                Ok(out)
-            })
-            .collect::<Result<_, ExportError>>()?;
-        for o in outs {
-            files.extend(o.files);
-            for (t, c) in counts.iter_mut().zip(o.counts) {
-                *t += c;
-            }
-        }
-        Ok(())
+    let out = write_layers(model, p, est, ctx, k, |z, c| {
+        write_layer(ctx, [nx, ny], z, digits, c, &pal, &folders, style)
     })?;
+    let (files, counts) = (out.files, out.counts);
     Ok(summary(model, p, est, files, counts))
 }
 
