@@ -4,15 +4,15 @@
 //! nearest J750 resins until mapped, and a vat stack from its panel.
 
 use std::path::Path;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use egui_kittest::Harness;
-use egui_kittest::kittest::{NodeT as _, Queryable};
+use egui_kittest::kittest::Queryable;
 use volcad_studio::studio::egui;
 use volcad_studio::studio::{StudioApp, StudioOptions};
 
 mod common;
-use common::{harness, wait_within};
+use common::{harness, wait_label, wait_within};
 
 /// The graded bar (15 × 10 × 5 mm, red and blue from default_materials()).
 const BAR: &str = r#"let m = default_materials();
@@ -39,24 +39,6 @@ fn set_field(h: &mut Harness<'static, StudioApp>, label: &str, text: &str) {
     h.step();
     h.get_by_label(label).type_text(text);
     h.run_steps(2);
-}
-
-/// Step until a widget whose label contains `text` shows; its label.
-#[track_caller]
-fn wait_label(h: &mut Harness<'static, StudioApp>, text: &str) -> String {
-    let t = Instant::now();
-    loop {
-        if let Some(n) = h.query_by_label_contains(text) {
-            let node = n.accesskit_node();
-            return node.label().or_else(|| node.value()).unwrap_or_default();
-        }
-        assert!(
-            t.elapsed() < Duration::from_secs(60),
-            "timed out waiting for {text:?}"
-        );
-        h.step();
-        std::thread::sleep(Duration::from_millis(5));
-    }
 }
 
 /// Click `button` and step until the last job ends; it must end done.
@@ -129,6 +111,34 @@ fn j750_refuses_default_materials_until_mapped_and_writes_a_gcvf() {
     h.get_by_label("Export GCVF (.gcvf)").click();
     h.run_steps(2);
     assert!(h.state().modal().is_some(), "asks before replacing");
+}
+
+#[test]
+fn the_png_printer_choice_j750_brings_its_resin_table() {
+    let (_dir, mut h) = studio("png-j750");
+    // Generic: the design's own materials.
+    wait_label(&mut h, "Estimate:");
+    h.get_by_label("Printer").click();
+    h.run_steps(2);
+    h.get_by_label("j750").click();
+    h.run_steps(2);
+    let e = wait_label(&mut h, "is not a J750 material");
+    assert!(e.contains("\"blue\"") && e.contains("VeroBlue"), "{e}");
+    assert!(
+        h.query_by_label("Export PNG stack")
+            .is_some_and(|b| b.accesskit_node().is_disabled()),
+        "refused before any work"
+    );
+    set_field(&mut h, "Resin map", "red=VeroMgnt,blue=VeroCyan");
+    let est = wait_label(&mut h, "Estimate:");
+    assert!(
+        est.contains("355 × 119 × 186 voxels"),
+        "the J750 grid: {est}"
+    );
+    // A map onto a name the J750 lacks is refused with its nearest resins.
+    set_field(&mut h, "Resin map", "red=Crimson,blue=VeroCyan");
+    let e = wait_label(&mut h, "is not a J750 material");
+    assert!(e.contains("Crimson") && e.contains("VeroMgnt"), "{e}");
 }
 
 #[test]

@@ -10,22 +10,17 @@ use anyhow::{Context, bail};
 use glam::DVec3;
 use volcad_compilers::gcvf::GcvfParams;
 use volcad_compilers::png_stack;
-use volcad_compilers::printer_table::{parse_map, relabel, resolve};
-use volcad_core::{MaterialTable, Model};
+use volcad_compilers::printer_table::{is_j750_preset, j750_model, parse_map};
+use volcad_core::Model;
 
 use super::export::{ExportArgs, parse_dither};
 use super::output::{Target, target};
-
-/// True for the presets that are J750 grids.
-fn is_j750(preset: Option<&str>) -> bool {
-    preset.is_some_and(|p| p.eq_ignore_ascii_case("j750") || p.eq_ignore_ascii_case("j750-hq"))
-}
 
 /// The design as a PNG stack writes it: with `--preset j750`, relabelled
 /// with J750 resins (refused when a material is not one and `--map` does
 /// not make it one); otherwise unchanged.
 pub(super) fn printer_model(a: &ExportArgs, model: Arc<Model>) -> anyhow::Result<Arc<Model>> {
-    if !is_j750(a.preset.as_deref()) {
+    if !a.preset.as_deref().is_some_and(is_j750_preset) {
         if let Some(m) = &a.map {
             bail!(
                 "--map {m}: maps onto a printer's resins, so it needs --preset j750 (or `volcad export gcvf`)"
@@ -34,9 +29,7 @@ pub(super) fn printer_model(a: &ExportArgs, model: Arc<Model>) -> anyhow::Result
         return Ok(model);
     }
     let map = parse_map(a.map.as_deref().unwrap_or(""))?;
-    let table = MaterialTable::j750();
-    let mats = resolve(&model, &table, &map, "J750")?;
-    Ok(Arc::new(relabel(&model, &mats, &table, "J750")))
+    Ok(j750_model(&model, &map)?)
 }
 
 /// The package's path: `--out` as a file (a symlink to one resolved);

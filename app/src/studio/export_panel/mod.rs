@@ -27,7 +27,8 @@ use volcad_compilers::job::design_hash;
 use volcad_compilers::mesh::MeshParams;
 use volcad_compilers::plan::folder::{self, Folder};
 use volcad_compilers::plan::{ExportParams, Opt, Severity, Verdict};
-use volcad_compilers::png_stack::PngParams;
+use volcad_compilers::png_stack::{self, PngParams};
+use volcad_compilers::printer_table::{is_j750_preset, j750_model, parse_map};
 use volcad_core::Model;
 
 use super::files::Document;
@@ -192,6 +193,9 @@ pub struct ExportPanels {
     printers: printer_fields::PrinterFields,
     /// The file a one-file export gets in a picked folder.
     file_name: String,
+    /// The design as the PNG printer choice prints it (a J750 relabels it
+    /// with resins), by model and resin map.
+    printed: Option<(usize, String, Result<Arc<Model>, String>)>,
     estimate: EstimateWorker,
     pending: Option<Pending>,
     /// Why the last Start did not start, shown until the next.
@@ -207,7 +211,7 @@ impl ExportPanels {
             shown: None,
             kind: Kind::Png,
             png: PngParams::default(),
-            preset: Some(0),
+            preset: None,
             mesh: MeshParams {
                 voxel: DVec3::splat(0.25),
                 ..MeshParams::default()
@@ -220,6 +224,7 @@ impl ExportPanels {
             fea_step: None,
             printers: printer_fields::PrinterFields::default(),
             file_name: String::new(),
+            printed: None,
             estimate: EstimateWorker::default(),
             pending: None,
             refusal: None,
@@ -271,6 +276,36 @@ impl ExportPanels {
             self.dir = dir.display().to_string();
             self.shown = Some(key);
             self.refusal = None;
+        }
+    }
+
+    /// True when the PNG printer choice is a J750 (its material table).
+    fn png_j750(&self) -> bool {
+        self.preset
+            .and_then(|i| png_stack::presets().get(i))
+            .is_some_and(|p| is_j750_preset(p.name))
+    }
+
+    /// The design as the export writes it: for a PNG stack on a J750, its
+    /// materials as J750 resins through the resin map (refused, naming
+    /// the nearest resins, when one is not); otherwise `model`.
+    fn printed_model(&mut self, model: &Arc<Model>) -> Result<Arc<Model>, String> {
+        if !(self.kind == Kind::Png && self.png_j750()) {
+            return Ok(model.clone());
+        }
+        let key = (
+            Arc::as_ptr(model) as usize,
+            self.printers.map_text().to_owned(),
+        );
+        match &self.printed {
+            Some((ptr, map, m)) if (*ptr, map) == (key.0, &key.1) => m.clone(),
+            _ => {
+                let m = parse_map(&key.1)
+                    .and_then(|map| j750_model(model, &map))
+                    .map_err(|e| in_panel_words(&e.to_string()));
+                self.printed = Some((key.0, key.1, m.clone()));
+                m
+            }
         }
     }
 
@@ -343,9 +378,10 @@ impl ExportPanels {
             ui.weak("No design to export yet.");
             return action;
         };
-        let params = self.params();
+        let printed = self.printed_model(model);
+        let params = printed.and_then(|m| self.params().map(|p| (m, p)));
         match &params {
-            Ok(p) => {
+            Ok((model, p)) => {
                 self.estimate.update(ui.ctx(), model, p);
                 self.estimate_ui(ui);
             }
@@ -367,10 +403,10 @@ impl ExportPanels {
         );
         if start.clicked()
             && let Some(dest) = dest
-            && let Ok(params) = params
+            && let Ok((model, params)) = params
         {
             let hash = design_hash(&[source.as_bytes()]);
-            action = self.start(params, model, dest, hash, &place.name, jobs);
+            action = self.start(params, &model, dest, hash, &place.name, jobs);
         }
         action
     }

@@ -111,6 +111,24 @@ impl PrinterFields {
         })
     }
 
+    /// The resin map's text (`red=VeroMgnt,blue=VeroCyan`).
+    pub(super) fn map_text(&self) -> &str {
+        &self.map
+    }
+
+    /// The resin map row (GCVF, and PNG stacks for a J750).
+    pub(super) fn map_row(&mut self, ui: &mut egui::Ui) {
+        let label = ui.label("Resin map").id;
+        ui.add(
+            egui::TextEdit::singleline(&mut self.map)
+                .hint_text("red=VeroMgnt,blue=VeroCyan")
+                .desired_width(220.0),
+        )
+        .labelled_by(label)
+        .on_hover_text("Design material = J750 resin, for names the J750 table lacks");
+        ui.end_row();
+    }
+
     /// Material choice and seed rows.
     fn draw_rows(&mut self, ui: &mut egui::Ui) {
         ui.label("Material choice");
@@ -135,15 +153,7 @@ impl PrinterFields {
                     ui.selectable_value(&mut self.hq, true, "high quality (14 µm)");
                 });
                 ui.end_row();
-                let label = ui.label("Resin map").id;
-                ui.add(
-                    egui::TextEdit::singleline(&mut self.map)
-                        .hint_text("red=VeroMgnt,blue=VeroCyan")
-                        .desired_width(220.0),
-                )
-                .labelled_by(label)
-                .on_hover_text("Design material = J750 resin, for names the J750 table lacks");
-                ui.end_row();
+                self.map_row(ui);
                 self.draw_rows(ui);
                 ui.label("Liquid keep-out");
                 ui.horizontal(|ui| {
