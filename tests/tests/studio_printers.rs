@@ -7,7 +7,7 @@ use std::path::Path;
 use std::time::Duration;
 
 use egui_kittest::Harness;
-use egui_kittest::kittest::Queryable;
+use egui_kittest::kittest::{NodeT as _, Queryable};
 use volcad_studio::studio::egui;
 use volcad_studio::studio::{StudioApp, StudioOptions};
 
