@@ -148,10 +148,16 @@ struct StackKind {
     notes: MergedNotes,
 }
 
-const KINDS: &[StackKind] = &[StackKind {
-    kind: "png",
-    notes: crate::png_stack::merged_notes,
-}];
+const KINDS: &[StackKind] = &[
+    StackKind {
+        kind: "png",
+        notes: crate::png_stack::merged_notes,
+    },
+    StackKind {
+        kind: "vat",
+        notes: crate::vat::merged_notes,
+    },
+];
 
 /// One shard folder's manifest, as read.
 pub struct Part {

@@ -11,6 +11,7 @@ use std::sync::Arc;
 
 use common::{decode, manifest, model, read_tree, run, scratch};
 use volcad_compilers::png_stack::Dither;
+use volcad_compilers::shard::plan_merge;
 use volcad_compilers::vat::{Intensity, VatParams, VatPrinter, export_vat, vat_preset};
 use volcad_compilers::{ExportError, Summary};
 use volcad_core::Model;
@@ -143,6 +144,33 @@ fn same_bytes_on_one_and_two_threads_and_in_a_layer_range() {
     for (name, bytes) in &fc {
         assert_eq!(Some(bytes), fa.get(name), "{name} as in the whole stack");
     }
+}
+
+#[test]
+fn shards_merge_into_the_whole_stack() {
+    let m = model(GRADED_BAR);
+    let (_t, whole) = scratch("whole");
+    let mut p = params(small(), &["red", "blue"], None);
+    p.intensity = Intensity::Fraction("red".into());
+    export(&m, &p, &whole).unwrap();
+    let parts: Vec<_> = (1..=3)
+        .map(|k| {
+            let (t, d) = scratch("part");
+            let mut q = p.clone();
+            q.shard = Some(format!("{k}/3").parse().unwrap());
+            export(&m, &q, &d).unwrap();
+            (t, d)
+        })
+        .collect();
+    let dirs: Vec<_> = parts.iter().map(|(_, d)| d.clone()).collect();
+    let plan = plan_merge(&dirs).unwrap();
+    let (_t2, merged) = scratch("merged");
+    run(&merged, move |ctx| plan.run(ctx)).unwrap();
+    assert_eq!(read_tree(&merged), read_tree(&whole));
+    assert_eq!(
+        String::from_utf8(manifest(&merged)).unwrap(),
+        String::from_utf8(manifest(&whole)).unwrap()
+    );
 }
 
 #[test]

@@ -29,6 +29,8 @@
 pub mod printers;
 mod write;
 
+pub(crate) use write::merged_notes;
+
 use std::ops::Range;
 
 use glam::DVec3;
@@ -161,13 +163,15 @@ pub fn estimate(model: &Model, p: &VatParams) -> Result<VatEstimate, ExportError
     let layers = stack.layers.len() as u64;
     let files = layers * vats as u64;
     // BMP: the raw screen plus header and palette. PNG: the black screen
-    // deflates to almost nothing; the part's pixels to about half a byte
-    // (a solid part) to one byte (graded grays, mixed vats).
+    // deflates to about a byte per 250 pixels (fdeflate's fastest level,
+    // "Up" filter: a few bytes per all-black row); the part's pixels to
+    // about half a byte (a solid part) to one byte (graded grays, mixed
+    // vats).
     let part = stack.voxels as f64;
     let disk_bytes = if p.bmp {
         files * (screen + 1078)
     } else {
-        (part * if gray == Gray::Solid { 0.5 } else { 1.0 }) as u64 + files * (screen / 500 + 200)
+        (part * if gray == Gray::Solid { 0.5 } else { 1.0 }) as u64 + files * (screen / 250 + 200)
     };
     Ok(VatEstimate {
         stack,

@@ -2,6 +2,9 @@
 //! layer's material codes and gray values.
 
 use std::io::Cursor;
+use std::ops::Range;
+
+use glam::DVec3;
 
 use serde_json::json;
 use volcad_core::Model;
@@ -11,6 +14,7 @@ use super::{Gray, VatEstimate, VatParams};
 use crate::job::{ExportError, JobContext, Summary};
 use crate::png_io::{self, PixelsPerMetre};
 use crate::png_stack::{self, LayerOut, grid_span_note};
+use crate::shard::Part;
 use crate::slice_image::Orientation;
 
 /// How every layer is written.
@@ -193,25 +197,20 @@ fn summary(
         .collect();
     let layers = &est.stack.layers;
     let mut notes = vec![
+        layers_note(layers, nz),
         format!(
-            "{} layer(s) {}..{} of {nz}, {w} × {h} px screen ({}), part {nx} × {ny} px at column {}, row {}",
-            layers.len(),
-            layers.start,
-            layers.end,
-            p.printer.name,
-            est.place[0],
-            est.place[1]
+            "{w} × {h} px screen ({}), part {nx} × {ny} px at column {}, row {}",
+            p.printer.name, est.place[0], est.place[1]
         ),
         "orientation: column 0 = min X, row 0 = max Y (top view), layer 0 = lowest Z".to_owned(),
         grid_span_note(&g, &model.bbox()),
     ];
-    let voxel_mm3 = g.voxel.x * g.voxel.y * g.voxel.z;
-    for (n, c) in vat_names.iter().zip(&counts) {
-        notes.push(format!(
-            "{n}: {c} voxels = {:.3} mm³",
-            *c as f64 * voxel_mm3
-        ));
-    }
+    let named: Vec<(String, u64)> = vat_names
+        .iter()
+        .cloned()
+        .zip(counts.iter().copied())
+        .collect();
+    notes.extend(count_notes(&named, g.voxel));
     let intensity = match &p.intensity {
         super::Intensity::Solid => json!("solid"),
         super::Intensity::Attribute { name, .. } => match est.gray {
@@ -232,6 +231,7 @@ fn summary(
         "seed": p.seed,
         "dither": p.dither.name(),
         "layers": [layers.start, layers.end],
+        "voxel_mm": g.voxel.to_array(),
         "grid": { "dims": [nx, ny, nz], "origin_mm": g.origin.to_array() },
         "place_px": est.place,
     });
@@ -248,4 +248,46 @@ fn summary(
         notes,
         seconds: 0.0,
     }
+}
+
+/// The first note: the layers written.
+fn layers_note(layers: &Range<usize>, nz: usize) -> String {
+    format!(
+        "{} layer(s) {}..{} of {nz}",
+        layers.len(),
+        layers.start,
+        layers.end
+    )
+}
+
+/// One note per vat: its voxels and their volume.
+fn count_notes(counts: &[(String, u64)], voxel: DVec3) -> Vec<String> {
+    let voxel_mm3 = voxel.x * voxel.y * voxel.z;
+    counts
+        .iter()
+        .map(|(n, c)| format!("{n}: {c} voxels = {:.3} mm³", *c as f64 * voxel_mm3))
+        .collect()
+}
+
+/// The notes of `layers` holding `counts`, from those of `part` (a shard
+/// of the same stack, see [`crate::shard`]); `None` when `part`'s notes
+/// are not the ones this version writes.
+pub(crate) fn merged_notes(
+    part: &Part,
+    layers: &Range<usize>,
+    counts: &[(String, u64)],
+) -> Option<Vec<String>> {
+    let notes = &part.summary.notes;
+    let own = count_notes(&part.summary.counts, part.voxel);
+    let middle_end = notes.len().checked_sub(own.len())?;
+    if notes.first()? != &layers_note(&part.layers, part.dims[2])
+        || notes[middle_end..] != own[..]
+        || middle_end < 1
+    {
+        return None;
+    }
+    let mut out = vec![layers_note(layers, part.dims[2])];
+    out.extend(notes[1..middle_end].iter().cloned());
+    out.extend(count_notes(counts, part.voxel));
+    Some(out)
 }
