@@ -62,16 +62,16 @@ pub struct ExportArgs {
     /// Seed of the material draw (same seed, same bytes).
     #[arg(long, default_value_t = 0, allow_negative_numbers = true)]
     pub seed: u64,
-    /// png: only layers A..B (A to B-1, B excluded) or A..=B (A to B
+    /// png, vat: only layers A..B (A to B-1, B excluded) or A..=B (A to B
     /// included); file names keep the global layer indices.
     #[arg(long)]
     pub layers: Option<String>,
-    /// png: only the K-th of N equal layer ranges (K counts from 1: 1/4 is
+    /// png, vat: only the K-th of N equal layer ranges (K counts from 1: 1/4 is
     /// the lowest quarter, 4/4 the top); file names keep the global layer
     /// indices, and `volcad merge` joins the N folders into the single export.
     #[arg(long, value_name = "K/N")]
     pub shard: Option<String>,
-    /// png: random (default) or diffusion.
+    /// png, gcvf, vat: random (default) or diffusion.
     #[arg(long)]
     pub dither: Option<String>,
     /// png: also write 1-bit stacks, one folder per material.
