@@ -8,7 +8,9 @@ use common::{example, fails, ok, tmp, volcad};
 
 /// Mean gray of the lit pixels of a PNG.
 fn mean_lit(path: &std::path::Path) -> f64 {
-    let img = image::open(path).unwrap().to_luma8();
+    let img = image::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_luma8();
     let lit: Vec<f64> = img
         .pixels()
         .filter(|p| p[0] > 0)

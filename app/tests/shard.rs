@@ -271,7 +271,10 @@ fn bad_shard_options_are_refused_before_any_work() {
         s(&mesh),
     ]));
     let e = merge_fails(&out, &[&mesh]);
-    assert!(e.contains("a mesh export; only layer stacks (png)"), "{e}");
+    assert!(
+        e.contains("a mesh export; only layer stacks (png, vat)"),
+        "{e}"
+    );
     let e = merge_fails(&out, &[dir.path()]);
     assert!(e.contains("holds no readable manifest.json"), "{e}");
 }

@@ -133,7 +133,7 @@ pub fn not_shardable(kind: &str) -> String {
             .to_owned(),
         _ => format!(
             "--shard does not apply to `volcad export {kind}`, which is made from the whole \
-             part at once; only layer stacks (png) split into layer ranges"
+             part at once; only layer stacks (png, vat) split into layer ranges"
         ),
     }
 }
