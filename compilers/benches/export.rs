@@ -19,7 +19,7 @@ use volcad_compilers::lazy_random::choose_random_row;
 use volcad_compilers::mesh::{MeshFormats, MeshParams, SegmentBy, export_meshes, segment_meshes};
 use volcad_compilers::png_stack::{Dither, PngParams, export_png_stack};
 use volcad_core::Model;
-use volcad_core::sampler::{Grid, Sampler, Slab};
+use volcad_core::sampler::{Consumer, Grid, Sampler, Slab};
 use volcad_core::script::{ScriptOptions, model_of, model_of_file};
 
 const BCC_SPHERE: &str = r#"let m = default_materials();
@@ -66,8 +66,8 @@ fn stage_times(model: &Model, voxel: f64, dither: Dither) -> (u64, f64, f64) {
     let cancel = AtomicBool::new(false);
     // As the export: random picks leave graded fractions to the chooser.
     let sampler = match dither {
-        Dither::Random => Sampler::new(model, grid, true).with_lazy_fractions(),
-        Dither::Diffusion => Sampler::new(model, grid, true),
+        Dither::Random => Sampler::new(model, grid, Consumer::PngStackRandom),
+        Dither::Diffusion => Sampler::new(model, grid, Consumer::PngStackDiffusion),
     };
     let mut slab = Slab::default();
     let layers = 16;

@@ -51,7 +51,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use serde_json::json;
 use volcad_core::expr::Expr;
-use volcad_core::sampler::{Grid, Sampler, Slab, UniformTest};
+use volcad_core::sampler::{Consumer, Grid, Sampler, Slab, UniformTest};
 use volcad_core::{MaterialId, Model};
 
 pub use field::marching_cubes;
@@ -385,11 +385,12 @@ pub fn segment_meshes(
 /// The sampler of a mesh export: fractions, and (unless `uniform` is
 /// `None`, in tests) label-uniform solid tiles filled with one evaluation.
 fn sampler_for<'a>(model: &'a Model, grid: Grid, uniform: Option<UniformTest<'a>>) -> Sampler<'a> {
-    let sampler = Sampler::new(model, grid, true);
-    match uniform {
-        Some(u) => sampler.with_uniform(u).with_solid_rects().with_blocks(),
-        None => sampler,
-    }
+    let consumer = match uniform {
+        Some(u) => Consumer::MeshContour(u),
+        // The reference the tests compare with: every voxel sampled.
+        None => Consumer::ViewportBake,
+    };
+    Sampler::new(model, grid, consumer)
 }
 
 /// Triangles of the curved (not flat-merged) surface, from a few cube
