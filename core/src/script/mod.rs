@@ -16,9 +16,10 @@ mod file_cache;
 mod files_api;
 mod leaves_api;
 mod nodes_api;
+mod one_shot;
 pub mod param_sets;
 mod query_api;
-pub mod read_policy;
+pub(crate) mod read_policy;
 pub mod reference;
 mod shapes_api;
 mod text_api;
@@ -35,6 +36,7 @@ use rhai::{Dynamic, Engine, EvalAltResult, NativeCallContext as Ctx, Position, S
 use crate::material::MaterialTable;
 use crate::node::{LatticeType, Node};
 pub use attribute_api::Vec4;
+pub use one_shot::{DesignError, model_of, model_of_file};
 pub use values::Vec3;
 use values::{RResult, fail};
 
@@ -219,25 +221,6 @@ pub(crate) fn load_mesh(full: &Path) -> Result<Arc<crate::trimesh::TriangleMesh>
         .map_err(|e| e.to_string())
 }
 
-/// Run a design script and prepare its model (what tests, benchmarks and
-/// one-shot tools do); the error is the script's or the preparation's
-/// message.
-pub fn model_of(source: &str, name: &str, opts: &ScriptOptions) -> Result<crate::Model, String> {
-    let d = crate::vcad::run_design(source, name, opts).map_err(|e| e.to_string())?;
-    crate::Model::prepare(&d.root, d.materials.clone()).map_err(|e| e.to_string())
-}
-
-/// [`model_of`] for a script file: its text, named by its file name, with
-/// relative data paths resolved beside it.
-pub fn model_of_file(path: &Path) -> Result<crate::Model, String> {
-    let src = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let name = path.file_name().map_or_else(
-        || path.display().to_string(),
-        |n| n.to_string_lossy().into(),
-    );
-    model_of(&src, &name, &ScriptOptions::for_file(path))
-}
-
 /// Run a design script.
 pub fn run_script(source: &str, name: &str, opts: &ScriptOptions) -> Result<Design, ScriptError> {
     // Some editors start UTF-8 files with a byte-order mark; it is not code.
@@ -297,10 +280,10 @@ pub fn run_script(source: &str, name: &str, opts: &ScriptOptions) -> Result<Desi
     })
 }
 
-/// Every material id in the tree must be in the table.
 /// The names of every function the script engine registers (sorted,
 /// once each): the language reference is checked against them.
-pub fn registered_functions() -> Vec<String> {
+#[cfg(test)]
+pub(crate) fn registered_functions() -> Vec<String> {
     let opts = ScriptOptions::default();
     let ctx = RunContext::from_options(&opts);
     let engine = build_engine(&ctx, &opts);
