@@ -114,12 +114,12 @@ pub struct MaterialTable {
 }
 
 /// pyvcad's default table (`configs/default.json`): red, green, blue, ...
-pub const DEFAULT_JSON: &str = include_str!("../../assets/materials/default.json");
+pub(crate) const DEFAULT_JSON: &str = include_str!("../../assets/materials/default.json");
 /// pyvcad's J750 table (`configs/j750.json`: 33 materials, ids and colours
 /// as pyvcad 2.3.4 has them), with elastic properties for the Vero and
 /// Agilus30 families and the names of our older table as aliases
 /// (VeroMagenta, VeroWhite, Agilus30).
-pub const J750_JSON: &str = include_str!("../../assets/materials/j750.json");
+pub(crate) const J750_JSON: &str = include_str!("../../assets/materials/j750.json");
 
 impl MaterialTable {
     /// Parse a table from JSON text; `origin` names it in errors.
@@ -291,7 +291,7 @@ pub fn nearest_name<'a>(wanted: &str, names: impl IntoIterator<Item = &'a str>) 
 }
 
 /// Levenshtein distance, for "did you mean" suggestions.
-pub fn edit_distance(a: &str, b: &str) -> usize {
+pub(crate) fn edit_distance(a: &str, b: &str) -> usize {
     let b: Vec<char> = b.chars().collect();
     let mut prev: Vec<usize> = (0..=b.len()).collect();
     let mut cur = vec![0; b.len() + 1];

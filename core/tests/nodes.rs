@@ -6,8 +6,8 @@
 
 use std::f64::consts::{PI, TAU};
 
+use volcad_core::bench::XorShift;
 use volcad_core::script::{ScriptOptions, run_script};
-use volcad_core::xorshift::XorShift;
 use volcad_core::{Aabb, DVec3, Model};
 
 fn model(src: &str) -> Model {

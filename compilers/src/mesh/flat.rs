@@ -39,7 +39,7 @@
 
 use glam::DVec3;
 use rayon::prelude::*;
-use volcad_core::fastmath::round_i32;
+use volcad_core::round_i32;
 
 use super::indexed::IndexedMesh;
 use super::interface::{Cube, Interface, cut_field, front_back};

@@ -85,7 +85,7 @@ mod tests {
 
     #[test]
     fn finds_exactly_the_mixed_cubes() {
-        let mut rng = volcad_core::xorshift::XorShift::new(5);
+        let mut rng = volcad_core::bench::XorShift::new(5);
         for len in [0, 1, 2, 8, 63, 64, 65, 66, 129, 300] {
             for density in [0.0, 0.01, 0.2, 1.0] {
                 let mut row = || -> Vec<u16> {

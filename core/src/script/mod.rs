@@ -60,7 +60,9 @@ pub struct Param {
 pub struct ScriptOptions {
     /// Folder that relative file names (CSV, meshes, tables) resolve in
     /// (the script's folder); the script may read files inside its project
-    /// (see [`read_policy`]). `None`: no file access.
+    /// (the nearest folder above it holding `.git` or `volcad.toml`, else
+    /// its own folder; never the home folder or one above it). `None`: no
+    /// file access.
     pub base_dir: Option<PathBuf>,
     /// More folders the script may read (`--allow-read DIR`, the studio's
     /// read folders).

@@ -184,7 +184,7 @@ pub enum SimFieldError {
 
 /// Most tetrahedra [`SimField::bounds`] gathers before giving up (a box
 /// that large is too coarse for its bounds to decide anything).
-pub const MAX_BOUND_TETS: usize = 512;
+pub(crate) const MAX_BOUND_TETS: usize = 512;
 
 /// A tetrahedral mesh with nodal values, sampled by barycentric
 /// interpolation. Immutable and `Sync`.
@@ -328,7 +328,8 @@ impl SimField {
     /// the points of `b` inside the mesh, into `out`: the nodal ranges over
     /// the tetrahedra whose boxes meet `b` (linear interpolation stays
     /// within them), and for `len` the magnitude of the component ranges.
-    /// False when no tetrahedron or more than [`MAX_BOUND_TETS`] meet `b`.
+    /// False when no tetrahedron or more than `MAX_BOUND_TETS` (512) meet
+    /// `b`.
     pub fn bounds(&self, b: &Aabb, out: &mut [Interval]) -> bool {
         let s = self.stride;
         if s > 64 {
