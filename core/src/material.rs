@@ -175,11 +175,16 @@ impl MaterialTable {
     }
 
     /// pyvcad's default table.
+    // The bundled JSON is compiled in and every test that prepares a
+    // design parses it: it cannot fail in a build that passed its tests.
+    #[allow(clippy::expect_used)]
     pub fn default_table() -> Self {
         Self::from_json(DEFAULT_JSON, "<default>").expect("bundled default.json is valid")
     }
 
     /// The J750-class table.
+    // Compiled in as `default_table`'s is, and parsed by this module's tests.
+    #[allow(clippy::expect_used)]
     pub fn j750() -> Self {
         Self::from_json(J750_JSON, "<j750>").expect("bundled j750.json is valid")
     }
