@@ -45,3 +45,34 @@ pub fn model_of_file(path: &Path) -> Result<Model, DesignError> {
     );
     model_of(&src, &name, &ScriptOptions::for_file(path))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each failure is its own variant, and says what the string error
+    /// said before it was typed.
+    #[test]
+    fn each_failure_has_its_variant_and_message() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let missing = dir.path().join("missing.rhai");
+        let e = model_of_file(&missing).expect_err("no file");
+        assert!(matches!(e, DesignError::Read { .. }), "{e:?}");
+        assert!(
+            e.to_string()
+                .starts_with(&format!("{}: ", missing.display())),
+            "{e}"
+        );
+        let opts = ScriptOptions::default();
+        let e = model_of("Sphere(Vec3(0, 0, 0), -1, 1)", "s.rhai", &opts).expect_err("radius");
+        assert!(matches!(e, DesignError::Script(_)), "{e:?}");
+        assert!(
+            e.to_string().starts_with("s.rhai:1:") && e.to_string().contains("radius must be > 0"),
+            "{e}"
+        );
+        let e = model_of("Union(false, [])", "u.rhai", &opts).expect_err("empty union");
+        assert!(matches!(e, DesignError::Prepare(_)), "{e:?}");
+        let good = model_of("Sphere(Vec3(0, 0, 0), 2, 1)", "g.rhai", &opts).expect("sphere");
+        assert!((good.distance(glam::DVec3::ZERO) + 2.0).abs() < 1e-12);
+    }
+}
