@@ -48,7 +48,7 @@ impl XvfbRun {
         let shot: PathBuf = dir.join("studio.png");
         let out = Command::new("xvfb-run")
             .args(["-a", "-s", "-screen 0 1280x800x24"])
-            .arg(env!("CARGO_BIN_EXE_volcad-studio"))
+            .arg(volcad_tests::bin("volcad-studio"))
             .args(args)
             .arg("--screenshot")
             .arg(&shot)

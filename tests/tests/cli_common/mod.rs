@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::process::{Command, Output};
 
 pub fn volcad(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_volcad"))
+    Command::new(volcad_tests::bin("volcad"))
         .args(args)
         .env("XDG_RUNTIME_DIR", runtime_dir())
         .output()
