@@ -7,6 +7,9 @@
 //! encoding or the disk. Output goes to a temporary folder that is removed.
 //! `--mesh` or `--png` runs only that export.
 
+// A failed setup step fails the benchmark run.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;

@@ -180,6 +180,9 @@ pub struct JobHandle {
     pub progress: Receiver<Progress>,
     cancel: Arc<AtomicBool>,
     thread: Option<JoinHandle<Result<Summary, ExportError>>>,
+    /// Why the worker thread could not be started (then `thread` is `None`
+    /// and `join` returns this as the job's error).
+    spawn_error: Option<String>,
     dest: PathBuf,
 }
 
@@ -204,7 +207,10 @@ impl JobHandle {
         match self.thread.take().map(|t| t.join()) {
             Some(Ok(r)) => r,
             Some(Err(panic)) => Err(ExportError::Panicked(panic_message(&panic))),
-            None => Err(ExportError::Other("job already joined".into())),
+            None => Err(ExportError::Other(format!(
+                "the export's thread could not be started: {}",
+                self.spawn_error.take().unwrap_or_default()
+            ))),
         }
     }
 }
@@ -317,14 +323,20 @@ where
     let cancel = Arc::new(AtomicBool::new(false));
     let c2 = cancel.clone();
     let d2 = dest.clone();
-    let thread = std::thread::Builder::new()
+    let spawned = std::thread::Builder::new()
         .name("volcad-export".into())
-        .spawn(move || runner(d2, c2, tx))
-        .expect("spawning a thread");
+        .spawn(move || runner(d2, c2, tx));
+    // A thread the system refuses (no memory, a process limit) becomes the
+    // job's error, reported by `join` like any other failure.
+    let (thread, spawn_error) = match spawned {
+        Ok(t) => (Some(t), None),
+        Err(e) => (None, Some(e.to_string())),
+    };
     JobHandle {
         progress: rx,
         cancel,
-        thread: Some(thread),
+        thread,
+        spawn_error,
         dest,
     }
 }

@@ -3,6 +3,9 @@
 //! counts against analytic volumes, byte-identical archives across thread
 //! counts, and refusals that leave nothing behind.
 
+// A failed setup step (a scratch folder, a file read) fails the test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 mod common;
 
 use std::io::{Cursor, Read};

@@ -8,6 +8,9 @@
 //! skip the 256 level; `cargo bench -p volcad-render -- bunny` runs only
 //! the designs whose name contains `bunny`.
 
+// A failed setup step fails the benchmark run.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 #[path = "../tests/common/mod.rs"]
 mod common;
 

@@ -1,6 +1,9 @@
 //! The `volcad` binary end to end: every command, and bad input giving a
 //! clear message and a non-zero exit (never a panic).
 
+// A failed setup step (a scratch folder, a file read) fails the test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 mod cli_common;
 
 use std::path::Path;

@@ -3,6 +3,9 @@
 //! folder is byte for byte the single export's; `volcad merge` refuses
 //! shards that do not belong together, before writing anything.
 
+// A failed setup step (a scratch folder, a file read) fails the test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 mod cli_common;
 
 use std::collections::BTreeMap;

@@ -7,6 +7,9 @@
 //! Needs `xvfb-run` (Debian: xvfb, xauth). Missing → the test fails, unless
 //! `VOLCAD_SKIP_XVFB=1`.
 
+// A failed setup step (a scratch folder, a file read) fails the test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::path::PathBuf;
 use std::process::Command;
 

@@ -1,5 +1,7 @@
 //! Helpers shared by the `volcad` binary's end-to-end tests.
 #![allow(dead_code)]
+// A failed setup step (a scratch folder, a file read) fails the test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::path::PathBuf;
 use std::process::{Command, Output};
