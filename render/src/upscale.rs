@@ -38,31 +38,14 @@ impl Upscaler {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("volcad upscale"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = crate::wgpu_parts::fullscreen_pipeline(
+            device,
+            "volcad upscale",
+            &pipeline_layout,
+            &module,
+            wgpu::PipelineCompilationOptions::default(),
+            format,
+        );
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("volcad upscale"),
             mag_filter: wgpu::FilterMode::Linear,
