@@ -6,11 +6,10 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::path::Path;
-use std::time::{Duration, Instant};
 
 use egui::accesskit::Role;
 use egui_kittest::Harness;
-use egui_kittest::kittest::{NodeT as _, Queryable};
+use egui_kittest::kittest::Queryable;
 use volcad_studio::studio::egui;
 use volcad_studio::studio::{Modal, StudioApp};
 
@@ -37,24 +36,6 @@ fn set_output_folder(h: &mut Harness<'static, StudioApp>, path: &Path) {
     h.get_by_label("Output folder")
         .type_text(&path.display().to_string());
     h.step();
-}
-
-/// Step until a widget whose label contains `text` shows; returns its label.
-#[track_caller]
-fn wait_label(h: &mut Harness<'static, StudioApp>, text: &str) -> String {
-    let t = Instant::now();
-    loop {
-        if let Some(n) = h.query_by_label_contains(text) {
-            let node = n.accesskit_node();
-            return node.label().or_else(|| node.value()).unwrap_or_default();
-        }
-        assert!(
-            t.elapsed() < Duration::from_secs(60),
-            "timed out waiting for a label with {text:?}"
-        );
-        h.step();
-        std::thread::sleep(Duration::from_millis(5));
-    }
 }
 
 fn set_png_voxel(h: &mut Harness<'static, StudioApp>, mm: f64) {

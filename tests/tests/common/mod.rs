@@ -58,6 +58,26 @@ pub fn wait_within(
     }
 }
 
+/// Step until a widget whose label contains `text` shows (60 s at most);
+/// returns its label (or value).
+#[track_caller]
+pub fn wait_label(h: &mut Harness<'static, StudioApp>, text: &str) -> String {
+    use egui_kittest::kittest::{NodeT as _, Queryable};
+    let t = Instant::now();
+    loop {
+        if let Some(n) = h.query_by_label_contains(text) {
+            let node = n.accesskit_node();
+            return node.label().or_else(|| node.value()).unwrap_or_default();
+        }
+        assert!(
+            t.elapsed() < Duration::from_secs(60),
+            "timed out waiting for a label with {text:?}"
+        );
+        h.step();
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
 /// Write a picture the README shows: `docs/images/<file>`.
 pub fn save_doc_image(img: &image::RgbaImage, file: &str) {
     let out = Path::new(env!("CARGO_MANIFEST_DIR"))
