@@ -57,8 +57,8 @@ fn chunk_mask([a, b, c, d]: [&[u16]; 4]) -> u64 {
     // Columns past the row's end are zero in `col` and `step`, but the
     // last cube's right column is `col[n]`: clear the bits beyond n.
     let mut bits = 0u64;
-    for (g, bytes) in mixed.chunks_exact(8).enumerate() {
-        let word = u64::from_le_bytes(bytes.try_into().expect("8 bytes"));
+    for (g, bytes) in mixed.as_chunks::<8>().0.iter().enumerate() {
+        let word = u64::from_le_bytes(*bytes);
         bits |= (word.wrapping_mul(0x0102_0408_1020_4080) >> 56) << (8 * g);
     }
     if n < CHUNK {
