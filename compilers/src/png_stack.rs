@@ -43,7 +43,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use serde_json::json;
 use volcad_core::Model;
-use volcad_core::sampler::{Grid, Sampler, Slab};
+use volcad_core::sampler::{Consumer, Grid, Sampler, Slab};
 
 use crate::design::{grid_for, palette};
 use crate::dither::{self, Diffuser};
@@ -379,7 +379,7 @@ pub(crate) fn for_each_slab(
     let mut diffuser =
         (p.dither == Dither::Diffusion && single.is_none()).then(|| Diffuser::new(nx, ny, k));
     let sampler = match keep {
-        Some(_) => Sampler::new(model, grid, true),
+        Some(_) => Sampler::new(model, grid, Consumer::PngStackKeepOut),
         None => stack_sampler(model, grid, single, diffuser.is_some()),
     };
     let first = if diffuser.is_some() {
@@ -444,12 +444,12 @@ fn single_material_code(model: &Model) -> Option<u8> {
 /// every one; a design of one material everywhere (`single`) needs none.
 /// Pixels need the sign of the distance only.
 fn stack_sampler(model: &Model, grid: Grid, single: Option<u8>, diffusion: bool) -> Sampler<'_> {
-    match (single, diffusion) {
-        (Some(_), _) => Sampler::new(model, grid, false),
-        (None, true) => Sampler::new(model, grid, true),
-        (None, false) => Sampler::new(model, grid, true).with_lazy_fractions(),
-    }
-    .with_signs_only()
+    let consumer = match (single, diffusion) {
+        (Some(_), _) => Consumer::PngStackSingle,
+        (None, true) => Consumer::PngStackDiffusion,
+        (None, false) => Consumer::PngStackRandom,
+    };
+    Sampler::new(model, grid, consumer)
 }
 
 /// Material codes of the layers of `slab` (from layer `z0`) by `single`'s
