@@ -150,15 +150,52 @@ impl Model {
     }
 }
 
-/// The distance at every grid point, x fastest.
+/// Samples per side of the blocks that [`sample`] bounds before sampling.
+const BLOCK: usize = 8;
+
+/// The distance at every grid point, x fastest. A block of samples whose
+/// distance interval lies wholly outside is filled with the interval's
+/// lower end instead: ridge points are inside samples compared with their
+/// neighbours, and any positive value outside compares the same.
 fn sample(model: &Model, g: &Grid) -> Vec<f64> {
     let [nx, ny, nz] = g.dims;
-    (0..nz)
+    let [bx, by, bz] = g.dims.map(|n| n.div_ceil(BLOCK));
+    let blocks: Vec<Vec<f64>> = (0..bx * by * bz)
         .into_par_iter()
-        .flat_map_iter(|k| {
-            (0..ny).flat_map(move |j| (0..nx).map(move |i| model.distance(g.at(i, j, k))))
+        .map(|b| {
+            let (i0, j0, k0) = (b % bx * BLOCK, b / bx % by * BLOCK, b / (bx * by) * BLOCK);
+            let (i1, j1, k1) = (
+                (i0 + BLOCK).min(nx),
+                (j0 + BLOCK).min(ny),
+                (k0 + BLOCK).min(nz),
+            );
+            let bounds = Aabb::new(g.at(i0, j0, k0), g.at(i1 - 1, j1 - 1, k1 - 1));
+            let lo = model.interval(&bounds).lo;
+            let at = |(i, j, k)| {
+                if lo > 0.0 {
+                    lo
+                } else {
+                    model.distance(g.at(i, j, k))
+                }
+            };
+            (k0..k1)
+                .flat_map(|k| (j0..j1).flat_map(move |j| (i0..i1).map(move |i| (i, j, k))))
+                .map(at)
+                .collect()
         })
-        .collect()
+        .collect();
+    let mut d = vec![0.0; nx * ny * nz];
+    for (b, vals) in blocks.iter().enumerate() {
+        let (i0, j0, k0) = (b % bx * BLOCK, b / bx % by * BLOCK, b / (bx * by) * BLOCK);
+        let w = (i0 + BLOCK).min(nx) - i0;
+        let h = (j0 + BLOCK).min(ny) - j0;
+        for (r, row) in vals.chunks(w).enumerate() {
+            let (j, k) = (j0 + r % h, k0 + r / h);
+            let start = i0 + nx * (j + ny * k);
+            d[start..start + w].copy_from_slice(row);
+        }
+    }
+    d
 }
 
 /// The [`CANDIDATES`] shallowest ridge points as (depth, index), ordered
