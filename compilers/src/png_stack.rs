@@ -43,7 +43,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use serde_json::json;
 use volcad_core::Model;
-use volcad_core::sampler::{Grid, Sampler, Slab};
+use volcad_core::sampler::{Consumer, Grid, Sampler, Slab};
 
 use crate::design::{grid_for, palette};
 use crate::dither::{self, Diffuser};
@@ -272,10 +272,55 @@ fn bitmap_folders(model: &Model) -> Vec<BitmapFolder> {
     out
 }
 
-/// What writing one layer produced.
-struct LayerOut {
-    files: Vec<String>,
-    counts: Vec<u64>,
+/// What writing one layer (or a whole stack) produced.
+pub(crate) struct LayerOut {
+    /// Files written, relative to the output folder.
+    pub files: Vec<String>,
+    /// Voxels per count slot (material or vat).
+    pub counts: Vec<u64>,
+}
+
+/// Run `write` on every layer of the stack (its global index and material
+/// codes, see [`for_each_slab`]), the layers of a slab in parallel, and
+/// gather their files in layer order and their `slots` counts.
+pub(crate) fn write_layers(
+    model: &Model,
+    p: &PngParams,
+    est: &Estimate,
+    ctx: &JobContext,
+    slots: usize,
+    write: impl Fn(usize, &[u8]) -> Result<LayerOut, ExportError> + Sync,
+) -> Result<LayerOut, ExportError> {
+    let [nx, ny, _] = est.grid.dims;
+    let layer = nx * ny;
+    let mut all = LayerOut {
+        files: Vec::new(),
+        counts: vec![0; slots],
+    };
+    let written = AtomicU64::new(0);
+    for_each_slab(model, p, est, ctx, |zs, codes| {
+        let outs: Vec<LayerOut> = zs
+            .clone()
+            .into_par_iter()
+            .map(|z| {
+                let i = z - zs.start;
+                let out = write(z, &codes[i * layer..(i + 1) * layer])?;
+                // Per layer, in whatever order layers finish (reports are snapshots).
+                let n = written.fetch_add(1, Ordering::Relaxed) + 1;
+                let total = est.layers.len() as u64;
+                ctx.progress("slicing", n, total, "layers", n as f64 / total as f64);
+                Ok(out)
+            })
+            .collect::<Result<_, ExportError>>()?;
+        for o in outs {
+            all.files.extend(o.files);
+            for (t, c) in all.counts.iter_mut().zip(o.counts) {
+                *t += c;
+            }
+        }
+        Ok(())
+    })?;
+    Ok(all)
 }
 
 fn write_stack(
@@ -297,34 +342,11 @@ fn write_stack(
         let dir = ctx.staging().join(&f.dir);
         std::fs::create_dir_all(&dir).map_err(|e| ExportError::io(&dir, e))?;
     }
-    let mut files = Vec::new();
-    let mut counts = vec![0u64; k];
-    let written = AtomicU64::new(0);
-    let layer = nx * ny;
     let style = top_view(est.grid.voxel);
-    for_each_slab(model, p, est, ctx, |zs, codes| {
-        let outs: Vec<LayerOut> = zs
-            .clone()
-            .into_par_iter()
-            .map(|z| {
-                let i = z - zs.start;
-                let c = &codes[i * layer..(i + 1) * layer];
-                let out = write_layer(ctx, [nx, ny], z, digits, c, &pal, &folders, style)?;
-                // Per layer, in whatever order layers finish (reports are snapshots).
-                let n = written.fetch_add(1, Ordering::Relaxed) + 1;
-                let total = est.layers.len() as u64;
-                ctx.progress("slicing", n, total, "layers", n as f64 / total as f64);
-                Ok(out)
-            })
-            .collect::<Result<_, ExportError>>()?;
-        for o in outs {
-            files.extend(o.files);
-            for (t, c) in counts.iter_mut().zip(o.counts) {
-                *t += c;
-            }
-        }
-        Ok(())
+    let out = write_layers(model, p, est, ctx, k, |z, c| {
+        write_layer(ctx, [nx, ny], z, digits, c, &pal, &folders, style)
     })?;
+    let (files, counts) = (out.files, out.counts);
     Ok(summary(model, p, est, files, counts))
 }
 
@@ -357,7 +379,7 @@ pub(crate) fn for_each_slab(
     let mut diffuser =
         (p.dither == Dither::Diffusion && single.is_none()).then(|| Diffuser::new(nx, ny, k));
     let sampler = match keep {
-        Some(_) => Sampler::new(model, grid, true),
+        Some(_) => Sampler::new(model, grid, Consumer::PngStackKeepOut),
         None => stack_sampler(model, grid, single, diffuser.is_some()),
     };
     let first = if diffuser.is_some() {
@@ -422,12 +444,12 @@ fn single_material_code(model: &Model) -> Option<u8> {
 /// every one; a design of one material everywhere (`single`) needs none.
 /// Pixels need the sign of the distance only.
 fn stack_sampler(model: &Model, grid: Grid, single: Option<u8>, diffusion: bool) -> Sampler<'_> {
-    match (single, diffusion) {
-        (Some(_), _) => Sampler::new(model, grid, false),
-        (None, true) => Sampler::new(model, grid, true),
-        (None, false) => Sampler::new(model, grid, true).with_lazy_fractions(),
-    }
-    .with_signs_only()
+    let consumer = match (single, diffusion) {
+        (Some(_), _) => Consumer::PngStackSingle,
+        (None, true) => Consumer::PngStackDiffusion,
+        (None, false) => Consumer::PngStackRandom,
+    };
+    Sampler::new(model, grid, consumer)
 }
 
 /// Material codes of the layers of `slab` (from layer `z0`) by `single`'s

@@ -1,6 +1,9 @@
 //! Every example in `assets/examples` runs, prepares, and shows what it
 //! promises at a few points.
 
+// A test crate: its helper functions stop on a failed setup as its tests do.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::path::PathBuf;
 
 use glam::DVec3;

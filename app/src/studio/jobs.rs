@@ -251,6 +251,13 @@ pub fn field(o: Opt) -> &'static str {
         Opt::PropertyBins => "\"Property bins\"",
         Opt::Shard => "the shard",
         Opt::Force => "\"Export anyway\"",
+        Opt::Preset => "\"Printer\"",
+        Opt::Map => "\"Resin map\"",
+        Opt::Intensity => "\"Intensity\"",
+        Opt::Range => "\"Range\"",
+        Opt::Vats => "\"Vats\"",
+        Opt::VatMaterials => "\"Vat materials\"",
+        Opt::Offset => "\"Offset (mm)\"",
         Opt::Design => "design",
     }
 }

@@ -313,7 +313,9 @@ fn data_from_a_simulation_field_column() {
                let s = Sphere(Vec3(2, 2, 2), 1.5, m.id(\"red\")); s.set_attribute(\"modulus\", f, \"e\"); s";
     let m = model_of(src, "t.rhai", &opts).unwrap();
     assert!((at(&m, "modulus", [2.0, 2.0, 2.0]) - 120.0).abs() < 1e-9);
-    let e = model_of(&src.replace("\"e\"", "\"E2\""), "t.rhai", &opts).unwrap_err();
+    let e = model_of(&src.replace("\"e\"", "\"E2\""), "t.rhai", &opts)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("no column \"E2\""), "{e}");
 }
 

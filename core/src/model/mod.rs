@@ -14,7 +14,7 @@ mod fractions;
 mod pnode;
 pub mod polygon2d;
 mod prepare;
-pub mod sdf;
+pub(crate) mod sdf;
 mod shapes;
 mod strut_grid;
 mod thin_sampled;
@@ -43,7 +43,7 @@ pub use flatten::rotation;
 
 /// Check a `PolygonRevolve` half-profile as prepare will (for errors at
 /// the script call): the reason it is refused, if it is.
-pub fn check_revolve(
+pub(crate) fn check_revolve(
     vertices: &[DVec3],
     axis_start: DVec3,
     axis_end: DVec3,

@@ -103,30 +103,7 @@ impl Preparer {
                     b.transformed(&m, *point),
                 )
             }
-            NodeKind::Sum { iso, children } => {
-                if children.is_empty() {
-                    return Err(err(
-                        n,
-                        "has no children; add some with add_child or pass a list",
-                    ));
-                }
-                let mut nodes = Vec::with_capacity(children.len());
-                let mut bbox = Aabb::EMPTY;
-                for c in children {
-                    let p = self.get(c)?;
-                    nodes.push(p.node.clone());
-                    bbox = bbox.union(&p.bbox);
-                }
-                // Outside every child's box each dᵢ > 0, so Σdᵢ + iso ≤ 0
-                // needs every dᵢ ≤ −iso: within −iso of every box.
-                (
-                    PNode::Sum {
-                        iso: *iso,
-                        children: nodes,
-                    },
-                    bbox.expand((-iso).max(0.0)),
-                )
-            }
+            NodeKind::Sum { iso, children } => self.build_sum(n, *iso, children)?,
             NodeKind::Text {
                 shape,
                 depth,
@@ -153,5 +130,36 @@ impl Preparer {
             }
             _ => return Err(err(n, "is not a leaf (a bug in volcad)")),
         })
+    }
+
+    /// `Sum`: the children's distances added, with `iso` added to the sum.
+    fn build_sum(
+        &self,
+        n: &Node,
+        iso: f64,
+        children: &[Node],
+    ) -> Result<(PNode, Aabb), PrepareError> {
+        if children.is_empty() {
+            return Err(err(
+                n,
+                "has no children; add some with add_child or pass a list",
+            ));
+        }
+        let mut nodes = Vec::with_capacity(children.len());
+        let mut bbox = Aabb::EMPTY;
+        for c in children {
+            let p = self.get(c)?;
+            nodes.push(p.node.clone());
+            bbox = bbox.union(&p.bbox);
+        }
+        // Outside every child's box each dᵢ > 0, so Σdᵢ + iso ≤ 0
+        // needs every dᵢ ≤ −iso: within −iso of every box.
+        Ok((
+            PNode::Sum {
+                iso,
+                children: nodes,
+            },
+            bbox.expand((-iso).max(0.0)),
+        ))
     }
 }
