@@ -2,9 +2,9 @@
 //! attribute, and the refusals (build area, unknown attribute, options of
 //! another export) that leave nothing behind.
 
-mod common;
+mod cli_common;
 
-use common::{example, fails, ok, tmp, volcad};
+use cli_common::{example, fails, ok, tmp, volcad};
 
 /// Mean gray of the lit pixels of a PNG.
 fn mean_lit(path: &std::path::Path) -> f64 {
