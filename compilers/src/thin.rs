@@ -50,7 +50,12 @@ fn two_digits(x: f64, round: fn(f64) -> f64) -> f64 {
 /// not sampled.
 pub fn thin_feature_notes(model: &Model, size: f64, option: &str) -> Vec<String> {
     let t = model.thinnest_feature();
-    let sampled = if t.unknown.is_empty() {
+    // A sampled feature is at least `2 h` thick and warns only when it is
+    // narrower than two cells, so cells no larger than `h` never meet one:
+    // fine exports skip the sampling (as costly as a coarse export).
+    let spacing = model.thin_sampling_spacing();
+    let fine = spacing.is_some_and(|h| size <= h);
+    let sampled = if t.unknown.is_empty() || fine {
         None
     } else {
         model.sampled_thinnest()
@@ -88,10 +93,18 @@ pub fn thin_feature_notes(model: &Model, size: f64, option: &str) -> Vec<String>
                 size_above(s.spacing),
                 size_above(3.0 * s.spacing)
             ),
-            None => format!(
-                "thin features of {} are not checked against {option} {size} (their thickness is not stated in the design, and it is unbounded, so it cannot be sampled)",
-                t.unknown.join(" and ")
-            ),
+            None => match spacing {
+                Some(h) => format!(
+                    "thin features of {} were not sampled: sampling every {} mm finds features down to {} mm, which {option} {size} resolves",
+                    t.unknown.join(" and "),
+                    size_above(h),
+                    size_above(2.0 * h)
+                ),
+                None => format!(
+                    "thin features of {} are not checked against {option} {size} (their thickness is not stated in the design, and it is unbounded, so it cannot be sampled)",
+                    t.unknown.join(" and ")
+                ),
+            },
         });
     }
     out

@@ -130,3 +130,15 @@ fn designs_whose_thickness_is_stated_are_not_sampled() {
     let notes = thin_feature_notes(&m, 0.5, "--voxel");
     assert!(notes.is_empty(), "{notes:?}");
 }
+
+#[test]
+fn cells_no_larger_than_the_sampling_spacing_skip_the_sampling() {
+    let m = mesh_design("sphere_10mm.obj");
+    let h = m.thin_sampling_spacing().expect("a bounded design");
+    let notes = thin_feature_notes(&m, h, "--voxel");
+    assert!(warnings(&notes).is_empty(), "{notes:?}");
+    assert!(
+        notes.iter().any(|n| n.contains("were not sampled")),
+        "{notes:?}"
+    );
+}

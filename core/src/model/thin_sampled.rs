@@ -120,6 +120,14 @@ impl Grid {
 }
 
 impl Model {
+    /// The spacing `h` (mm) that [`Model::sampled_thinnest`] samples at,
+    /// without sampling; `None` when the design's box is unbounded. Every
+    /// feature it reports is at least `2 h` thick, so cells of `h` or less
+    /// resolve whatever it could find.
+    pub fn thin_sampling_spacing(&self) -> Option<f64> {
+        Grid::over(&self.bbox).map(|g| g.h)
+    }
+
     /// The design's thinnest feature estimated by sampling (see the module
     /// doc); `None` when the design's box is unbounded. Computed once per
     /// model and kept.
