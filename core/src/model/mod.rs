@@ -17,10 +17,12 @@ mod prepare;
 pub(crate) mod sdf;
 mod shapes;
 mod strut_grid;
+mod thin_sampled;
 mod thinnest;
 mod tpms;
 mod union_index;
 
+pub use thin_sampled::{Sampled, SampledFeature};
 pub use thinnest::{Feature, Thinnest};
 
 #[cfg(test)]
@@ -77,6 +79,9 @@ pub struct Model {
     /// The attribute evaluator, only when some node carries an attribute
     /// (kept apart from `root` so distances and fractions never look at it).
     pub(crate) attrs: Option<Arc<crate::attribute::Evaluator>>,
+    /// The sampled thin-feature estimate, made on first use and shared by
+    /// clones (see [`Model::sampled_thinnest`]).
+    sampled: Arc<std::sync::OnceLock<Option<Sampled>>>,
 }
 
 /// The distance of one script subtree in its own frame (the attribute
@@ -191,6 +196,7 @@ impl Model {
             table,
             node_count: root.count_nodes(),
             prepare_time: start.elapsed(),
+            sampled: Arc::default(),
         })
     }
 

@@ -9,8 +9,9 @@
 //! their cell size before sampling.
 //!
 //! Geometry whose thickness the tree does not state (meshes, `Function`s,
-//! simulation fields) is reported as unknown rather than guessed, and gaps
-//! between separate primitives are not measured.
+//! simulation fields) is listed as unknown here and measured by sampling
+//! ([`Model::sampled_thinnest`]); gaps between separate primitives are not
+//! measured.
 
 use std::collections::HashSet;
 use std::sync::Arc;
