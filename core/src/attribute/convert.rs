@@ -13,7 +13,7 @@ pub struct Table {
 
 impl Table {
     /// A table of `(input, output)` rows; `what` names it in errors.
-    pub fn new(rows: &[(f64, f64)], what: &str) -> Result<Table, String> {
+    pub(crate) fn new(rows: &[(f64, f64)], what: &str) -> Result<Table, String> {
         check_pairs(rows, what, "a lookup table", "(input, output)")?;
         if let Some(i) = rows.windows(2).position(|w| w[1].0 <= w[0].0) {
             return Err(format!(
@@ -30,7 +30,7 @@ impl Table {
     }
 
     /// Rows from CSV text (see [`csv_rows`]).
-    pub fn parse_csv(text: &str, what: &str) -> Result<Table, String> {
+    pub(crate) fn parse_csv(text: &str, what: &str) -> Result<Table, String> {
         Table::new(&csv_rows(text, what)?, what)
     }
 
@@ -69,7 +69,7 @@ impl Table {
 /// The non-empty lines of CSV text that are not `#` comments, as the
 /// 1-based line number and the trimmed cells; a byte-order mark is
 /// skipped.
-pub fn csv_cells(text: &str) -> impl Iterator<Item = (usize, Vec<&str>)> {
+pub(crate) fn csv_cells(text: &str) -> impl Iterator<Item = (usize, Vec<&str>)> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     text.lines().enumerate().filter_map(|(n, line)| {
         let line = line.trim();
@@ -82,7 +82,7 @@ pub fn csv_cells(text: &str) -> impl Iterator<Item = (usize, Vec<&str>)> {
 /// that is not numeric is a header, and lines starting with `#` (the
 /// source of the numbers) are skipped; `what` names the file in errors,
 /// with the 1-based line.
-pub fn csv_rows(text: &str, what: &str) -> Result<Vec<(f64, f64)>, String> {
+pub(crate) fn csv_rows(text: &str, what: &str) -> Result<Vec<(f64, f64)>, String> {
     let mut rows = Vec::new();
     let mut header = false;
     for (n, cells) in csv_cells(text) {

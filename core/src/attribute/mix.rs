@@ -25,7 +25,7 @@ pub struct MixTable {
 impl MixTable {
     /// A table of `(share of the second material, value)` rows; `what`
     /// names it in errors.
-    pub fn new(rows: &[(f64, f64)], what: &str) -> Result<MixTable, String> {
+    pub(crate) fn new(rows: &[(f64, f64)], what: &str) -> Result<MixTable, String> {
         check_pairs(rows, what, "a mix table", "(share, value)")?;
         for (i, (s, _)) in rows.iter().enumerate() {
             if !(0.0..=1.0).contains(s) {
@@ -66,7 +66,7 @@ impl MixTable {
 
     /// Rows from CSV text: `share,value` (header and `#` lines as
     /// [`csv_rows`]).
-    pub fn parse_csv(text: &str, what: &str) -> Result<MixTable, String> {
+    pub(crate) fn parse_csv(text: &str, what: &str) -> Result<MixTable, String> {
         MixTable::new(&csv_rows(text, what)?, what)
     }
 

@@ -28,7 +28,7 @@ mod to_fractions;
 
 use std::sync::Arc;
 
-pub use convert::{ConvMap, FRACTIONS, Table, csv_cells, csv_rows};
+pub use convert::{ConvMap, FRACTIONS, Table};
 pub use describe::{column_names, describe_tree, value_text};
 pub use mix::MixTable;
 pub use names::{COMMON, Common, check_kind, range, range_text};

@@ -42,7 +42,7 @@ impl PointCloud {
     /// any order) and one or more value columns, then one row of numbers a
     /// point; `#` lines and a byte-order mark are skipped. `what` names the
     /// file in errors, which give the line and column.
-    pub fn parse(text: &str, what: &str) -> Result<PointCloud, String> {
+    pub(crate) fn parse(text: &str, what: &str) -> Result<PointCloud, String> {
         let mut rows = csv_cells(text);
         let Some((hl, header)) = rows.next() else {
             return Err(format!(

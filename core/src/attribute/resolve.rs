@@ -28,7 +28,7 @@ pub enum Resolver {
 impl Resolver {
     /// `"first"`, `"average"`, `"min"`, `"max"`, `"sum"`, or a math string
     /// of `a` and `b`.
-    pub fn parse(text: &str) -> Result<Resolver, String> {
+    pub(crate) fn parse(text: &str) -> Result<Resolver, String> {
         Ok(match text.trim().to_ascii_lowercase().as_str() {
             "first" => Resolver::First,
             "average" => Resolver::Average,
