@@ -251,6 +251,10 @@ pub fn field(o: Opt) -> &'static str {
         Opt::PropertyBins => "\"Property bins\"",
         Opt::Shard => "the shard",
         Opt::Force => "\"Export anyway\"",
+        Opt::FullColor => "\"Full colour\"",
+        Opt::ColorProfile => "\"Colour profile\"",
+        Opt::BitmapFormat => "\"Bitmap format\"",
+        Opt::BitmapWidth => "\"Bitmap width\"",
         Opt::Design => "design",
     }
 }

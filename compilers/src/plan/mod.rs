@@ -76,6 +76,14 @@ pub enum Opt {
     Shard,
     /// Override the refusals that protect the user.
     Force,
+    /// One colour resin per voxel from the design's colours.
+    FullColor,
+    /// Measured resin colours of a full-colour stack.
+    ColorProfile,
+    /// File format of per-material bitmaps.
+    BitmapFormat,
+    /// Fixed width of BMP bitmaps.
+    BitmapWidth,
     /// The design itself.
     Design,
 }
@@ -83,7 +91,7 @@ pub enum Opt {
 impl Opt {
     /// Every key. No flag starts another, so a message can be rewritten
     /// flag by flag.
-    pub const ALL: [Opt; 16] = [
+    pub const ALL: [Opt; 20] = [
         Opt::MinCell,
         Opt::MaxCell,
         Opt::Sizing,
@@ -99,6 +107,10 @@ impl Opt {
         Opt::PropertyBins,
         Opt::Shard,
         Opt::Force,
+        Opt::FullColor,
+        Opt::ColorProfile,
+        Opt::BitmapFormat,
+        Opt::BitmapWidth,
         Opt::Design,
     ];
 
@@ -120,6 +132,10 @@ impl Opt {
             Opt::PropertyBins => "--property-bins",
             Opt::Shard => "--shard",
             Opt::Force => "--force",
+            Opt::FullColor => "--full-color",
+            Opt::ColorProfile => "--color-profile",
+            Opt::BitmapFormat => "--bitmap-format",
+            Opt::BitmapWidth => "--bitmap-width",
             Opt::Design => "design",
         }
     }
