@@ -1,6 +1,8 @@
 //! 1-bit BMP bitmaps in pyvcad's MyersonCompiler layout, read back with
 //! the `image` crate: names, sizes, bit depth, fixed width, and per-material
 //! pixels equal to the PNG bitmaps' and the summary's counts.
+// Test helpers fail the test with a message where a value is missing.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod common;
 

@@ -2,6 +2,8 @@
 //! region by region, byte-identical across thread counts, counts that sum
 //! to the inside voxels; material colours and alpha without a `color`
 //! attribute; a procedural texture; profiles; refusals.
+// Test helpers fail the test with a message where a value is missing.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod common;
 
@@ -14,6 +16,10 @@ use volcad_compilers::color::{CHANNELS, ColorPlan, Ink};
 use volcad_compilers::png_stack::{PngParams, estimate, export_png_stack};
 use volcad_compilers::{ExportError, Summary};
 use volcad_core::Model;
+
+/// Per region: the sum of the resins' points, of the wanted points, and
+/// the voxel count.
+type RegionSums = BTreeMap<(usize, usize), ([f64; CHANNELS], [f64; CHANNELS], f64)>;
 
 const WHEEL: &str = include_str!("../../assets/examples/color_wheel.rhai");
 
@@ -78,8 +84,7 @@ fn colour_wheel_regions_average_to_the_wanted_colour() {
     let index = m.attribute_index("color").unwrap();
     // Regions: 12 sectors of 30° by 4 rings of 4 mm, through every layer
     // (about 1,200 to 8,000 voxels each).
-    let mut sums: BTreeMap<(usize, usize), ([f64; CHANNELS], [f64; CHANNELS], f64)> =
-        BTreeMap::new();
+    let mut sums = RegionSums::new();
     let mut c = [0.0; 4];
     for z in 0..nz {
         for j in 0..ny {
