@@ -436,7 +436,7 @@ fn preflight(
 }
 
 /// The slice stack's parameters from the options (`voxel` as parsed).
-fn png_params(a: &ExportArgs, voxel: Option<DVec3>) -> anyhow::Result<PngParams> {
+pub(crate) fn png_params(a: &ExportArgs, voxel: Option<DVec3>) -> anyhow::Result<PngParams> {
     let dither = match a.dither.as_deref().unwrap_or("random") {
         "random" => Dither::Random,
         "diffusion" => Dither::Diffusion,
