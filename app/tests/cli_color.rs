@@ -30,14 +30,7 @@ fn full_color_writes_resin_slices_and_counts() {
         "0.5",
         "--full-color",
     ]));
-    for resin in [
-        "VeroCyan",
-        "VeroMgnt",
-        "VeroYellow",
-        "VeroBlack",
-        "VeroPureWht",
-        "VeroClear",
-    ] {
+    for resin in volcad_compilers::color::J750_COLOR_RESINS {
         assert!(text.contains(resin), "{text}");
     }
     assert!(out.join("slice_00003.png").is_file());

@@ -12,10 +12,11 @@ use std::sync::Arc;
 
 use common::{decode, manifest, model, read_tree, run, tmp};
 use glam::DVec3;
-use volcad_compilers::color::{CHANNELS, ColorPlan, Ink};
+use volcad_compilers::color::{CHANNELS, ColorPlan, Ink, J750_COLOR_RESINS};
 use volcad_compilers::png_stack::{PngParams, estimate, export_png_stack};
 use volcad_compilers::{ExportError, Summary};
 use volcad_core::Model;
+use volcad_core::sampler::Grid;
 
 /// Per region: the sum of the resins' points, of the wanted points, and
 /// the voxel count.
@@ -71,15 +72,20 @@ fn voxel_inks(
     out
 }
 
+/// Export `m` with `p` and read each voxel's resin back.
+fn exported_inks(m: &Arc<Model>, p: &PngParams) -> (Grid, ColorPlan, Vec<Option<Ink>>) {
+    let grid = estimate(m, p).unwrap().grid;
+    let plan = ColorPlan::new(m, p).unwrap();
+    let dir = tmp();
+    export(m, p, &dir.path().join("out")).unwrap();
+    let inks = voxel_inks(&read_tree(&dir.path().join("out")), &plan, grid.dims);
+    (grid, plan, inks)
+}
+
 #[test]
 fn colour_wheel_regions_average_to_the_wanted_colour() {
     let m = model(WHEEL);
-    let p = params(0.25);
-    let grid = estimate(&m, &p).unwrap().grid;
-    let plan = ColorPlan::new(&m, &p).unwrap();
-    let dir = tmp();
-    export(&m, &p, &dir.path().join("out")).unwrap();
-    let inks = voxel_inks(&read_tree(&dir.path().join("out")), &plan, grid.dims);
+    let (grid, plan, inks) = exported_inks(&m, &params(0.25));
     let [nx, ny, nz] = grid.dims;
     let index = m.attribute_index("color").unwrap();
     // Regions: 12 sectors of 30° by 4 rings of 4 mm, through every layer
@@ -158,17 +164,7 @@ fn thread_counts_give_identical_bytes_and_counts_sum_to_the_inside() {
     );
     let s = s.unwrap();
     let names: Vec<&str> = s.counts.iter().map(|(n, _)| n.as_str()).collect();
-    assert_eq!(
-        names,
-        [
-            "VeroCyan",
-            "VeroMgnt",
-            "VeroYellow",
-            "VeroBlack",
-            "VeroPureWht",
-            "VeroClear"
-        ]
-    );
+    assert_eq!(names, J750_COLOR_RESINS);
     // The same design as a material stack: its one material fills every
     // inside voxel.
     let dir = tmp();
@@ -240,12 +236,7 @@ let g = "(floor(x / 5) + floor(y / 5)) % 2 == 0 ? 0.2 : 0.8";
 b.set_attribute("color", [g, g, g, 1.0]);
 b"#,
     );
-    let p = params(0.25);
-    let grid = estimate(&m, &p).unwrap().grid;
-    let plan = ColorPlan::new(&m, &p).unwrap();
-    let dir = tmp();
-    export(&m, &p, &dir.path().join("out")).unwrap();
-    let inks = voxel_inks(&read_tree(&dir.path().join("out")), &plan, grid.dims);
+    let (grid, plan, inks) = exported_inks(&m, &params(0.25));
     let [nx, ny, _] = grid.dims;
     for (sx, sy) in [(0, 0), (1, 0), (2, 3)] {
         let (mut sum, mut n) = (0.0, 0.0);
