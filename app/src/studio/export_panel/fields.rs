@@ -75,11 +75,19 @@ impl ExportPanels {
             ui.add(egui::DragValue::new(&mut self.png.seed))
                 .labelled_by(label);
             ui.end_row();
+            // One row for both switches: a taller panel would push a
+            // running job's Cancel out of view.
             ui.label("");
-            ui.checkbox(
-                &mut self.png.per_material_bitmaps,
-                "1-bit bitmaps per material",
-            );
+            ui.horizontal(|ui| {
+                ui.checkbox(
+                    &mut self.png.per_material_bitmaps,
+                    "1-bit bitmaps per material",
+                );
+                ui.checkbox(&mut self.png.full_color, "Full colour")
+                    .on_hover_text(
+                        "Each voxel a J750 colour resin reproducing the design's colour",
+                    );
+            });
             ui.end_row();
             if self.png.per_material_bitmaps {
                 self.bitmap_ui(ui);
@@ -120,12 +128,8 @@ impl ExportPanels {
         ui.end_row();
     }
 
-    /// Full colour and its profile (`--full-color`, `--color-profile`).
+    /// The profile of a full-colour stack (`--color-profile`).
     fn full_color_ui(&mut self, ui: &mut egui::Ui) {
-        ui.label("");
-        ui.checkbox(&mut self.png.full_color, "Full colour")
-            .on_hover_text("Each voxel a J750 colour resin reproducing the design's colour");
-        ui.end_row();
         if !self.png.full_color {
             self.png.color_profile = None;
             return;
