@@ -3,7 +3,8 @@
 
 use std::path::Path;
 
-fn main() {
+/// A failure here stops the build with cargo's report of the error.
+fn main() -> std::io::Result<()> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/examples");
     println!("cargo:rerun-if-changed={}", dir.display());
     let mut files: Vec<_> = std::fs::read_dir(&dir)
@@ -24,6 +25,9 @@ fn main() {
         println!("cargo:rerun-if-changed={}", p.display());
     }
     out.push_str("];\n");
-    let dest = Path::new(&std::env::var("OUT_DIR").expect("OUT_DIR")).join("examples.rs");
-    std::fs::write(dest, out).expect("writing examples.rs");
+    let out_dir = std::env::var("OUT_DIR")
+        .map_err(|e| std::io::Error::other(format!("OUT_DIR (set by cargo): {e}")))?;
+    let dest = Path::new(&out_dir).join("examples.rs");
+    std::fs::write(&dest, out)
+        .map_err(|e| std::io::Error::other(format!("writing {}: {e}", dest.display())))
 }

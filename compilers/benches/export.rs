@@ -7,6 +7,9 @@
 //! encoding or the disk. Output goes to a temporary folder that is removed.
 //! `--mesh` or `--png` runs only that export.
 
+// A failed setup step fails the benchmark run.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
@@ -19,7 +22,7 @@ use volcad_compilers::lazy_random::choose_random_row;
 use volcad_compilers::mesh::{MeshFormats, MeshParams, SegmentBy, export_meshes, segment_meshes};
 use volcad_compilers::png_stack::{Dither, PngParams, export_png_stack};
 use volcad_core::Model;
-use volcad_core::sampler::{Grid, Sampler, Slab};
+use volcad_core::sampler::{Consumer, Grid, Sampler, Slab};
 use volcad_core::script::{ScriptOptions, model_of, model_of_file};
 
 const BCC_SPHERE: &str = r#"let m = default_materials();
@@ -66,8 +69,8 @@ fn stage_times(model: &Model, voxel: f64, dither: Dither) -> (u64, f64, f64) {
     let cancel = AtomicBool::new(false);
     // As the export: random picks leave graded fractions to the chooser.
     let sampler = match dither {
-        Dither::Random => Sampler::new(model, grid, true).with_lazy_fractions(),
-        Dither::Diffusion => Sampler::new(model, grid, true),
+        Dither::Random => Sampler::new(model, grid, Consumer::PngStackRandom),
+        Dither::Diffusion => Sampler::new(model, grid, Consumer::PngStackDiffusion),
     };
     let mut slab = Slab::default();
     let layers = 16;
@@ -156,7 +159,26 @@ fn main() {
     let only = |what: &str| flags.is_empty() || flags.iter().any(|f| f[2..] == *what);
     let tmp = tempfile::tempdir().expect("temp dir");
     println!("threads: {}", rayon::current_num_threads());
-    let cases = [
+    for c in cases() {
+        if filter
+            .as_ref()
+            .is_some_and(|f| !c.name.contains(f.as_str()))
+        {
+            continue;
+        }
+        let model = (c.model)();
+        if only("png") {
+            bench_png(tmp.path(), &c, &model);
+        }
+        if only("mesh") {
+            bench_mesh(tmp.path(), &c, &model);
+        }
+    }
+}
+
+/// The designs and settings measured.
+fn cases() -> [Case; 6] {
+    [
         Case {
             name: "cube",
             model: || load("hello_cube.rhai"),
@@ -212,105 +234,100 @@ fn main() {
             segments: 1,
             pyvcad_png: Some(2.5),
         },
-    ];
-    for c in cases {
-        if filter
-            .as_ref()
-            .is_some_and(|f| !c.name.contains(f.as_str()))
-        {
-            continue;
-        }
-        let model = (c.model)();
-        for dither in [Dither::Random, Dither::Diffusion] {
-            if !only("png") {
-                break;
-            }
-            let (voxels, sample, choose) = stage_times(&model, c.png_voxel, dither);
-            let p = PngParams {
-                voxel: DVec3::splat(c.png_voxel),
-                seed: 1,
-                dither,
-                ..PngParams::default()
-            };
-            let m = model.clone();
-            let probe = tmp.path().join("size");
-            let (secs, s) = run_job(tmp.path(), move |ctx| {
-                let s = export_png_stack(&m, &p, ctx)?;
-                std::fs::write(&probe, bytes_of(ctx.staging()).to_string()).ok();
-                Ok(s)
-            });
-            let size: u64 = std::fs::read_to_string(tmp.path().join("size"))
-                .ok()
-                .and_then(|s| s.parse().ok())
-                .unwrap_or(0);
-            let rate = voxels as f64 / secs / 1e6;
-            let versus = c
-                .pyvcad_png
-                .map(|r| format!("; {:.0}× pyvcad's {r} M/s", rate / r))
-                .unwrap_or_default();
-            println!(
-                "png  {:<14} {:<9} {:>6} mm {:>12} voxels {:>8.3} s {:>8.1} M voxels/s  (sample {:.0} M/s, sample+choose {:.0} M/s; {} files, {:.1} MB{versus})",
-                c.name,
-                dither.name(),
-                c.png_voxel,
-                voxels,
-                secs,
-                rate,
-                voxels as f64 / sample / 1e6,
-                voxels as f64 / choose / 1e6,
-                s.files.len(),
-                size as f64 / 1e6
-            );
-        }
-        if !only("mesh") {
-            continue;
-        }
-        let p = MeshParams {
-            voxel: DVec3::splat(c.mesh_voxel),
-            segments: c.segments,
-            by: c.by,
-            ..MeshParams::default()
-        };
-        let t = Instant::now();
-        segment_meshes(&model, &p, &AtomicBool::new(false), |_, _| {}).expect("meshes");
-        let contour = t.elapsed().as_secs_f64();
-        // pyvcad's mesh compiler writes STL only: the like-for-like figure.
-        let stl_only = MeshParams {
-            formats: MeshFormats {
-                stl: true,
-                obj: false,
-                threemf: false,
-            },
-            ..p.clone()
+    ]
+}
+
+/// The PNG stack of case `c`, both dithers: the whole export's rate beside
+/// its stages' (sampling; sampling and choosing materials).
+fn bench_png(tmp: &Path, c: &Case, model: &Arc<Model>) {
+    for dither in [Dither::Random, Dither::Diffusion] {
+        let (voxels, sample, choose) = stage_times(model, c.png_voxel, dither);
+        let p = PngParams {
+            voxel: DVec3::splat(c.png_voxel),
+            seed: 1,
+            dither,
+            ..PngParams::default()
         };
         let m = model.clone();
-        let (stl_secs, _) = run_job(tmp.path(), move |ctx| export_meshes(&m, &stl_only, ctx));
-        let m = model.clone();
-        let (secs, s) = run_job(tmp.path(), move |ctx| export_meshes(&m, &p, ctx));
-        let tris: u64 = s
-            .notes
-            .iter()
-            .filter_map(|n| {
-                n.split(" triangles")
-                    .next()?
-                    .rsplit(' ')
-                    .next()?
-                    .parse::<u64>()
-                    .ok()
-            })
-            .sum();
+        let probe = tmp.join("size");
+        let (secs, s) = run_job(tmp, move |ctx| {
+            let s = export_png_stack(&m, &p, ctx)?;
+            std::fs::write(&probe, bytes_of(ctx.staging()).to_string()).ok();
+            Ok(s)
+        });
+        let size: u64 = std::fs::read_to_string(tmp.join("size"))
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(0);
+        let rate = voxels as f64 / secs / 1e6;
+        let versus = c
+            .pyvcad_png
+            .map(|r| format!("; {:.0}× pyvcad's {r} M/s", rate / r))
+            .unwrap_or_default();
         println!(
-            "mesh {:<14} {:<9} {:>6} mm {:>12} voxels {:>8.3} s {:>8.1} M voxels/s  (STL only {:.1} M/s, meshes alone {:.1} M/s; {} segments, {} triangles, STL+OBJ+3MF)",
+            "png  {:<14} {:<9} {:>6} mm {:>12} voxels {:>8.3} s {:>8.1} M voxels/s  (sample {:.0} M/s, sample+choose {:.0} M/s; {} files, {:.1} MB{versus})",
             c.name,
-            "",
-            c.mesh_voxel,
-            s.units,
+            dither.name(),
+            c.png_voxel,
+            voxels,
             secs,
-            s.units as f64 / secs / 1e6,
-            s.units as f64 / stl_secs / 1e6,
-            s.units as f64 / contour / 1e6,
-            s.counts.len(),
-            tris
+            rate,
+            voxels as f64 / sample / 1e6,
+            voxels as f64 / choose / 1e6,
+            s.files.len(),
+            size as f64 / 1e6
         );
     }
+}
+
+/// The mesh export of case `c`: contouring alone, STL only (pyvcad's
+/// output), and all formats.
+fn bench_mesh(tmp: &Path, c: &Case, model: &Arc<Model>) {
+    let p = MeshParams {
+        voxel: DVec3::splat(c.mesh_voxel),
+        segments: c.segments,
+        by: c.by,
+        ..MeshParams::default()
+    };
+    let t = Instant::now();
+    segment_meshes(model, &p, &AtomicBool::new(false), |_, _| {}).expect("meshes");
+    let contour = t.elapsed().as_secs_f64();
+    // pyvcad's mesh compiler writes STL only: the like-for-like figure.
+    let stl_only = MeshParams {
+        formats: MeshFormats {
+            stl: true,
+            obj: false,
+            threemf: false,
+        },
+        ..p.clone()
+    };
+    let m = model.clone();
+    let (stl_secs, _) = run_job(tmp, move |ctx| export_meshes(&m, &stl_only, ctx));
+    let m = model.clone();
+    let (secs, s) = run_job(tmp, move |ctx| export_meshes(&m, &p, ctx));
+    let tris: u64 = s
+        .notes
+        .iter()
+        .filter_map(|n| {
+            n.split(" triangles")
+                .next()?
+                .rsplit(' ')
+                .next()?
+                .parse::<u64>()
+                .ok()
+        })
+        .sum();
+    println!(
+        "mesh {:<14} {:<9} {:>6} mm {:>12} voxels {:>8.3} s {:>8.1} M voxels/s  (STL only {:.1} M/s, meshes alone {:.1} M/s; {} segments, {} triangles, STL+OBJ+3MF)",
+        c.name,
+        "",
+        c.mesh_voxel,
+        s.units,
+        secs,
+        s.units as f64 / secs / 1e6,
+        s.units as f64 / stl_secs / 1e6,
+        s.units as f64 / contour / 1e6,
+        s.counts.len(),
+        tris
+    );
 }

@@ -14,7 +14,7 @@ use std::sync::atomic::AtomicBool;
 
 use glam::DVec3;
 use volcad_core::Model;
-use volcad_core::sampler::{Grid, Sampler, Slab};
+use volcad_core::sampler::{Consumer, Grid, Sampler, Slab};
 
 /// Samples per axis of the coarse grid (at most).
 pub const COARSE_CELLS: usize = 40;
@@ -66,7 +66,7 @@ pub fn coarse_estimate(model: &Model, voxel: DVec3) -> CoarseEstimate {
     };
     let [nx, ny, nz] = grid.dims;
     // Counts read signs only.
-    let sampler = Sampler::new(model, grid, true).with_signs_only();
+    let sampler = Sampler::new(model, grid, Consumer::Estimate);
     let mut slab = Slab::default();
     if sampler
         .sample_layers(0, nz, &mut slab, &AtomicBool::new(false))

@@ -41,7 +41,7 @@ use std::io::{BufWriter, Write};
 use glam::DVec3;
 use rayon::prelude::*;
 use serde_json::json;
-use volcad_core::sampler::{Sampler, Slab};
+use volcad_core::sampler::{Consumer, Sampler, Slab};
 use volcad_core::{MaterialTable, Model};
 
 use crate::design::grid_for;
@@ -259,7 +259,7 @@ fn preview_mesh(
         .max((span.x * span.y * span.z / MESH_CELLS).cbrt());
     let grid = grid_for(model, DVec3::splat(cell), cell)?;
     let mut slab = Slab::default();
-    Sampler::new(model, grid, false)
+    Sampler::new(model, grid, Consumer::SurfaceContour)
         .sample_layers(0, grid.dims[2], &mut slab, ctx.cancel_flag())
         .map_err(|_| ExportError::Cancelled)?;
     let mut mesh = marching_cubes(&grid, &slab.dist);

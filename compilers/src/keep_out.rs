@@ -9,7 +9,7 @@
 
 use rayon::prelude::*;
 use volcad_core::Model;
-use volcad_core::sampler::{Grid, Sampler, Slab};
+use volcad_core::sampler::{Consumer, Grid, Sampler, Slab};
 
 use crate::design::grid_for;
 use crate::dither::MIN_TOTAL;
@@ -72,7 +72,7 @@ fn check_not_emptied(model: &Model, k: &KeepOut) -> Result<(), ExportError> {
     let cell = (size.x * size.y * size.z / CHECK_CELLS).cbrt();
     let grid: Grid = grid_for(model, glam::DVec3::splat(cell), 0.0)?;
     let mut slab = Slab::default();
-    Sampler::new(model, grid, true)
+    Sampler::new(model, grid, Consumer::PngStackKeepOut)
         .sample_layers(
             0,
             grid.dims[2],

@@ -215,7 +215,7 @@ mod tests {
     use std::sync::atomic::AtomicBool;
 
     use glam::DVec3;
-    use volcad_core::sampler::{Sampler, Slab};
+    use volcad_core::sampler::{Consumer, Sampler, Slab};
     use volcad_core::script::model_of_file;
 
     use super::*;
@@ -230,8 +230,8 @@ mod tests {
         let [nx, ny, nz] = grid.dims;
         let k = m.materials().len();
         let cancel = AtomicBool::new(false);
-        let eager = Sampler::new(m, grid, true);
-        let lazy = Sampler::new(m, grid, true).with_lazy_fractions();
+        let eager = Sampler::new(m, grid, Consumer::PngStackDiffusion);
+        let lazy = Sampler::new(m, grid, Consumer::PngStackRandom);
         let (mut a, mut b) = (Slab::default(), Slab::default());
         let (mut ca, mut cb) = (vec![0u8; nx], vec![0u8; nx]);
         let (mut marked, mut evaluated, mut inside) = (0, 0, 0);

@@ -36,6 +36,7 @@ pub mod shard;
 pub mod slice_image;
 pub mod thin;
 mod union_find;
+pub mod vat;
 pub mod zip_writer;
 
 pub use job::{ExportError, JobHandle, Progress, Summary};

@@ -43,7 +43,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use glam::DVec3;
 use rayon::prelude::*;
 use volcad_core::Model;
-use volcad_core::sampler::{Grid, Sampler, Slab};
+use volcad_core::sampler::{Consumer, Grid, Sampler, Slab};
 
 use crate::bitmaps::{self, BitmapFolder, BitmapFormat, BitmapStyle};
 use crate::color::{self, ColorPlan};
@@ -357,10 +357,62 @@ fn inks(model: &Model, p: &PngParams) -> Result<Inks, ExportError> {
     })
 }
 
-/// What writing one layer produced.
-struct LayerOut {
-    files: Vec<String>,
-    counts: Vec<u64>,
+/// What writing one layer (or a whole stack) produced.
+pub(crate) struct LayerOut {
+    /// Files written, relative to the output folder.
+    pub files: Vec<String>,
+    /// Voxels per count slot (material or vat).
+    pub counts: Vec<u64>,
+}
+
+/// Run `write` on every layer of the stack (its global index and material
+/// codes, see [`for_each_slab`], or the resin codes of a full-colour
+/// `plan`, see [`color::for_each_slab`]), the layers of a slab in
+/// parallel, and gather their files in layer order and their `slots`
+/// counts.
+pub(crate) fn write_layers(
+    model: &Model,
+    p: &PngParams,
+    plan: Option<&ColorPlan>,
+    est: &Estimate,
+    ctx: &JobContext,
+    slots: usize,
+    write: impl Fn(usize, &[u8]) -> Result<LayerOut, ExportError> + Sync,
+) -> Result<LayerOut, ExportError> {
+    let [nx, ny, _] = est.grid.dims;
+    let layer = nx * ny;
+    let mut all = LayerOut {
+        files: Vec::new(),
+        counts: vec![0; slots],
+    };
+    let written = AtomicU64::new(0);
+    let each = |zs: Range<usize>, codes: &[u8]| {
+        let outs: Vec<LayerOut> = zs
+            .clone()
+            .into_par_iter()
+            .map(|z| {
+                let i = z - zs.start;
+                let out = write(z, &codes[i * layer..(i + 1) * layer])?;
+                // Per layer, in whatever order layers finish (reports are snapshots).
+                let n = written.fetch_add(1, Ordering::Relaxed) + 1;
+                let total = est.layers.len() as u64;
+                ctx.progress("slicing", n, total, "layers", n as f64 / total as f64);
+                Ok(out)
+            })
+            .collect::<Result<_, ExportError>>()?;
+        for o in outs {
+            all.files.extend(o.files);
+            for (t, c) in all.counts.iter_mut().zip(o.counts) {
+                *t += c;
+            }
+        }
+        Ok(())
+    };
+    match plan {
+        Some(plan) => color::for_each_slab(model, plan, est, ctx, each)?,
+        None => for_each_slab(model, p, est, ctx, each)?,
+    }
+    Ok(all)
 }
 
 fn write_stack(
@@ -381,50 +433,23 @@ fn write_stack(
         let dir = ctx.staging().join(&f.dir);
         std::fs::create_dir_all(&dir).map_err(|e| ExportError::io(&dir, e))?;
     }
-    let mut files = Vec::new();
-    let mut counts = vec![0u64; inks.names.len()];
-    let written = AtomicU64::new(0);
-    let layer = nx * ny;
     let style = top_view(est.grid.voxel);
     let bits = BitmapStyle {
         format: p.bitmap_format,
         width: p.bitmap_width,
         image: style,
     };
-    let out = |zs: Range<usize>, codes: &[u8]| {
-        let outs: Vec<LayerOut> = zs
-            .clone()
-            .into_par_iter()
-            .map(|z| {
-                let i = z - zs.start;
-                let c = &codes[i * layer..(i + 1) * layer];
-                let out = write_layer(ctx, [nx, ny], z, digits, c, &inks.pal, &folders, bits)?;
-                // Per layer, in whatever order layers finish (reports are snapshots).
-                let n = written.fetch_add(1, Ordering::Relaxed) + 1;
-                let total = est.layers.len() as u64;
-                ctx.progress("slicing", n, total, "layers", n as f64 / total as f64);
-                Ok(out)
-            })
-            .collect::<Result<_, ExportError>>()?;
-        for o in outs {
-            files.extend(o.files);
-            for (t, c) in counts.iter_mut().zip(o.counts) {
-                *t += c;
-            }
-        }
-        Ok(())
-    };
-    match &inks.plan {
-        Some(plan) => color::for_each_slab(model, plan, est, ctx, out)?,
-        None => for_each_slab(model, p, est, ctx, out)?,
-    }
-    let names: Vec<String> = inks.names.into_iter().map(|(n, _)| n).collect();
+    let slots = inks.names.len();
+    let out = write_layers(model, p, inks.plan.as_ref(), est, ctx, slots, |z, c| {
+        write_layer(ctx, [nx, ny], z, digits, c, &inks.pal, &folders, bits)
+    })?;
+    let names = inks.names.into_iter().map(|(n, _)| n);
     Ok(summary(
         model,
         p,
         est,
-        files,
-        names.into_iter().zip(counts).collect(),
+        out.files,
+        names.zip(out.counts).collect(),
         inks.plan.as_ref(),
     ))
 }
@@ -458,7 +483,7 @@ pub(crate) fn for_each_slab(
     let mut diffuser =
         (p.dither == Dither::Diffusion && single.is_none()).then(|| Diffuser::new(nx, ny, k));
     let sampler = match keep {
-        Some(_) => Sampler::new(model, grid, true),
+        Some(_) => Sampler::new(model, grid, Consumer::PngStackKeepOut),
         None => stack_sampler(model, grid, single, diffuser.is_some()),
     };
     let first = if diffuser.is_some() {
@@ -523,12 +548,12 @@ fn single_material_code(model: &Model) -> Option<u8> {
 /// every one; a design of one material everywhere (`single`) needs none.
 /// Pixels need the sign of the distance only.
 fn stack_sampler(model: &Model, grid: Grid, single: Option<u8>, diffusion: bool) -> Sampler<'_> {
-    match (single, diffusion) {
-        (Some(_), _) => Sampler::new(model, grid, false),
-        (None, true) => Sampler::new(model, grid, true),
-        (None, false) => Sampler::new(model, grid, true).with_lazy_fractions(),
-    }
-    .with_signs_only()
+    let consumer = match (single, diffusion) {
+        (Some(_), _) => Consumer::PngStackSingle,
+        (None, true) => Consumer::PngStackDiffusion,
+        (None, false) => Consumer::PngStackRandom,
+    };
+    Sampler::new(model, grid, consumer)
 }
 
 /// Material codes of the layers of `slab` (from layer `z0`) by `single`'s

@@ -154,6 +154,24 @@ pub fn relabel(
         .with_table(std::sync::Arc::new(model.table().replaced(&with, &origin)))
 }
 
+/// True for the slice-stack presets that are J750 grids (`j750`,
+/// `j750-hq`): choosing one also means the J750 material table.
+pub fn is_j750_preset(name: &str) -> bool {
+    name.eq_ignore_ascii_case("j750") || name.eq_ignore_ascii_case("j750-hq")
+}
+
+/// `model` as a J750 stack writes it: relabelled with J750 resins through
+/// `map`, or refused naming each material the table lacks with the
+/// nearest resins (what `--preset j750` and the studio's J750 choice do).
+pub fn j750_model(
+    model: &std::sync::Arc<Model>,
+    map: &[(String, String)],
+) -> Result<std::sync::Arc<Model>, ExportError> {
+    let table = MaterialTable::j750();
+    let mats = resolve(model, &table, map, "J750")?;
+    Ok(std::sync::Arc::new(relabel(model, &mats, &table, "J750")))
+}
+
 /// The palette by code from resolved materials: 0 is void `(0, 0, 0, 0)`.
 pub fn palette_of(mats: &[PrinterMaterial]) -> Vec<[u8; 4]> {
     std::iter::once([0; 4])

@@ -133,7 +133,7 @@ pub fn not_shardable(kind: &str) -> String {
             .to_owned(),
         _ => format!(
             "--shard does not apply to `volcad export {kind}`, which is made from the whole \
-             part at once; only layer stacks (png) split into layer ranges"
+             part at once; only layer stacks (png, vat) split into layer ranges"
         ),
     }
 }
@@ -148,10 +148,16 @@ struct StackKind {
     notes: MergedNotes,
 }
 
-const KINDS: &[StackKind] = &[StackKind {
-    kind: "png",
-    notes: crate::png_stack::merged_notes,
-}];
+const KINDS: &[StackKind] = &[
+    StackKind {
+        kind: "png",
+        notes: crate::png_stack::merged_notes,
+    },
+    StackKind {
+        kind: "vat",
+        notes: crate::vat::merged_notes,
+    },
+];
 
 /// One shard folder's manifest, as read.
 pub struct Part {

@@ -1,5 +1,7 @@
 //! Features the export's cell size cannot resolve, found before sampling
-//! from the design's thinnest stated feature ([`Model::thinnest_feature`]).
+//! from the design's thinnest stated feature ([`Model::thinnest_feature`])
+//! and, where the design holds geometry whose thickness is not stated,
+//! from sampling its distance ([`Model::sampled_thinnest`]).
 //!
 //! A feature survives sampling when at least two cells span it: a strut of
 //! diameter `t` sampled with cells larger than `t / 2` can fall between the
@@ -42,26 +44,68 @@ fn two_digits(x: f64, round: fn(f64) -> f64) -> f64 {
 
 /// A `warning: …` line when cells of `size` mm (set by `option`) cannot
 /// resolve the design's thinnest feature, naming the size that would; a
-/// plain note when the design holds geometry whose thickness is unknown.
+/// plain note when the design holds geometry whose thickness is not stated
+/// (measured by sampling, [`Model::sampled_thinnest`], or not at all when
+/// the design is unbounded). Designs whose thickness is all stated are
+/// not sampled.
 pub fn thin_feature_notes(model: &Model, size: f64, option: &str) -> Vec<String> {
     let t = model.thinnest_feature();
+    // A sampled feature is at least `2 h` thick and warns only when it is
+    // narrower than two cells, so cells no larger than `h` never meet one:
+    // fine exports skip the sampling (as costly as a coarse export).
+    let spacing = model.thin_sampling_spacing();
+    let fine = spacing.is_some_and(|h| size <= h);
+    let sampled = if t.unknown.is_empty() || fine {
+        None
+    } else {
+        model.sampled_thinnest()
+    };
+    let found = sampled.and_then(|s| s.feature.as_ref().map(|f| (s.spacing, f)));
+    let stated = t.feature.as_ref();
+    let limit = |thickness: f64| thickness / CELLS_ACROSS;
     let mut out = Vec::new();
-    if let Some(f) = &t.feature {
-        let limit = f.thickness / CELLS_ACROSS;
-        if size > limit {
+    match (stated, found) {
+        (_, Some((h, f)))
+            if stated.is_none_or(|s| f.thickness < s.thickness) && size > limit(f.thickness) =>
+        {
+            let [x, y, z] = f.at.to_array().map(|v| (v * 10.0).round() / 10.0 + 0.0);
             out.push(format!(
-                "warning: the design's thinnest feature ({} mm, {} mm across) is narrower than two cells of {option} {size}: it can vanish or break into loose pieces; {option} {} resolves it",
-                f.what,
-                f.thickness,
-                size_below(limit)
+                "warning: the design's thinnest feature (a wall or strut of {} about {} mm across near ({x}, {y}, {z}) mm, measured by sampling every {} mm) is narrower than two cells of {option} {size}: it can vanish or break into loose pieces; {option} {} resolves it",
+                t.unknown.join(" or "),
+                two_digits(f.thickness, f64::round),
+                size_above(h),
+                size_below(limit(f.thickness))
             ));
         }
+        (Some(f), _) if size > limit(f.thickness) => out.push(format!(
+            "warning: the design's thinnest feature ({} mm, {} mm across) is narrower than two cells of {option} {size}: it can vanish or break into loose pieces; {option} {} resolves it",
+            f.what,
+            f.thickness,
+            size_below(limit(f.thickness))
+        )),
+        _ => {}
     }
     if !t.unknown.is_empty() {
-        out.push(format!(
-            "thin features of {} are not checked against {option} {size} (their thickness is not stated in the design)",
-            t.unknown.join(" and ")
-        ));
+        out.push(match sampled {
+            Some(s) => format!(
+                "thin features of {} were measured by sampling every {} mm: features thinner than {} mm are not checked against {option} {size}",
+                t.unknown.join(" and "),
+                size_above(s.spacing),
+                size_above(3.0 * s.spacing)
+            ),
+            None => match spacing {
+                Some(h) => format!(
+                    "thin features of {} were not sampled: sampling every {} mm finds features down to {} mm, which {option} {size} resolves",
+                    t.unknown.join(" and "),
+                    size_above(h),
+                    size_above(2.0 * h)
+                ),
+                None => format!(
+                    "thin features of {} are not checked against {option} {size} (their thickness is not stated in the design, and it is unbounded, so it cannot be sampled)",
+                    t.unknown.join(" and ")
+                ),
+            },
+        });
     }
     out
 }

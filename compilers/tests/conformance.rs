@@ -8,6 +8,9 @@
 //! program fails the test, as a missing `ccx` does, unless
 //! `VOLCAD_SKIP_CONFORMANCE=1`.
 
+// A failed setup step (a scratch folder, a file read) fails the test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 mod common;
 
 use std::io::{Cursor, Read};

@@ -2,6 +2,9 @@
 //! and oblique shapes, determinism across thread counts, material errors,
 //! sizing expressions.
 
+// A failed setup step (a scratch folder, a file read) fails the test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;

@@ -3,6 +3,9 @@
 //! counts against analytic volumes, byte-identical archives across thread
 //! counts, and refusals that leave nothing behind.
 
+// A failed setup step (a scratch folder, a file read) fails the test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 mod common;
 
 use std::io::{Cursor, Read};
@@ -93,9 +96,18 @@ fn graded_bar_matches_pyvcad_structure() {
     want.sort();
     assert_eq!(names, want);
     let xml = String::from_utf8(entry(&mut z, "ConfigFile.xml")).unwrap();
+    bar_config_matches_pyvcad(&xml);
+    assert_eq!(s.counts.iter().map(|c| c.1).sum::<u64>(), 355 * 119 * 186);
+    bar_slices_match_pyvcad(&mut z);
+    bar_mesh_matches_pyvcad(&mut z);
+}
+
+/// The graded bar's ConfigFile.xml against pyvcad 2.3.4's: element order,
+/// values, materials and voxel counts.
+fn bar_config_matches_pyvcad(xml: &str) {
     // pyvcad 2.3.4's element order.
     assert_eq!(
-        tags(&xml),
+        tags(xml),
         [
             "GCVF",
             "Version",
@@ -142,12 +154,12 @@ fn graded_bar_matches_pyvcad_structure() {
         ("ImageFilePrefix", "gcvf_export_"),
         ("BackGroundMaterialRGBA", "0 0 0 0"),
     ] {
-        assert_eq!(field(&xml, tag), [value], "{tag}");
+        assert_eq!(field(xml, tag), [value], "{tag}");
     }
     // Our materials come in the design's id order (pyvcad: FGrade order).
-    let mut mats: Vec<(&str, &str)> = field(&xml, "Name")
+    let mut mats: Vec<(&str, &str)> = field(xml, "Name")
         .into_iter()
-        .zip(field(&xml, "RGBA"))
+        .zip(field(xml, "RGBA"))
         .collect();
     mats.sort();
     assert_eq!(
@@ -156,7 +168,7 @@ fn graded_bar_matches_pyvcad_structure() {
     );
     // Every voxel of the grid is inside the bar, as in pyvcad's file
     // (3 925 490 VeroMgnt + 3 932 080 VeroCyan = 355 · 119 · 186).
-    let counts: Vec<u64> = field(&xml, "VoxelCount")
+    let counts: Vec<u64> = field(xml, "VoxelCount")
         .iter()
         .map(|c| c.parse().unwrap())
         .collect();
@@ -167,9 +179,12 @@ fn graded_bar_matches_pyvcad_structure() {
             "{counts:?}"
         );
     }
-    assert_eq!(s.counts.iter().map(|c| c.1).sum::<u64>(), 355 * 119 * 186);
+}
+
+/// The graded bar's slices and Z-buffer against pyvcad 2.3.4's.
+fn bar_slices_match_pyvcad(z: &mut zip::ZipArchive<Cursor<Vec<u8>>>) {
     // Slices: 8-bit RGBA; X flipped as pyvcad's: VeroMgnt (+x) in column 0.
-    let first = decode(&entry(&mut z, "gcvf_export_0.png"));
+    let first = decode(&entry(z, "gcvf_export_0.png"));
     assert_eq!((first.width, first.height), (355, 119));
     assert_eq!(
         (first.color, first.depth),
@@ -187,7 +202,7 @@ fn graded_bar_matches_pyvcad_structure() {
         column(354)
     );
     // Z-buffer: 16-bit, the top layer's index everywhere (pyvcad: 185).
-    let zb = decode(&entry(&mut z, "Zbuffer.png"));
+    let zb = decode(&entry(z, "Zbuffer.png"));
     assert_eq!(
         (zb.width, zb.height, zb.depth),
         (355, 119, png::BitDepth::Sixteen)
@@ -197,15 +212,19 @@ fn graded_bar_matches_pyvcad_structure() {
             .chunks_exact(2)
             .all(|v| u16::from_be_bytes([v[0], v[1]]) == 185)
     );
+}
+
+/// The graded bar's MeshBbx.ktn and Mesh.stl against pyvcad 2.3.4's.
+fn bar_mesh_matches_pyvcad(z: &mut zip::ZipArchive<Cursor<Vec<u8>>>) {
     // MeshBbx.ktn: pyvcad's (0, 0, 0, 355, 119, 186).
-    let ktn: Vec<f32> = entry(&mut z, "MeshBbx.ktn")
+    let ktn: Vec<f32> = entry(z, "MeshBbx.ktn")
         .chunks_exact(4)
         .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
         .collect();
     assert_eq!(ktn, [0.0, 0.0, 0.0, 355.0, 119.0, 186.0]);
     // Mesh.stl: pyvcad's spans x 0..15, y −10..0, z 0..5 mm; ours sits in
     // the same frame, within the grid's overhang (under one voxel a side).
-    let stl = entry(&mut z, "Mesh.stl");
+    let stl = entry(z, "Mesh.stl");
     let n = u32::from_le_bytes(stl[80..84].try_into().unwrap()) as usize;
     assert_eq!(stl.len(), 84 + 50 * n);
     let (mut lo, mut hi) = ([f32::MAX; 3], [f32::MIN; 3]);

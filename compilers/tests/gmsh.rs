@@ -6,6 +6,9 @@
 //! A missing gmsh fails the test, as a missing `ccx` does, unless
 //! `VOLCAD_SKIP_CONFORMANCE=1`.
 
+// A failed setup step (a scratch folder, a file read) fails the test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 mod common;
 
 use std::collections::HashMap;

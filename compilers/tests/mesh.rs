@@ -2,6 +2,9 @@
 //! segments that cover the part once with shared interfaces, the 3MF
 //! structure, deterministic bytes, cancel and bad input.
 
+// A failed setup step (a scratch folder, a file read) fails the test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 mod common;
 
 use std::collections::HashMap;

@@ -6,6 +6,9 @@
 //! Plain timers (no criterion): `bench::median_points_per_second`, the
 //! median of up to five passes after a warm-up, as `volcad bench` reports.
 
+// A benchmark crate: its helper functions stop on a failed setup as its tests do.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::path::PathBuf;
 
 use volcad_core::Model;

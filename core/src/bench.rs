@@ -8,6 +8,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::Model;
+pub use crate::xorshift::XorShift;
 
 /// `n` points within `band` mm of the surface, uniformly distributed over
 /// that band, drawn deterministically (xorshift from `seed`): the hard case

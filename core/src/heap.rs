@@ -99,11 +99,11 @@ pub fn available_memory() -> Option<u64> {
 }
 
 /// The environment variable that sets a script's heap budget in MiB.
-pub const BUDGET_VAR: &str = "VOLCAD_SCRIPT_MEMORY_MB";
+pub(crate) const BUDGET_VAR: &str = "VOLCAD_SCRIPT_MEMORY_MB";
 
 /// The budget [`BUDGET_VAR`] asks for, in bytes: `Ok(None)` when it is not
 /// set, an error naming it when it is not a whole number of MiB above 0.
-pub fn budget_from_env() -> Result<Option<u64>, String> {
+pub(crate) fn budget_from_env() -> Result<Option<u64>, String> {
     let Some(v) = std::env::var_os(BUDGET_VAR) else {
         return Ok(None);
     };
@@ -135,7 +135,7 @@ pub fn address_space_left() -> Option<u64> {
 /// fails, and a failed allocation aborts a Rust process). A design script
 /// needs megabytes; the budget only has to stop a runaway while its peak
 /// (about three budgets, see the module doc) still fits.
-pub fn default_script_budget() -> u64 {
+pub(crate) fn default_script_budget() -> u64 {
     let budget = match budget_from_env() {
         Ok(Some(b)) => b,
         _ => available_memory().map_or(4 << 30, |a| a / 4),

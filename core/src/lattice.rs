@@ -9,7 +9,7 @@ use glam::DVec3;
 use crate::node::LatticeType;
 
 /// The struts of one unit cell of `kind`, scaled to `cell` (full side lengths).
-pub fn unit_cell_edges(kind: LatticeType, cell: DVec3) -> Vec<(DVec3, DVec3)> {
+pub(crate) fn unit_cell_edges(kind: LatticeType, cell: DVec3) -> Vec<(DVec3, DVec3)> {
     let h = 0.5;
     let corners: Vec<DVec3> = (0..8)
         .map(|i| {

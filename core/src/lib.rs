@@ -22,16 +22,28 @@
 //! let model = Model::prepare(&design.root, design.materials.clone()).unwrap();
 //! assert!((model.distance(glam::DVec3::new(12.0, 0.0, 0.0)) - 2.0).abs() < 1e-12);
 //! ```
+//!
+//! ## Embedding
+//!
+//! The crate root holds what a program that samples designs needs:
+//! [`model_of_file`] (or [`run_script`] and [`Model::prepare`]) gives a
+//! [`Model`]; a [`Grid`] over its box and a [`Sampler`] made for a
+//! [`Consumer`] fill a caller-owned [`Slab`] a few layers at a time, on
+//! the current rayon pool. `cargo run -p volcad-core --example sample`
+//! shows the whole path. The modules hold the rest: [`attribute`]s a
+//! design carries, [`material`] tables, the [`node`] tree, imported
+//! [`trimesh`]es and [`simfield`]s, [`text`] outlines, the legacy
+//! [`vcad`] language, and the [`heap`] accounting the binaries install.
 #![warn(missing_docs)]
 
-pub mod aabb;
+mod aabb;
 pub mod attribute;
 pub mod bench;
 pub mod expr;
-pub mod fastmath;
+mod fastmath;
 pub mod heap;
 pub mod interval;
-pub mod lattice;
+mod lattice;
 pub mod material;
 pub mod model;
 pub mod names;
@@ -39,14 +51,20 @@ pub mod node;
 pub mod sampler;
 pub mod script;
 pub mod simfield;
-pub mod spatial;
+mod spatial;
 pub mod text;
 pub mod trimesh;
 pub mod vcad;
-pub mod xorshift;
+mod xorshift;
 
 pub use aabb::Aabb;
+pub use fastmath::round_i32;
 pub use glam::DVec3;
+pub use interval::Interval;
 pub use material::{MaterialId, MaterialTable};
 pub use model::{Model, Points, PrepareError};
 pub use node::{Node, NodeKind};
+pub use sampler::{Consumer, Grid, Sampler, Slab};
+pub use script::{
+    Design, DesignError, ScriptError, ScriptOptions, model_of, model_of_file, run_script,
+};

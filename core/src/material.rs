@@ -114,12 +114,12 @@ pub struct MaterialTable {
 }
 
 /// pyvcad's default table (`configs/default.json`): red, green, blue, ...
-pub const DEFAULT_JSON: &str = include_str!("../../assets/materials/default.json");
+pub(crate) const DEFAULT_JSON: &str = include_str!("../../assets/materials/default.json");
 /// pyvcad's J750 table (`configs/j750.json`: 33 materials, ids and colours
 /// as pyvcad 2.3.4 has them), with elastic properties for the Vero and
 /// Agilus30 families and the names of our older table as aliases
 /// (VeroMagenta, VeroWhite, Agilus30).
-pub const J750_JSON: &str = include_str!("../../assets/materials/j750.json");
+pub(crate) const J750_JSON: &str = include_str!("../../assets/materials/j750.json");
 
 impl MaterialTable {
     /// Parse a table from JSON text; `origin` names it in errors.
@@ -175,11 +175,16 @@ impl MaterialTable {
     }
 
     /// pyvcad's default table.
+    // The bundled JSON is compiled in and every test that prepares a
+    // design parses it: it cannot fail in a build that passed its tests.
+    #[allow(clippy::expect_used)]
     pub fn default_table() -> Self {
         Self::from_json(DEFAULT_JSON, "<default>").expect("bundled default.json is valid")
     }
 
     /// The J750-class table.
+    // Compiled in as `default_table`'s is, and parsed by this module's tests.
+    #[allow(clippy::expect_used)]
     pub fn j750() -> Self {
         Self::from_json(J750_JSON, "<j750>").expect("bundled j750.json is valid")
     }
@@ -291,7 +296,7 @@ pub fn nearest_name<'a>(wanted: &str, names: impl IntoIterator<Item = &'a str>) 
 }
 
 /// Levenshtein distance, for "did you mean" suggestions.
-pub fn edit_distance(a: &str, b: &str) -> usize {
+pub(crate) fn edit_distance(a: &str, b: &str) -> usize {
     let b: Vec<char> = b.chars().collect();
     let mut prev: Vec<usize> = (0..=b.len()).collect();
     let mut cur = vec![0; b.len() + 1];

@@ -3,6 +3,9 @@
 //! failed allocation. The only test of its binary: the limit it sets holds
 //! for the whole process.
 
+// A test crate: its helper functions stop on a failed setup as its tests do.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use rustix::process::{Resource, getrlimit, setrlimit};
 use volcad_core::heap::{CountingAllocator, address_space_left};
 use volcad_core::script::{ScriptOptions, run_script};

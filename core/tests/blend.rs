@@ -3,6 +3,9 @@
 //! after `prepare(Vec3(0.1, 0.1, 0.1), 1, 1)` (its floats are single
 //! precision, hence the 1e-6 tolerance).
 
+// A test crate: its helper functions stop on a failed setup as its tests do.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use volcad_core::script::{ScriptOptions, run_script};
 use volcad_core::{DVec3, Model};
 

@@ -3,6 +3,9 @@
 //! the default for spawned threads), and the chains that cannot be read
 //! flat are refused with the depth and what to write instead.
 
+// A test crate: its helper functions stop on a failed setup as its tests do.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::sync::Arc;
 
 use volcad_core::expr::{COORD_VARS, Expr};

@@ -2,6 +2,9 @@
 //! prepare in bounded time and memory: endless loops, nodes added to
 //! themselves, thousands of coincident children, sizes of 1e308.
 
+// A test crate: its helper functions stop on a failed setup as its tests do.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 

@@ -4,6 +4,9 @@
 //!
 //! `cargo test -p volcad-core --test meshio`
 
+// A test crate: its helper functions stop on a failed setup as its tests do.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 #[path = "meshio/writers.rs"]
 mod writers;
 

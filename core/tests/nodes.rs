@@ -4,10 +4,13 @@
 //! test written from the shape's definition), the interval property over
 //! random boxes, and pyvcad 2.3.4's values for `Sum`.
 
+// A test crate: its helper functions stop on a failed setup as its tests do.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::f64::consts::{PI, TAU};
 
+use volcad_core::bench::XorShift;
 use volcad_core::script::{ScriptOptions, run_script};
-use volcad_core::xorshift::XorShift;
 use volcad_core::{Aabb, DVec3, Model};
 
 fn model(src: &str) -> Model {

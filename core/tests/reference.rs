@@ -14,6 +14,9 @@
 //!   approximates it on a grid; ours is compared with the exact distance the
 //!   harness computed (`exact_mesh_distance`).
 
+// A test crate: its helper functions stop on a failed setup as its tests do.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::path::PathBuf;
 
 use serde_json::Value;

@@ -2,6 +2,9 @@
 //! process goes on (this test binary installs the counting allocator, as
 //! the `volcad` and `volcad-studio` binaries do).
 
+// A test crate: its helper functions stop on a failed setup as its tests do.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use volcad_core::heap::{CountingAllocator, live_bytes};
 use volcad_core::script::{ScriptOptions, run_script};
 

@@ -3,13 +3,16 @@
 //! test names "DejaVu Sans", which resolves to the built-in font, so the
 //! outlines are the same on every machine.
 
+// A test crate: its helper functions stop on a failed setup as its tests do.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use glam::{DVec2, DVec3};
+use volcad_core::bench::XorShift;
 use volcad_core::model::polygon2d::Polygon2d;
 use volcad_core::script::{ScriptOptions, run_script};
 use volcad_core::text::{
     FontAspect, HorizontalAlignment, TextOutline, TextStyle, VerticalAlignment, outline,
 };
-use volcad_core::xorshift::XorShift;
 use volcad_core::{Aabb, Model};
 
 fn style(h: HorizontalAlignment, v: VerticalAlignment) -> TextStyle {

@@ -8,6 +8,9 @@
 //! skip the 256 level; `cargo bench -p volcad-render -- bunny` runs only
 //! the designs whose name contains `bunny`.
 
+// A failed setup step fails the benchmark run.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 #[path = "../tests/common/mod.rs"]
 mod common;
 
@@ -91,33 +94,11 @@ fn main() {
     let mut reference: Vec<Vec<u16>> = Vec::new();
     for (name, model) in &designs {
         let name = name.as_str();
-        // Coarse first image: bake 64 + upload + one frame.
-        let t = Instant::now();
-        let b = bake_blocking(model, 64).unwrap();
-        let t_bake = t.elapsed().as_secs_f64();
-        off.upload(&b);
-        let t_upload = t.elapsed().as_secs_f64();
-        let cam = Camera::fit(&model.bbox(), StandardView::Iso);
         let solid = ViewSettings {
-            camera: cam,
+            camera: Camera::fit(&model.bbox(), StandardView::Iso),
             ..Default::default()
         };
-        off.render(&solid).unwrap();
-        let first = t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        let b = bake_blocking(model, 64).unwrap();
-        off.upload(&b);
-        off.render(&ViewSettings {
-            render_scale: 0.5,
-            ..solid.clone()
-        })
-        .unwrap();
-        let first_half = t.elapsed().as_secs_f64();
-        println!(
-            "{name:<18} first coarse image (bake 64 + upload + 1280x800 frame + readback): {first:.3} s (bake {t_bake:.3}, upload {:.3}, frame {:.3}), at render_scale 0.5: {first_half:.3} s",
-            t_upload - t_bake,
-            first - t_upload
-        );
+        first_image(&mut off, name, model, &solid);
         for &level in levels {
             let b = bake_blocking(model, level).unwrap();
             off.upload(&b);
@@ -188,8 +169,40 @@ fn main() {
     if filter.is_some() {
         return;
     }
-    // Thin features: coverage of the BCC sphere's disk (front, orthographic)
-    // by level and bias. The finest level without bias is the reference.
+    thin_feature_coverage(&mut off, levels, &out);
+    println!("images in {}", out.display());
+}
+
+/// The time to a first coarse image (bake 64 + upload + one frame and its
+/// readback), at full and at half render scale.
+fn first_image(off: &mut Offscreen, name: &str, model: &Model, solid: &ViewSettings) {
+    // Coarse first image: bake 64 + upload + one frame.
+    let t = Instant::now();
+    let b = bake_blocking(model, 64).unwrap();
+    let t_bake = t.elapsed().as_secs_f64();
+    off.upload(&b);
+    let t_upload = t.elapsed().as_secs_f64();
+    off.render(solid).unwrap();
+    let first = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let b = bake_blocking(model, 64).unwrap();
+    off.upload(&b);
+    off.render(&ViewSettings {
+        render_scale: 0.5,
+        ..solid.clone()
+    })
+    .unwrap();
+    let first_half = t.elapsed().as_secs_f64();
+    println!(
+        "{name:<18} first coarse image (bake 64 + upload + 1280x800 frame + readback): {first:.3} s (bake {t_bake:.3}, upload {:.3}, frame {:.3}), at render_scale 0.5: {first_half:.3} s",
+        t_upload - t_bake,
+        first - t_upload
+    );
+}
+
+/// Thin features: coverage of the BCC sphere's disk (front, orthographic)
+/// by level and bias. The finest level without bias is the reference.
+fn thin_feature_coverage(off: &mut Offscreen, levels: &[u32], out: &std::path::Path) {
     let model = model(BCC_SPHERE);
     let mut cam = Camera::fit(&model.bbox(), StandardView::Front);
     cam.orthographic = true;
@@ -229,5 +242,4 @@ fn main() {
         off.renderer_mut()
             .set_thin_bias_voxels(volcad_render::THIN_BIAS_VOXELS);
     }
-    println!("images in {}", out.display());
 }

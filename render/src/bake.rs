@@ -24,7 +24,7 @@ use std::time::Instant;
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-use volcad_core::sampler::{Cancelled, Grid, GridError, Sampler, Slab};
+use volcad_core::sampler::{Cancelled, Consumer, Grid, GridError, Sampler, Slab};
 use volcad_core::{Aabb, MaterialId, Model};
 
 use crate::attribute_bake::{AttributeEval, AttributeShading, shade};
@@ -222,7 +222,7 @@ pub fn bake_shaded(
     let mut color = vec![[0u8; 4]; n];
     let mut fractions = vec![[0u8; 4]; n];
 
-    let sampler = Sampler::new(model, grid, true);
+    let sampler = Sampler::new(model, grid, Consumer::ViewportBake);
     let mut slab = Slab::default();
     let layers_per_slab = (1usize << 18).div_ceil(layer).clamp(1, nz);
     let mut z0 = 0;

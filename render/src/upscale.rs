@@ -38,31 +38,14 @@ impl Upscaler {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("volcad upscale"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = crate::wgpu_parts::fullscreen_pipeline(
+            device,
+            "volcad upscale",
+            &pipeline_layout,
+            &module,
+            wgpu::PipelineCompilationOptions::default(),
+            format,
+        );
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("volcad upscale"),
             mag_filter: wgpu::FilterMode::Linear,
@@ -80,36 +63,42 @@ impl Upscaler {
 
     /// The render target of `size` (made again only when the size changes).
     pub(crate) fn target(&mut self, device: &wgpu::Device, size: [u32; 2]) -> &wgpu::TextureView {
-        if self.target.as_ref().is_none_or(|t| t.size != size) {
-            let texture = crate::wgpu_parts::target_texture(
-                device,
-                "volcad reduced resolution",
-                size,
-                self.format,
-                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            );
-            let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
-            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("volcad upscale"),
-                layout: &self.layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::TextureView(&view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::Sampler(&self.sampler),
-                    },
-                ],
-            });
-            self.target = Some(Target {
-                size,
-                view,
-                bind_group,
-            });
+        let target = match self.target.take() {
+            Some(t) if t.size == size => t,
+            _ => self.make_target(device, size),
+        };
+        &self.target.insert(target).view
+    }
+
+    /// A render target of `size` and the bind group that samples it.
+    fn make_target(&self, device: &wgpu::Device, size: [u32; 2]) -> Target {
+        let texture = crate::wgpu_parts::target_texture(
+            device,
+            "volcad reduced resolution",
+            size,
+            self.format,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("volcad upscale"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::Sampler(&self.sampler),
+                },
+            ],
+        });
+        Target {
+            size,
+            view,
+            bind_group,
         }
-        &self.target.as_ref().expect("target just made").view
     }
 
     /// Draw the reduced image over the whole viewport of `pass`.

@@ -1,6 +1,6 @@
-//! Bind-group entries and render targets that the ray-march pipeline
-//! ([`crate::gpu`]), the upscaler and the offscreen renderer all build the
-//! same way.
+//! Bind-group entries, render targets and full-screen pipelines that the
+//! ray-march pipeline ([`crate::gpu`]), the upscaler and the offscreen
+//! renderer all build the same way.
 
 /// A fragment-stage binding of a filterable float texture.
 pub(crate) fn texture_entry(
@@ -51,5 +51,43 @@ pub(crate) fn target_texture(
         format,
         usage,
         view_formats: &[],
+    })
+}
+
+/// A pipeline that draws one full-screen triangle: `vs_main` and `fs_main`
+/// of `module` (with `options`, its pipeline constants), writing `format`
+/// without blending or depth.
+pub(crate) fn fullscreen_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    options: wgpu::PipelineCompilationOptions<'_>,
+    format: wgpu::TextureFormat,
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_main"),
+            compilation_options: options.clone(),
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: None,
+        multisample: wgpu::MultisampleState::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some("fs_main"),
+            compilation_options: options,
+            targets: &[Some(wgpu::ColorTargetState {
+                format,
+                blend: None,
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+        }),
+        multiview_mask: None,
+        cache: None,
     })
 }

@@ -38,7 +38,7 @@ fn bake_covers_the_box_with_padding_and_colours() {
 }
 
 #[test]
-fn bake_cancels() {
+fn a_bake_cancelled_before_it_starts_returns_cancelled() {
     let model = model(BCC_SPHERE);
     assert_eq!(
         bake(&model, 64, &AtomicBool::new(true)).unwrap_err(),

@@ -1,4 +1,4 @@
-//! `volcad export png|mesh|fea`: run an export job
+//! `volcad export png|mesh|fea|gcvf|vat`: run an export job
 //! with a progress bar; Ctrl-C cancels cleanly (nothing is left behind).
 
 use std::path::{Path, PathBuf};
@@ -13,7 +13,7 @@ use volcad_compilers::bitmaps::BitmapFormat;
 use volcad_compilers::fea::{Element, EndSets, FeaParams, Sizing, StepParams};
 use volcad_compilers::job::{self, design_hash};
 use volcad_compilers::mesh::{MeshFormats, MeshParams, SegmentBy};
-use volcad_compilers::plan::{self, ExportParams, Severity, Verdict, blocking};
+use volcad_compilers::plan::{ExportParams, Severity, Verdict, blocking};
 use volcad_compilers::png_stack::{self, Dither, PngParams};
 use volcad_compilers::shard;
 
@@ -31,12 +31,14 @@ pub enum Kind {
     Fea,
     /// GrabCAD Voxel Print package for PolyJet (J750) printers (.gcvf).
     Gcvf,
+    /// Grayscale slice stack for vat photopolymer (MSLA) printers.
+    Vat,
 }
 
 /// `volcad export` options (spelled as scripts rely on them).
 #[derive(clap::Args, Debug)]
 pub struct ExportArgs {
-    /// png, mesh or fea.
+    /// png, mesh, fea, gcvf or vat.
     #[arg(value_enum)]
     pub kind: Kind,
     /// The design.
@@ -52,7 +54,7 @@ pub struct ExportArgs {
     /// part per axis (its summary and manifest give both sizes).
     #[arg(long, allow_hyphen_values = true)]
     pub voxel: Option<String>,
-    /// Printer preset for the voxel size (png): j750.
+    /// Printer preset: the voxel size for png (j750, j750-hq, cube-0.1), the screen for vat (saturn-4-ultra, photon-mono-m7-pro).
     #[arg(long)]
     pub preset: Option<String>,
     /// Worker threads (default: all cores).
@@ -61,16 +63,16 @@ pub struct ExportArgs {
     /// Seed of the material draw (same seed, same bytes).
     #[arg(long, default_value_t = 0, allow_negative_numbers = true)]
     pub seed: u64,
-    /// png: only layers A..B (A to B-1, B excluded) or A..=B (A to B
+    /// png, vat: only layers A..B (A to B-1, B excluded) or A..=B (A to B
     /// included); file names keep the global layer indices.
     #[arg(long)]
     pub layers: Option<String>,
-    /// png: only the K-th of N equal layer ranges (K counts from 1: 1/4 is
+    /// png, vat: only the K-th of N equal layer ranges (K counts from 1: 1/4 is
     /// the lowest quarter, 4/4 the top); file names keep the global layer
     /// indices, and `volcad merge` joins the N folders into the single export.
     #[arg(long, value_name = "K/N")]
     pub shard: Option<String>,
-    /// png: random (default) or diffusion.
+    /// png, gcvf, vat: random (default) or diffusion.
     #[arg(long)]
     pub dither: Option<String>,
     /// png: also write 1-bit stacks, one folder per material.
@@ -124,6 +126,9 @@ pub struct ExportArgs {
     /// fea: end sets, pieces and property bins.
     #[command(flatten)]
     pub fea_checks: Box<FeaChecks>,
+    /// vat: intensity, vats and printer screen.
+    #[command(flatten)]
+    pub vat: Box<super::vat::VatArgs>,
     /// Override the refusals that protect your work and machine: replace a
     /// finished export in --out (a folder holding our manifest.json), and
     /// (fea) write a deck even when CalculiX would need more memory than
@@ -186,7 +191,7 @@ fn parse_voxel(s: &str) -> anyhow::Result<DVec3> {
     Ok(v)
 }
 
-fn parse_layers(s: &str) -> anyhow::Result<std::ops::Range<usize>> {
+pub(super) fn parse_layers(s: &str) -> anyhow::Result<std::ops::Range<usize>> {
     let (a, b, inclusive) = match s.split_once("..=") {
         Some((a, b)) => (a, b, true),
         None => {
@@ -239,10 +244,14 @@ fn parse_formats(s: &str) -> anyhow::Result<MeshFormats> {
 /// The options given that belong to another kind of export than `a.kind`.
 fn foreign_options(a: &ExportArgs) -> Vec<&'static str> {
     let given = [
-        ("--layers", a.layers.is_some(), Kind::Png),
+        (
+            "--layers",
+            a.layers.is_some() && a.kind != Kind::Vat,
+            Kind::Png,
+        ),
         (
             "--dither",
-            a.dither.is_some() && a.kind != Kind::Gcvf,
+            a.dither.is_some() && !matches!(a.kind, Kind::Gcvf | Kind::Vat),
             Kind::Png,
         ),
         ("--bitmaps", a.bitmaps, Kind::Png),
@@ -250,6 +259,7 @@ fn foreign_options(a: &ExportArgs) -> Vec<&'static str> {
         ("--bitmap-width", a.bitmap_width.is_some(), Kind::Png),
         ("--full-color", a.full_color, Kind::Png),
         ("--color-profile", a.color_profile.is_some(), Kind::Png),
+        ("--map", a.map.is_some() && a.kind != Kind::Gcvf, Kind::Png),
         (
             "--liquid-keep-out",
             a.liquid_keep_out.is_some() && a.kind != Kind::Gcvf,
@@ -274,10 +284,12 @@ fn foreign_options(a: &ExportArgs) -> Vec<&'static str> {
         ("--load", a.fea_checks.load.is_some(), Kind::Fea),
         ("--allow-pieces", a.fea_checks.allow_pieces, Kind::Fea),
     ];
+    let vat = a.vat.given().into_iter().map(|n| (n, true, Kind::Vat));
     given
-        .iter()
+        .into_iter()
+        .chain(vat)
         .filter(|(_, on, kind)| *on && *kind != a.kind)
-        .map(|(name, ..)| *name)
+        .map(|(name, ..)| name)
         .collect()
 }
 
@@ -339,7 +351,7 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
             if foreign.len() == 1 { "does" } else { "do" }
         );
     }
-    if a.shard.is_some() && a.kind != Kind::Png {
+    if a.shard.is_some() && !matches!(a.kind, Kind::Png | Kind::Vat) {
         bail!(shard::not_shardable(
             &format!("{:?}", a.kind).to_lowercase()
         ));
@@ -350,6 +362,8 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
     let l = load_design(&a.design)?;
     let model = l.model.clone();
     let voxel = match (&a.voxel, &a.preset) {
+        // A vat printer's pixel and layer are its voxel (`vat.rs`).
+        _ if a.kind == Kind::Vat => None,
         (Some(v), _) => Some(parse_voxel(v)?),
         (None, Some(p)) => Some(
             png_stack::presets()
@@ -376,17 +390,17 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
     if let Some(t) = a.threads {
         volcad_compilers::resources::check_threads(t)?;
     }
+    // A GrabCAD package is one file, not a folder of ours.
+    let dest = match a.kind {
+        Kind::Gcvf => super::gcvf::package_path(&a.out)?,
+        _ => a.out.clone(),
+    };
     let params = match a.kind {
-        // A GrabCAD package is one file, not a folder of ours: it has its
-        // own checks and job (`gcvf.rs`).
-        Kind::Gcvf => {
-            let interrupted = interrupt_flag();
-            let handle = super::gcvf::start(a, model, voxel, hash, a.out.clone())?;
-            return follow(handle, &interrupted);
-        }
+        Kind::Gcvf => ExportParams::Gcvf(super::gcvf::gcvf_params(a, voxel, &dest)?),
         Kind::Png => ExportParams::Png(png_params(a, voxel)?),
         Kind::Mesh => ExportParams::Mesh(mesh_params(a, voxel, &model)?),
         Kind::Fea => ExportParams::Fea(fea_params(a, voxel, &model)?),
+        Kind::Vat => ExportParams::Vat(super::vat::vat_params(a, &model)?),
     };
     // `--preset j750` relabels the design with the printer's resins (a
     // full-colour stack is made of them whatever the design's materials).
@@ -394,7 +408,7 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
         ExportParams::Png(_) if !a.full_color => super::gcvf::printer_model(a, model)?,
         _ => model,
     };
-    let verdicts = preflight(&params, &model, &a.out)?;
+    let verdicts = preflight(&params, &model, &dest)?;
     for v in verdicts.iter().filter(|v| v.severity == Severity::Warn) {
         eprintln!("{}", v.message);
     }
@@ -412,7 +426,7 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
         .design
         .file_name()
         .map(|n| n.to_string_lossy().into_owned());
-    let handle = params.run(model, a.out.clone(), hash, design);
+    let handle = params.run(model, dest, hash, design);
     follow(handle, &interrupted)
 }
 
@@ -431,7 +445,7 @@ fn preflight(
         note!("estimate: {}", a.text);
         (a.verdicts, a.disk_bytes)
     };
-    verdicts.extend(plan::preflight(disk, dest));
+    verdicts.extend(params.preflight(disk, dest));
     Ok(verdicts)
 }
 
@@ -557,16 +571,6 @@ fn fea_params(
         solver_memory: None,
         threads: a.threads,
     })
-}
-
-/// Print the warnings about features thinner than `size` can resolve
-/// before the export starts (the summary repeats them).
-pub(super) fn warn_thin(model: &volcad_core::Model, size: f64, option: &str) {
-    for n in volcad_compilers::thin::thin_feature_notes(model, size, option) {
-        if n.starts_with("warning") {
-            eprintln!("{n}");
-        }
-    }
 }
 
 /// A flag that Ctrl-C, SIGTERM and SIGHUP set, for [`follow`] to cancel the

@@ -1,32 +1,26 @@
 //! `volcad export gcvf DESIGN --out part.gcvf`: a GrabCAD Voxel Print
 //! package for PolyJet printers, and the J750 material table that
-//! `--preset j750` brings to PNG stacks (`--map red=VeroMgnt`).
+//! `--preset j750` brings to PNG stacks (`--map red=VeroMgnt`). The checks
+//! and the job are the export plan's (`plan::ExportParams::Gcvf`).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use anyhow::{Context, bail};
 use glam::DVec3;
-use volcad_compilers::gcvf::{self, GcvfParams};
-use volcad_compilers::job::{self, JobHandle};
+use volcad_compilers::gcvf::GcvfParams;
 use volcad_compilers::png_stack;
-use volcad_compilers::printer_table::{parse_map, relabel, resolve};
-use volcad_compilers::resources::check_disk_for;
-use volcad_core::{MaterialTable, Model};
+use volcad_compilers::printer_table::{is_j750_preset, j750_model, parse_map};
+use volcad_core::Model;
 
-use super::export::{ExportArgs, parse_dither, warn_thin};
+use super::export::{ExportArgs, parse_dither};
 use super::output::{Target, target};
-
-/// True for the presets that are J750 grids.
-fn is_j750(preset: Option<&str>) -> bool {
-    preset.is_some_and(|p| p.eq_ignore_ascii_case("j750") || p.eq_ignore_ascii_case("j750-hq"))
-}
 
 /// The design as a PNG stack writes it: with `--preset j750`, relabelled
 /// with J750 resins (refused when a material is not one and `--map` does
 /// not make it one); otherwise unchanged.
 pub(super) fn printer_model(a: &ExportArgs, model: Arc<Model>) -> anyhow::Result<Arc<Model>> {
-    if !is_j750(a.preset.as_deref()) {
+    if !a.preset.as_deref().is_some_and(is_j750_preset) {
         if let Some(m) = &a.map {
             bail!(
                 "--map {m}: maps onto a printer's resins, so it needs --preset j750 (or `volcad export gcvf`)"
@@ -35,38 +29,28 @@ pub(super) fn printer_model(a: &ExportArgs, model: Arc<Model>) -> anyhow::Result
         return Ok(model);
     }
     let map = parse_map(a.map.as_deref().unwrap_or(""))?;
-    let table = MaterialTable::j750();
-    let mats = resolve(&model, &table, &map, "J750")?;
-    Ok(Arc::new(relabel(&model, &mats, &table, "J750")))
+    Ok(j750_model(&model, &map)?)
 }
 
-/// Check everything and start the package's job (see [`gcvf`]).
-pub(super) fn start(
-    a: &ExportArgs,
-    model: Arc<Model>,
-    voxel: Option<DVec3>,
-    hash: String,
-    dest: PathBuf,
-) -> anyhow::Result<JobHandle> {
-    let dest = match target(&dest, "--out")? {
-        Target::Staged(p) => p,
+/// The package's path: `--out` as a file (a symlink to one resolved);
+/// folders and special files are refused.
+pub(super) fn package_path(out: &Path) -> anyhow::Result<PathBuf> {
+    match target(out, "--out")? {
+        Target::Staged(p) => Ok(p),
         _ => bail!(
             "--out {}: a .gcvf is a zip archive written beside its destination and renamed; give a file name",
-            dest.display()
+            out.display()
         ),
-    };
-    // As for export folders: a finished package is replaced only with
-    // --force (the job itself refuses anything that is not a regular file).
-    if !a.force
-        && let Ok(m) = std::fs::metadata(&dest)
-        && m.is_file()
-    {
-        bail!(
-            "--out {}: a file of {:.1} MB is already there; add --force to replace it, or give another name",
-            dest.display(),
-            m.len() as f64 / 1e6
-        );
     }
+}
+
+/// The package's parameters from the options (`voxel` as parsed; the J750
+/// grid when none was given), written to `dest`.
+pub(super) fn gcvf_params(
+    a: &ExportArgs,
+    voxel: Option<DVec3>,
+    dest: &Path,
+) -> anyhow::Result<GcvfParams> {
     let file_name = dest
         .file_name()
         .map(|n| n.to_string_lossy().to_string())
@@ -77,7 +61,7 @@ pub(super) fn start(
             .map(|p| p.voxel)
             .context("the j750 preset")?,
     };
-    let p = GcvfParams {
+    Ok(GcvfParams {
         voxel,
         seed: a.seed,
         dither: parse_dither(a.dither.as_deref())?,
@@ -85,18 +69,5 @@ pub(super) fn start(
         threads: a.threads,
         file_name,
         liquid_keep_out: a.liquid_keep_out,
-    };
-    let (est, _) = gcvf::estimate(&model, &p)?;
-    let [nx, ny, nz] = est.grid.dims;
-    note!(
-        "grid {nx} x {ny} x {nz} ({} voxels); about {:.1} MB, {:.1} MB working memory",
-        est.voxels,
-        est.disk_bytes as f64 / 1e6,
-        est.memory_bytes as f64 / 1e6
-    );
-    check_disk_for(est.disk_bytes, &dest, "a larger voxel size")?;
-    warn_thin(&model, voxel.max_element(), "--voxel");
-    Ok(job::spawn_file(dest, hash, move |ctx| {
-        gcvf::export_gcvf(&model, &p, ctx)
-    }))
+    })
 }

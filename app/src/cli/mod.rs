@@ -31,6 +31,7 @@ mod merge;
 mod output;
 mod render;
 mod sample;
+mod vat;
 
 use std::path::PathBuf;
 

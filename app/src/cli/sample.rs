@@ -87,7 +87,11 @@ pub fn sample(
                 for &i in &wanted {
                     let mut v = [0.0; 4];
                     let v = &mut v[..model.attributes()[i].kind.width()];
-                    model.attribute_at(i, *p, v)?;
+                    if d <= 0.0 {
+                        model.attribute_inside(i, *p, v)?;
+                    } else {
+                        v.fill(f64::NAN);
+                    }
                     for x in v.iter() {
                         s.push(',');
                         s.push_str(&x.to_string());

@@ -162,7 +162,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn legend_numbers() {
+    fn legend_numbers_keep_four_significant_digits() {
         assert_eq!(fmt(2850.0), "2850");
         assert_eq!(fmt(0.35), "0.3500");
         assert_eq!(fmt(12.25), "12.25");

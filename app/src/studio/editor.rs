@@ -345,44 +345,13 @@ impl Editor {
                     self.complete_and_explain(ui, &output, &response, forced);
                     let lines = line_rects(&output.galley, output.galley_pos);
                     let right = ui.clip_rect().right().max(output.response.rect.right());
-                    let mut tints = Vec::new();
-                    let visuals = ui.visuals().clone();
-                    for mark in &self.marks {
-                        if let Some(r) = lines.get(mark.line.saturating_sub(1)) {
-                            let full = Rect::from_x_y_ranges(gutter.left()..=right, r.y_range());
-                            tints.push(Shape::rect_filled(
-                                full,
-                                0.0,
-                                visuals.error_fg_color.gamma_multiply(0.18),
-                            ));
-                        }
-                    }
-                    for (i, m) in matches.iter().enumerate() {
-                        let current = self.find.current.as_ref() == Some(m);
-                        let a = output
-                            .galley
-                            .pos_from_cursor(CCursor::new(textops::byte_to_char(
-                                &self.text, m.start,
-                            )));
-                        let b = output
-                            .galley
-                            .pos_from_cursor(CCursor::new(textops::byte_to_char(
-                                &self.text, m.end,
-                            )));
-                        let rect = Rect::from_min_max(a.min, egui::pos2(b.max.x, a.max.y))
-                            .translate(output.galley_pos.to_vec2());
-                        let color = if current {
-                            Color32::from_rgb(255, 170, 0)
-                        } else {
-                            visuals.warn_fg_color
-                        };
-                        tints.push(Shape::rect_filled(
-                            rect,
-                            2.0,
-                            color.gamma_multiply(if current { 0.55 } else { 0.3 }),
-                        ));
-                        let _ = i;
-                    }
+                    let tints = self.tints(
+                        ui.visuals(),
+                        &output,
+                        &lines,
+                        gutter.left()..=right,
+                        &matches,
+                    );
                     ui.painter().set(under_text, Shape::Vec(tints));
                     self.paint_gutter_and_messages(ui, gutter, &lines, &font);
                     if !defer
@@ -398,6 +367,52 @@ impl Editor {
                 });
             });
         out
+    }
+
+    /// What is drawn under the text: the marked lines across `x` (the gutter
+    /// to the right edge), and the find bar's `matches` (the current one
+    /// brighter).
+    fn tints(
+        &self,
+        visuals: &egui::Visuals,
+        output: &egui::text_edit::TextEditOutput,
+        lines: &[Rect],
+        x: std::ops::RangeInclusive<f32>,
+        matches: &[Range<usize>],
+    ) -> Vec<Shape> {
+        let mut tints = Vec::new();
+        for mark in &self.marks {
+            if let Some(r) = lines.get(mark.line.saturating_sub(1)) {
+                let full = Rect::from_x_y_ranges(x.clone(), r.y_range());
+                tints.push(Shape::rect_filled(
+                    full,
+                    0.0,
+                    visuals.error_fg_color.gamma_multiply(0.18),
+                ));
+            }
+        }
+        for m in matches {
+            let current = self.find.current.as_ref() == Some(m);
+            let at = |byte: usize| {
+                output
+                    .galley
+                    .pos_from_cursor(CCursor::new(textops::byte_to_char(&self.text, byte)))
+            };
+            let (a, b) = (at(m.start), at(m.end));
+            let rect = Rect::from_min_max(a.min, egui::pos2(b.max.x, a.max.y))
+                .translate(output.galley_pos.to_vec2());
+            let color = if current {
+                Color32::from_rgb(255, 170, 0)
+            } else {
+                visuals.warn_fg_color
+            };
+            tints.push(Shape::rect_filled(
+                rect,
+                2.0,
+                color.gamma_multiply(if current { 0.55 } else { 0.3 }),
+            ));
+        }
+        tints
     }
 
     /// After the text was laid out: update and draw the completion list

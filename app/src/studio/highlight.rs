@@ -23,8 +23,8 @@ pub fn settings() -> Arc<SyntectSettings> {
 
 fn build_settings() -> SyntectSettings {
     let mut builder = SyntaxSetBuilder::new();
-    // The grammar is ours and tested (`grammar_loads`); a broken grammar
-    // falls back to plain text rather than taking the studio down.
+    // The grammar is ours and tested (this file's tests load it); a broken
+    // grammar falls back to plain text rather than taking the studio down.
     match SyntaxDefinition::load_from_str(RHAI_GRAMMAR, true, None) {
         Ok(def) => builder.add(def),
         Err(e) => eprintln!("volcad-studio: the Rhai grammar did not load ({e}); no highlighting"),
@@ -86,7 +86,7 @@ mod tests {
     }
 
     #[test]
-    fn grammar_loads() {
+    fn the_design_grammar_is_found_by_name_and_extension() {
         assert!(settings().ps.find_syntax_by_name(LANGUAGE).is_some());
         assert!(settings().ps.find_syntax_by_extension("rhai").is_some());
     }

@@ -255,6 +255,13 @@ pub fn field(o: Opt) -> &'static str {
         Opt::ColorProfile => "\"Colour profile\"",
         Opt::BitmapFormat => "\"Bitmap format\"",
         Opt::BitmapWidth => "\"Bitmap width\"",
+        Opt::Preset => "\"Printer\"",
+        Opt::Map => "\"Resin map\"",
+        Opt::Intensity => "\"Intensity\"",
+        Opt::Range => "\"Range\"",
+        Opt::Vats => "\"Vats\"",
+        Opt::VatMaterials => "\"Vat materials\"",
+        Opt::Offset => "\"Offset (mm)\"",
         Opt::Design => "design",
     }
 }

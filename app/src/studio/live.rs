@@ -310,7 +310,7 @@ RectPrism(Vec3(0, 0, 0), Vec3(15, 10, 5), m.id("gray"))"#;
     }
 
     #[test]
-    fn debounce_waits() {
+    fn a_scheduled_run_waits_for_the_debounce_deadline() {
         let ctx = egui::Context::default();
         let mut r = LiveRunner::new(Duration::from_secs(3600));
         r.schedule(req(BAR));

@@ -51,7 +51,7 @@ impl ParamPanel {
         if !path.exists() {
             return Ok(());
         }
-        self.sets = ParamSets::load(&path)?;
+        self.sets = ParamSets::load(&path).map_err(|e| e.to_string())?;
         if let Some(name) = self.sets.last_set.clone() {
             self.choose(&name)?;
         }
@@ -60,7 +60,7 @@ impl ParamPanel {
 
     /// Take the values of set `name`.
     pub fn choose(&mut self, name: &str) -> Result<(), String> {
-        self.overrides = self.sets.values(name)?;
+        self.overrides = self.sets.values(name).map_err(|e| e.to_string())?;
         self.current = Some(name.to_owned());
         Ok(())
     }
@@ -85,7 +85,7 @@ impl ParamPanel {
             })
             .collect();
         self.sets.store(name, &values);
-        self.sets.save(&path)?;
+        self.sets.save(&path).map_err(|e| e.to_string())?;
         self.current = Some(name.to_owned());
         Ok(path)
     }

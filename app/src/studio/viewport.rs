@@ -334,33 +334,7 @@ impl Viewport {
                 self.rebake(ui.ctx());
             }
             ui.separator();
-            let mut cut_on = self.settings.cut.is_some();
-            if ui.checkbox(&mut cut_on, "Cut").changed() {
-                let c = self
-                    .model
-                    .as_ref()
-                    .map_or(0.0, |m| m.bbox().center().z as f32);
-                self.settings.cut = cut_on.then_some(CutPlane {
-                    axis: 2,
-                    offset: c,
-                    keep_below: true,
-                });
-            }
-            if let Some(cut) = &mut self.settings.cut {
-                for (i, a) in ["x", "y", "z"].iter().enumerate() {
-                    ui.selectable_value(&mut cut.axis, i, *a);
-                }
-                let (lo, hi) = self
-                    .model
-                    .as_ref()
-                    .map(|m| m.bbox())
-                    .filter(|b| b.is_finite() && !b.is_empty())
-                    .map_or((-10.0, 10.0), |b| {
-                        (b.min[cut.axis] as f32, b.max[cut.axis] as f32)
-                    });
-                ui.add(egui::Slider::new(&mut cut.offset, lo..=hi).text("mm"));
-                ui.checkbox(&mut cut.keep_below, "keep below");
-            }
+            self.cut_ui(ui);
         });
         if let ViewMode::Iso {
             material_index,
@@ -384,6 +358,37 @@ impl Viewport {
                     });
                 ui.add(egui::Slider::new(level, 0.0..=1.0).text("fraction"));
             });
+        }
+    }
+
+    /// The cut plane's switch, and its axis, offset and side when on.
+    fn cut_ui(&mut self, ui: &mut egui::Ui) {
+        let mut cut_on = self.settings.cut.is_some();
+        if ui.checkbox(&mut cut_on, "Cut").changed() {
+            let c = self
+                .model
+                .as_ref()
+                .map_or(0.0, |m| m.bbox().center().z as f32);
+            self.settings.cut = cut_on.then_some(CutPlane {
+                axis: 2,
+                offset: c,
+                keep_below: true,
+            });
+        }
+        if let Some(cut) = &mut self.settings.cut {
+            for (i, a) in ["x", "y", "z"].iter().enumerate() {
+                ui.selectable_value(&mut cut.axis, i, *a);
+            }
+            let (lo, hi) = self
+                .model
+                .as_ref()
+                .map(|m| m.bbox())
+                .filter(|b| b.is_finite() && !b.is_empty())
+                .map_or((-10.0, 10.0), |b| {
+                    (b.min[cut.axis] as f32, b.max[cut.axis] as f32)
+                });
+            ui.add(egui::Slider::new(&mut cut.offset, lo..=hi).text("mm"));
+            ui.checkbox(&mut cut.keep_below, "keep below");
         }
     }
 

@@ -24,7 +24,7 @@ use std::sync::atomic::AtomicBool;
 use glam::DVec3;
 use volcad_core::Model;
 use volcad_core::material::VOID;
-use volcad_core::sampler::{Grid, Sampler, Slab};
+use volcad_core::sampler::{Consumer, Grid, Sampler, Slab};
 
 use super::topology::GridFaces;
 use super::{FeaMesh, draw};
@@ -60,7 +60,7 @@ pub fn brick_mesh(
     let grid = grid(model, voxel)?;
     let [nx, ny, nz] = grid.dims;
     // A brick is kept by the sign at its centre only.
-    let sampler = Sampler::new(model, grid, true).with_signs_only();
+    let sampler = Sampler::new(model, grid, Consumer::FeaBricks);
     let slots = model.materials();
     let mut mesh = FeaMesh::new(super::Element::C3D8R);
     let mut slab = Slab::default();

@@ -91,7 +91,7 @@ impl Lattice {
             for j in 0..dims[1] {
                 for i in 0..dims[0] {
                     let b = IVec3::new(i, j, k) * step;
-                    for p in crate::mesh::contour::PERMS.map(|p| p.map(usize::from)) {
+                    for p in crate::mesh::kuhn::PERMS.map(|p| p.map(usize::from)) {
                         let mut x1 = b;
                         x1[p[0]] += step;
                         let mut x2 = x1;

@@ -509,6 +509,50 @@ fn check_property_bins(model: &Model, bins: Option<usize>) -> Result<bool, Expor
     Ok(model.attribute_index("modulus").is_some())
 }
 
+/// The materials the deck writes, and each element's set in `mesh.mat`:
+/// sets binned from the design's `modulus` field when it has one (the
+/// elements' slots replaced by set numbers), else the table's materials
+/// that some element uses.
+fn element_materials(
+    model: &Model,
+    p: &FeaParams,
+    mesh: &mut FeaMesh,
+    materials: Vec<MatOut>,
+    notes: &mut Vec<String>,
+) -> Result<Vec<MatOut>, ExportError> {
+    Ok(match property_bins::element_props(model, mesh)? {
+        Some(props) => {
+            let bins = p.property_bins.unwrap_or(property_bins::DEFAULT_BINS);
+            let mut sets = property_bins::bin_elements(&props, bins);
+            notes.extend(property_bins::cap_poisson(&mut sets));
+            notes.push(format!(
+                "elastic sets from the modulus field: {} sets ({bins} bins per property over modulus {:.6} … {:.6} MPa), each with the mean of its elements' centroid values",
+                sets.materials.len(),
+                sets.materials.first().map_or(0.0, |m| m.e),
+                sets.materials.last().map_or(0.0, |m| m.e),
+            ));
+            mesh.mat = sets.set_of;
+            sets.materials
+        }
+        None => materials
+            .into_iter()
+            .filter(|m| mesh.mat.contains(&m.slot))
+            .collect(),
+    })
+}
+
+/// Elements per written material, by the material's table name.
+fn material_counts(used: &[MatOut], mesh: &FeaMesh) -> Vec<(String, u64)> {
+    used.iter()
+        .map(|m| {
+            (
+                m.original.clone(),
+                mesh.mat.iter().filter(|s| **s == m.slot).count() as u64,
+            )
+        })
+        .collect()
+}
+
 /// Mesh `model` and write `<staging>/model.inp` (see the module doc).
 pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summary, ExportError> {
     let start = Instant::now();
@@ -544,25 +588,7 @@ pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summ
     if mesh.is_empty() {
         return Err(ExportError::Other("the mesh has no elements: the design is empty at this element size (try a smaller --voxel or --max-cell)".into()));
     }
-    let used: Vec<MatOut> = match property_bins::element_props(model, &mesh)? {
-        Some(props) => {
-            let bins = p.property_bins.unwrap_or(property_bins::DEFAULT_BINS);
-            let mut sets = property_bins::bin_elements(&props, bins);
-            notes.extend(property_bins::cap_poisson(&mut sets));
-            notes.push(format!(
-                "elastic sets from the modulus field: {} sets ({bins} bins per property over modulus {:.6} … {:.6} MPa), each with the mean of its elements' centroid values",
-                sets.materials.len(),
-                sets.materials.first().map_or(0.0, |m| m.e),
-                sets.materials.last().map_or(0.0, |m| m.e),
-            ));
-            mesh.mat = sets.set_of;
-            sets.materials
-        }
-        None => materials
-            .into_iter()
-            .filter(|m| mesh.mat.contains(&m.slot))
-            .collect(),
-    };
+    let used = element_materials(model, p, &mut mesh, materials, &mut notes)?;
     notes.push(solver::check_solver_memory(
         mesh.nodes.len() as u64,
         match p.solver_memory {
@@ -582,15 +608,7 @@ pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summ
         mesh.nodes.len(),
         mesh.len(),
     ));
-    let counts: Vec<(String, u64)> = used
-        .iter()
-        .map(|m| {
-            (
-                m.original.clone(),
-                mesh.mat.iter().filter(|s| **s == m.slot).count() as u64,
-            )
-        })
-        .collect();
+    let counts = material_counts(&used, &mesh);
     let kind = match mesh.element {
         Element::C3D8R => "C3D8R",
         Element::C3D4 => "C3D4",

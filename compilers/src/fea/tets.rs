@@ -199,7 +199,59 @@ pub fn stuff(
     if cancel.load(Ordering::Relaxed) {
         return None;
     }
-    // 2. Cut points on edges with a − and a + end (sorted: a fixed order).
+    // 2. Cut points on edges with a − and a + end.
+    let mut cuts = cut_points(model, lat, &pos, &dist, &sg);
+    if cancel.load(Ordering::Relaxed) {
+        return None;
+    }
+    // 3. Warp violated vertices onto cut points.
+    let warped = warp(lat, p, &mut cuts, &mut pos, &mut sg);
+    // 4. Stencils.
+    let nodes = Nodes {
+        lattice: &pos,
+        cuts: &cuts.pos,
+    };
+    let (raw, dropped, quality) = stencils(lat, p, &cuts.edges, &sg, nodes, cancel)?;
+    // 5. Compact: nodes numbered in order of first use.
+    let mut map = vec![u32::MAX; nv + cuts.edges.len()];
+    let mut used = Vec::new();
+    let tets = raw
+        .into_iter()
+        .map(|t| {
+            t.map(|id| {
+                if map[id as usize] == u32::MAX {
+                    map[id as usize] = used.len() as u32;
+                    used.push(nodes.at(id));
+                }
+                map[id as usize]
+            })
+        })
+        .collect();
+    Some(TetMesh {
+        nodes: used,
+        tets,
+        dropped,
+        warped,
+        cuts: cuts.edges.len(),
+        quality,
+    })
+}
+
+/// The cut points of [`stuff`]'s phase 2: one on every lattice edge whose
+/// ends have opposite signs.
+struct Cuts {
+    /// The edges, sorted and without repeats (a fixed order, so node
+    /// numbers do not depend on thread count).
+    edges: Vec<(u32, u32)>,
+    /// Where along each edge the surface crosses (0 at its first end).
+    t: Vec<f64>,
+    /// The cut points, filled in by [`warp`].
+    pos: Vec<DVec3>,
+}
+
+/// Phase 2 of [`stuff`]: the edges with a − and a + end and the surface's
+/// crossing on each.
+fn cut_points(model: &Model, lat: &Lattice, pos: &[DVec3], dist: &[f64], sg: &[i8]) -> Cuts {
     let mut mixed: Vec<(u32, u32)> = Vec::new();
     for t in &lat.tets {
         for (i, j) in EDGES {
@@ -227,11 +279,25 @@ pub fn stuff(
             }
         })
         .collect();
-    if cancel.load(Ordering::Relaxed) {
-        return None;
+    Cuts {
+        edges: mixed,
+        t: cut_t,
+        pos: Vec::new(),
     }
-    // 3. Warp: each violated vertex moves to its nearest violating cut point,
-    // at most `graded_cap · α` times its shortest lattice edge.
+}
+
+/// Phase 3 of [`stuff`]: each violated vertex moves to its nearest
+/// violating cut point, at most `graded_cap · α` times its shortest lattice
+/// edge (its sign becomes 0). Fills `cuts.pos` from the unmoved vertices;
+/// returns how many vertices moved.
+fn warp(
+    lat: &Lattice,
+    p: &StuffParams,
+    cuts: &mut Cuts,
+    pos: &mut [DVec3],
+    sg: &mut [i8],
+) -> usize {
+    let nv = pos.len();
     let mut shortest = vec![f64::INFINITY; nv];
     for t in &lat.tets {
         for (i, j) in EDGES {
@@ -242,7 +308,7 @@ pub fn stuff(
         }
     }
     let mut best: Vec<(f64, u32)> = vec![(f64::INFINITY, u32::MAX); nv];
-    for (e, (&(a, b), &t)) in mixed.iter().zip(&cut_t).enumerate() {
+    for (e, (&(a, b), &t)) in cuts.edges.iter().zip(&cuts.t).enumerate() {
         let len = (pos[b as usize] - pos[a as usize]).length();
         for (v, frac) in [(a, t), (b, 1.0 - t)] {
             let d = frac * len;
@@ -252,38 +318,68 @@ pub fn stuff(
             }
         }
     }
-    let cut_pos: Vec<DVec3> = mixed
+    cuts.pos = cuts
+        .edges
         .iter()
-        .zip(&cut_t)
+        .zip(&cuts.t)
         .map(|(&(a, b), &t)| pos[a as usize] + (pos[b as usize] - pos[a as usize]) * t)
         .collect();
     let mut warped = 0;
     for (v, &(_, e)) in best.iter().enumerate() {
         if e != u32::MAX {
-            pos[v] = cut_pos[e as usize];
+            pos[v] = cuts.pos[e as usize];
             sg[v] = 0;
             warped += 1;
         }
     }
-    // 4. Stencils.
+    warped
+}
+
+/// Node positions by id: lattice vertices first, then cut points.
+#[derive(Clone, Copy)]
+struct Nodes<'a> {
+    lattice: &'a [DVec3],
+    cuts: &'a [DVec3],
+}
+
+impl Nodes<'_> {
+    #[inline]
+    fn at(&self, id: u32) -> DVec3 {
+        let nv = self.lattice.len();
+        if (id as usize) < nv {
+            self.lattice[id as usize]
+        } else {
+            self.cuts[id as usize - nv]
+        }
+    }
+}
+
+/// Phase 4 of [`stuff`]: the elements of every background tetrahedron with
+/// an inside vertex (whole, or its cut stencil), each kept when positive and
+/// within the dihedral-angle bounds. `None` when cancelled.
+fn stencils(
+    lat: &Lattice,
+    p: &StuffParams,
+    mixed: &[(u32, u32)],
+    sg: &[i8],
+    nodes: Nodes<'_>,
+    cancel: &AtomicBool,
+) -> Option<(Vec<[u32; 4]>, usize, QualityReport)> {
+    let nv = nodes.lattice.len();
+    // Stencils ask only for edges whose ends have opposite signs now;
+    // warping only zeroes signs, so each such edge was mixed in phase 2.
+    #[allow(clippy::expect_used)]
     let cut_id = |a: u32, b: u32| -> u32 {
         let k = mixed
             .binary_search(&edge(a, b))
             .expect("cut edge was collected");
         nv as u32 + k as u32
     };
-    let at = |id: u32| -> DVec3 {
-        if (id as usize) < nv {
-            pos[id as usize]
-        } else {
-            cut_pos[id as usize - nv]
-        }
-    };
     let mut raw: Vec<[u32; 4]> = Vec::with_capacity(lat.tets.len());
     let mut dropped = 0;
     let mut quality = QualityReport::default();
     let mut accept = |t: [u32; 4], out: &mut Vec<[u32; 4]>| {
-        let c = t.map(at);
+        let c = t.map(|id| nodes.at(id));
         let (lo, hi) = dihedral_range(&c);
         if signed_volume(&c) > 0.0 && lo >= p.min_angle && hi <= p.max_angle {
             quality.add(&c);
@@ -312,29 +408,7 @@ pub fn stuff(
             accept(t, &mut raw);
         }
     }
-    // 5. Compact: nodes numbered in order of first use.
-    let mut map = vec![u32::MAX; nv + mixed.len()];
-    let mut nodes = Vec::new();
-    let tets = raw
-        .into_iter()
-        .map(|t| {
-            t.map(|id| {
-                if map[id as usize] == u32::MAX {
-                    map[id as usize] = nodes.len() as u32;
-                    nodes.push(at(id));
-                }
-                map[id as usize]
-            })
-        })
-        .collect();
-    Some(TetMesh {
-        nodes,
-        tets,
-        dropped,
-        warped,
-        cuts: mixed.len(),
-        quality,
-    })
+    Some((raw, dropped, quality))
 }
 
 /// The elements filling the inside part of a positively oriented background

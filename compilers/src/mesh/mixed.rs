@@ -57,8 +57,8 @@ fn chunk_mask([a, b, c, d]: [&[u16]; 4]) -> u64 {
     // Columns past the row's end are zero in `col` and `step`, but the
     // last cube's right column is `col[n]`: clear the bits beyond n.
     let mut bits = 0u64;
-    for (g, bytes) in mixed.chunks_exact(8).enumerate() {
-        let word = u64::from_le_bytes(bytes.try_into().expect("8 bytes"));
+    for (g, bytes) in mixed.as_chunks::<8>().0.iter().enumerate() {
+        let word = u64::from_le_bytes(*bytes);
         bits |= (word.wrapping_mul(0x0102_0408_1020_4080) >> 56) << (8 * g);
     }
     if n < CHUNK {
@@ -85,7 +85,7 @@ mod tests {
 
     #[test]
     fn finds_exactly_the_mixed_cubes() {
-        let mut rng = volcad_core::xorshift::XorShift::new(5);
+        let mut rng = volcad_core::bench::XorShift::new(5);
         for len in [0, 1, 2, 8, 63, 64, 65, 66, 129, 300] {
             for density in [0.0, 0.01, 0.2, 1.0] {
                 let mut row = || -> Vec<u16> {

@@ -100,7 +100,7 @@ impl Classifier {
     /// True when every fraction vector within `bounds` (one interval per
     /// material) gets the same non-void label, with a margin of 10⁻⁵ for the
     /// `f32` rounding of sampled fractions: the sampler may then fill a
-    /// solid tile with one evaluation (see `Sampler::with_uniform`).
+    /// solid tile with one evaluation (see `Consumer::MeshContour`).
     pub fn uniform(&self, bounds: &[Interval]) -> bool {
         let sum_lo: f64 = bounds.iter().map(|i| i.lo).sum();
         let sum_hi: f64 = bounds.iter().map(|i| i.hi).sum();

@@ -156,6 +156,23 @@ fn the_fallback_samples_again_what_the_planes_held() {
     }
 }
 
+/// `slab` with each solid rectangle's fractions written into its voxels
+/// (`nx` voxels a row), as a sampler without rectangles writes them.
+fn rects_written_out(slab: &Slab, nx: usize) -> Slab {
+    let mut out = slab.clone();
+    let (k, layer) = (slab.k, slab.dist.len() / slab.layers.max(1));
+    for r in &slab.rects {
+        let one = &slab.rect_fracs[r.at..r.at + k];
+        for y in r.y0..r.y0 + r.h {
+            let v = (r.z - slab.z0) * layer + y * nx + r.x0;
+            volcad_core::sampler::fill_pattern(&mut out.fracs[v * k..(v + r.w) * k], one);
+        }
+    }
+    out.rects.clear();
+    out.rect_fracs.clear();
+    out
+}
+
 #[test]
 fn uniform_tiles_are_used_and_agree_on_labels() {
     let bar = graded_bar();
@@ -167,25 +184,24 @@ fn uniform_tiles_are_used_and_agree_on_labels() {
     let pl = plan(&bar, &p, Look::Coarse).expect("plan");
     let dims = pl.grid.dims;
     let test = |b: &[volcad_core::interval::Interval]| pl.classifier.uniform(b);
-    let fast = Sampler::new(&bar, pl.grid, true).with_uniform(&test);
-    let plain = Sampler::new(&bar, pl.grid, true);
-    let rects = Sampler::new(&bar, pl.grid, true)
-        .with_uniform(&test)
-        .with_solid_rects();
+    // One layer at a time: a mesh export's blocks through layers play no
+    // part, so `a` (the rectangles written voxel by voxel) is what the
+    // uniform tiles alone give.
+    let rects = Sampler::new(&bar, pl.grid, Consumer::MeshContour(&test));
+    let plain = Sampler::new(&bar, pl.grid, Consumer::ViewportBake);
     let cancel = AtomicBool::new(false);
-    let (mut a, mut b, mut c) = (Slab::default(), Slab::default(), Slab::default());
+    let (mut b, mut c) = (Slab::default(), Slab::default());
     // Stale fractions in the reused buffer must not matter.
     c.fracs = vec![f32::NAN; dims[0] * dims[1] * 3];
     let (mut filled, mut in_rects) = (0, 0);
     for z in 0..dims[2] {
-        fast.sample_layers(z, z + 1, &mut a, &cancel)
-            .expect("sample");
         plain
             .sample_layers(z, z + 1, &mut b, &cancel)
             .expect("sample");
         rects
             .sample_layers(z, z + 1, &mut c, &cancel)
             .expect("sample");
+        let a = rects_written_out(&c, dims[0]);
         let (la, ta) = pl.classifier.plane(&a, 0, dims, z);
         let (lb, tb) = pl.classifier.plane(&b, 0, dims, z);
         let (lc, tc) = pl.classifier.plane(&c, 0, dims, z);
@@ -246,11 +262,8 @@ fn blocks_through_layers_agree_on_labels() {
         let pl = plan(&m, &p, Look::Coarse).expect("plan");
         let dims = pl.grid.dims;
         let test = |b: &[volcad_core::interval::Interval]| pl.classifier.uniform(b);
-        let plain = Sampler::new(&m, pl.grid, true);
-        let blocks = Sampler::new(&m, pl.grid, true)
-            .with_uniform(&test)
-            .with_solid_rects()
-            .with_blocks();
+        let plain = Sampler::new(&m, pl.grid, Consumer::ViewportBake);
+        let blocks = Sampler::new(&m, pl.grid, Consumer::MeshContour(&test));
         let cancel = AtomicBool::new(false);
         let (mut a, mut b) = (Slab::default(), Slab::default());
         let mut z0 = 0;

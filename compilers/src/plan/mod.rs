@@ -27,8 +27,10 @@
 
 mod fea;
 pub mod folder;
+mod gcvf;
 mod mesh;
 mod png;
+mod vat;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -36,11 +38,13 @@ use std::sync::Arc;
 use volcad_core::Model;
 
 use crate::fea::FeaParams;
+use crate::gcvf::GcvfParams;
 use crate::job::{self, ExportError, JobHandle};
 use crate::mesh::MeshParams;
 use crate::png_stack::PngParams;
 use crate::resources::check_disk_for;
 use crate::thin::thin_feature_notes;
+use crate::vat::VatParams;
 
 /// The options a verdict can concern: a stable key for each, spelled as a
 /// flag by the command line ([`Opt::flag`]) and as a field by the studio.
@@ -84,6 +88,20 @@ pub enum Opt {
     BitmapFormat,
     /// Fixed width of BMP bitmaps.
     BitmapWidth,
+    /// The printer preset (voxel size, screen, material table).
+    Preset,
+    /// Design material = printer resin pairs.
+    Map,
+    /// A vat stack's gray source.
+    Intensity,
+    /// The attribute values a vat stack maps onto 0..=255.
+    Range,
+    /// How many vats a vat stack feeds.
+    Vats,
+    /// Which materials each vat holds.
+    VatMaterials,
+    /// Where the part sits on a vat printer's screen.
+    Offset,
     /// The design itself.
     Design,
 }
@@ -91,7 +109,7 @@ pub enum Opt {
 impl Opt {
     /// Every key. No flag starts another, so a message can be rewritten
     /// flag by flag.
-    pub const ALL: [Opt; 20] = [
+    pub const ALL: [Opt; 27] = [
         Opt::MinCell,
         Opt::MaxCell,
         Opt::Sizing,
@@ -111,6 +129,13 @@ impl Opt {
         Opt::ColorProfile,
         Opt::BitmapFormat,
         Opt::BitmapWidth,
+        Opt::Preset,
+        Opt::Map,
+        Opt::Intensity,
+        Opt::Range,
+        Opt::Vats,
+        Opt::VatMaterials,
+        Opt::Offset,
         Opt::Design,
     ];
 
@@ -136,6 +161,13 @@ impl Opt {
             Opt::ColorProfile => "--color-profile",
             Opt::BitmapFormat => "--bitmap-format",
             Opt::BitmapWidth => "--bitmap-width",
+            Opt::Preset => "--preset",
+            Opt::Map => "--map",
+            Opt::Intensity => "--intensity",
+            Opt::Range => "--range",
+            Opt::Vats => "--vats",
+            Opt::VatMaterials => "--vat-materials",
+            Opt::Offset => "--offset",
             Opt::Design => "design",
         }
     }
@@ -201,6 +233,10 @@ pub enum ExportParams {
     Mesh(MeshParams),
     /// FEA deck.
     Fea(FeaParams),
+    /// GrabCAD Voxel Print package (one file).
+    Gcvf(GcvfParams),
+    /// Vat photopolymer slice stack.
+    Vat(VatParams),
 }
 
 /// What an export will produce, and what the design alone says about it.
@@ -222,6 +258,8 @@ impl ExportParams {
             ExportParams::Png(_) => "png",
             ExportParams::Mesh(_) => "mesh",
             ExportParams::Fea(_) => "fea",
+            ExportParams::Gcvf(_) => "gcvf",
+            ExportParams::Vat(_) => "vat",
         }
     }
 
@@ -238,6 +276,8 @@ impl ExportParams {
             ExportParams::Png(p) => png::estimate(model, p)?,
             ExportParams::Mesh(p) => mesh::estimate(model, p)?,
             ExportParams::Fea(p) => fea::estimate(model, p)?,
+            ExportParams::Gcvf(p) => gcvf::estimate(model, p)?,
+            ExportParams::Vat(p) => vat::estimate(model, p)?,
         };
         let mut verdicts = self.design_verdicts(model);
         verdicts.append(&mut a.verdicts);
@@ -252,6 +292,8 @@ impl ExportParams {
             ExportParams::Png(p) => png::cell(p),
             ExportParams::Mesh(p) => mesh::cell(p),
             ExportParams::Fea(p) => fea::cell(p),
+            ExportParams::Gcvf(p) => gcvf::cell(p),
+            ExportParams::Vat(p) => vat::cell(p),
         };
         thin_feature_notes(model, size, option.flag())
             .into_iter()
@@ -292,7 +334,36 @@ impl ExportParams {
             ExportParams::Fea(p) => job::spawn_design(dest, design_hash, design, move |ctx| {
                 fea::run(&model, &p, ctx)
             }),
+            ExportParams::Gcvf(mut p) => {
+                // The job writes the archive under its own file name.
+                if let Some(n) = dest.file_name() {
+                    p.file_name = n.to_string_lossy().into_owned();
+                }
+                job::spawn_file(dest, design_hash, move |ctx| gcvf::run(&model, &p, ctx))
+            }
+            ExportParams::Vat(p) => job::spawn_design(dest, design_hash, design, move |ctx| {
+                vat::run(&model, &p, ctx)
+            }),
         }
+    }
+
+    /// True when the export is one file (a `.gcvf`) rather than a folder.
+    pub fn is_file(&self) -> bool {
+        matches!(self, ExportParams::Gcvf(_))
+    }
+
+    /// [`preflight`] for this kind: a one-file export checks its file
+    /// rather than a folder.
+    pub fn preflight(&self, disk_bytes: Option<u64>, dest: &Path) -> Vec<Verdict> {
+        if !self.is_file() {
+            return preflight(disk_bytes, dest);
+        }
+        let mut out = Vec::new();
+        if let Some(Err(e)) = disk_bytes.map(|b| check_disk_for(b, dest, "a larger voxel size")) {
+            out.push(Verdict::refuse(&e));
+        }
+        out.extend(gcvf::file_verdict(dest));
+        out
     }
 }
 

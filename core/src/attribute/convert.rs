@@ -14,20 +14,7 @@ pub struct Table {
 impl Table {
     /// A table of `(input, output)` rows; `what` names it in errors.
     pub fn new(rows: &[(f64, f64)], what: &str) -> Result<Table, String> {
-        if rows.len() < 2 {
-            return Err(format!(
-                "{what} has {} rows; a lookup table needs at least 2 (input, output) rows",
-                rows.len()
-            ));
-        }
-        for (i, (x, y)) in rows.iter().enumerate() {
-            if !x.is_finite() || !y.is_finite() {
-                return Err(format!(
-                    "{what}: row {} ({x}, {y}) is not a pair of finite numbers",
-                    i + 1
-                ));
-            }
-        }
+        check_pairs(rows, what, "a lookup table", "(input, output)")?;
         if let Some(i) = rows.windows(2).position(|w| w[1].0 <= w[0].0) {
             return Err(format!(
                 "{what}: the inputs must rise row by row, but row {} has {} after {}; sort the rows by input and merge repeated inputs",
@@ -42,30 +29,9 @@ impl Table {
         })
     }
 
-    /// Rows from CSV text: two numeric columns; a first line that is not
-    /// numeric is a header, and lines starting with `#` (the source of the
-    /// numbers) are skipped.
+    /// Rows from CSV text (see [`csv_rows`]).
     pub fn parse_csv(text: &str, what: &str) -> Result<Table, String> {
-        let mut rows = Vec::new();
-        for (n, line) in text.lines().enumerate() {
-            let line = line.trim();
-            if line.is_empty() || line.starts_with('#') {
-                continue;
-            }
-            let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-            let nums: Option<Vec<f64>> = cells.iter().map(|c| c.parse::<f64>().ok()).collect();
-            match nums {
-                Some(v) if v.len() == 2 => rows.push((v[0], v[1])),
-                None if rows.is_empty() => {} // the header
-                _ => {
-                    return Err(format!(
-                        "{what}:{}: expected two numbers `input,output`, got {line:?}",
-                        n + 1
-                    ));
-                }
-            }
-        }
-        Table::new(&rows, what)
+        Table::new(&csv_rows(text, what)?, what)
     }
 
     /// The output at `x`, and whether `x` was outside the inputs (then the
@@ -98,6 +64,66 @@ impl Table {
     pub fn input_range(&self) -> (f64, f64) {
         (self.xs[0], self.xs[self.xs.len() - 1])
     }
+}
+
+/// The non-empty lines of CSV text that are not `#` comments, as the
+/// 1-based line number and the trimmed cells; a byte-order mark is
+/// skipped.
+pub fn csv_cells(text: &str) -> impl Iterator<Item = (usize, Vec<&str>)> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    text.lines().enumerate().filter_map(|(n, line)| {
+        let line = line.trim();
+        (!line.is_empty() && !line.starts_with('#'))
+            .then(|| (n + 1, line.split(',').map(str::trim).collect()))
+    })
+}
+
+/// Rows of two numeric columns from CSV text ([`csv_cells`]): a first line
+/// that is not numeric is a header, and lines starting with `#` (the
+/// source of the numbers) are skipped; `what` names the file in errors,
+/// with the 1-based line.
+pub fn csv_rows(text: &str, what: &str) -> Result<Vec<(f64, f64)>, String> {
+    let mut rows = Vec::new();
+    let mut header = false;
+    for (n, cells) in csv_cells(text) {
+        let nums: Option<Vec<f64>> = cells.iter().map(|c| c.parse::<f64>().ok()).collect();
+        match nums {
+            Some(v) if v.len() == 2 => rows.push((v[0], v[1])),
+            None if rows.is_empty() && !header => header = true,
+            _ => {
+                return Err(format!(
+                    "{what}:{n}: expected two numbers `input,output`, got {:?}",
+                    cells.join(",")
+                ));
+            }
+        }
+    }
+    Ok(rows)
+}
+
+/// Refuse fewer than 2 rows or a number that is not finite (`table`,
+/// `pair`: how the message names the table and its rows).
+pub(super) fn check_pairs(
+    rows: &[(f64, f64)],
+    what: &str,
+    table: &str,
+    pair: &str,
+) -> Result<(), String> {
+    if rows.len() < 2 {
+        return Err(format!(
+            "{what} has {} rows; {table} needs at least 2 {pair} rows",
+            rows.len()
+        ));
+    }
+    for (i, (x, y)) in rows.iter().enumerate() {
+        if !x.is_finite() || !y.is_finite() {
+            return Err(format!(
+                "{what}: row {} ({x}, {y}) is not a pair of finite numbers",
+                i + 1
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// How a conversion maps its input.

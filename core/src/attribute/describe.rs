@@ -24,6 +24,16 @@ pub fn describe_tree(root: &Node) -> Vec<String> {
                     n.describe()
                 ));
             }
+            if let Some(c) = &a.to_fractions {
+                let (lo, hi) = c.table.value_range();
+                out.push(format!(
+                    "fractions = materials {} and {} mixed for \"{}\" through a mix table over {lo}..{hi} on {}",
+                    c.materials[0],
+                    c.materials[1],
+                    c.from,
+                    n.describe()
+                ));
+            }
             for (name, r, _) in &a.resolvers {
                 out.push(format!(
                     "{name}: overlaps resolved by {} on {}",
@@ -70,6 +80,11 @@ fn source_text(s: &AttrSource) -> String {
         } => format!(
             "column \"{column_name}\" of a SimulationField ({} nodes)",
             field.node_count()
+        ),
+        AttrSource::Points { cloud, column } => format!(
+            "column \"{}\" of {} points, inverse-distance weighted",
+            cloud.names()[*column],
+            cloud.len()
         ),
     }
 }

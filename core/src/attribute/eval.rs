@@ -12,6 +12,14 @@ use crate::model::{Model, Points, sdf};
 /// Most numbers of one value (a Vec4).
 const MAX_WIDTH: usize = 4;
 
+/// The children of a sharp pick, their grid, and whether the point is
+/// known to be inside the picking node.
+struct Near<'a> {
+    children: &'a [std::sync::Arc<ANode>],
+    grid: Option<&'a super::pick_grid::PickGrid>,
+    inside: bool,
+}
+
 impl ANode {
     /// Attribute `idx` at `q` (this node's frame; `pw` the design point for
     /// messages) into `out`; false when nothing on or below this node
@@ -27,24 +35,49 @@ impl ANode {
             self.own_value(pos as usize, q, pw, out)?;
             return Ok(true);
         }
-        self.eval_below(idx, q, pw, out)
+        self.eval_below(idx, q, pw, out, false)
     }
 
-    /// Attribute `idx` as the children below this node give it.
+    /// [`ANode::eval`] at a point known to be inside this node: a union
+    /// here need not test that again (its whole distance) where no child
+    /// with the attribute holds the point.
+    pub(super) fn eval_inside(
+        &self,
+        idx: usize,
+        q: DVec3,
+        out: &mut [f64],
+    ) -> Result<bool, AttributeError> {
+        if let Some(pos) = self.own_of[idx] {
+            self.own_value(pos as usize, q, q, out)?;
+            return Ok(true);
+        }
+        self.eval_below(idx, q, q, out, true)
+    }
+
+    /// Attribute `idx` as the children below this node give it (`inside`:
+    /// q is known to be inside this node).
     fn eval_below(
         &self,
         idx: usize,
         q: DVec3,
         pw: DVec3,
         out: &mut [f64],
+        inside: bool,
     ) -> Result<bool, AttributeError> {
         match &self.op {
             Op::Leaf => Ok(false),
             Op::Map(m, c) => c.eval(idx, m.apply(q), pw, out),
-            Op::Pick { children, smooth } if *smooth > 0.0 => {
-                blend_children(children, *smooth, idx, q, pw, out)
+            Op::Pick {
+                children, smooth, ..
+            } if *smooth > 0.0 => blend_children(children, *smooth, idx, q, pw, out),
+            Op::Pick { children, grid, .. } => {
+                let near = Near {
+                    children,
+                    grid: grid.as_ref(),
+                    inside,
+                };
+                self.pick_children(&near, idx, q, pw, out)
             }
-            Op::Pick { children, .. } => self.pick_children(children, idx, q, pw, out),
         }
     }
 
@@ -53,18 +86,25 @@ impl ANode {
     /// parent's fillet, or on a seam within rounding), the nearest child.
     fn pick_children(
         &self,
-        children: &[std::sync::Arc<ANode>],
+        near: &Near<'_>,
         idx: usize,
         q: DVec3,
         pw: DVec3,
         out: &mut [f64],
     ) -> Result<bool, AttributeError> {
+        let (children, grid) = (near.children, near.grid);
         let r = self.resolver(idx);
         let first_only = matches!(r, super::Resolver::First);
         let mut tmp = [0.0; MAX_WIDTH];
         let tmp = &mut tmp[..out.len()];
         let mut found = false;
-        for c in children.iter().filter(|c| c.defines[idx]) {
+        // The children near q (a grid's list), else all, in child order.
+        let list = grid.map(|g| g.candidates(q));
+        for k in 0..list.map_or(children.len(), <[u32]>::len) {
+            let c = &children[list.map_or(k, |l| l[k] as usize)];
+            if !c.defines[idx] {
+                continue;
+            }
             if !c.dist.contains(q) {
                 continue;
             }
@@ -78,7 +118,7 @@ impl ANode {
             }
         }
         // Inside this node, a child without the attribute holds the point.
-        if found || self.dist.contains(q) {
+        if found || near.inside || self.dist.contains(q) {
             return Ok(found);
         }
         let nearest = children
@@ -166,6 +206,7 @@ impl ANode {
                     f64::NAN
                 };
             }
+            OwnSrc::Points { cloud, column } => out[0] = cloud.sample(q, *column),
             OwnSrc::Convert {
                 from,
                 from_own,
@@ -192,7 +233,7 @@ impl ANode {
                 match from_own {
                     Some(j) => x[0] = slots[COORD_SLOTS + j],
                     None => {
-                        self.eval_below(*from, q, pw, &mut x)?;
+                        self.eval_below(*from, q, pw, &mut x, false)?;
                     }
                 }
                 out[0] = match map {
@@ -229,7 +270,9 @@ impl ANode {
         match &self.op {
             Op::Leaf => None,
             Op::Map(m, c) => c.interval(idx, &m.apply_box(b)),
-            Op::Pick { children, smooth } => {
+            Op::Pick {
+                children, smooth, ..
+            } => {
                 let r = self.resolver(idx);
                 let mut acc: Option<Interval> = None;
                 for c in children.iter().filter(|c| c.defines[idx]) {
@@ -304,6 +347,11 @@ impl ANode {
             },
             // Linear interpolation in a tetrahedron stays within its nodes'
             // values; outside the mesh the value is NaN (no sample).
+            // Inverse-distance weights are positive: a convex combination.
+            OwnSrc::Points { cloud, column } => {
+                let (lo, hi) = cloud.range(*column);
+                Interval::new(lo, hi)
+            }
             OwnSrc::Data { field, column } => match field.variable_range(*column) {
                 Some((lo, hi)) => Interval::new(lo, hi),
                 None => Interval::EVERYTHING,
@@ -417,7 +465,20 @@ impl Model {
         out: &mut [f64],
     ) -> Result<(), AttributeError> {
         self.attribute_checked(index, out.len(), 1)?;
-        self.attribute_unchecked(index, p, out)
+        self.attribute_unchecked(index, p, out, false)
+    }
+
+    /// [`Model::attribute_at`] at a point the caller knows is inside the
+    /// part (its distance from [`Model::eval_into`] is ≤ 0): skips the
+    /// inside test, a second distance evaluation.
+    pub fn attribute_inside(
+        &self,
+        index: usize,
+        p: DVec3,
+        out: &mut [f64],
+    ) -> Result<(), AttributeError> {
+        self.attribute_checked(index, out.len(), 1)?;
+        self.attribute_unchecked(index, p, out, true)
     }
 
     #[inline]
@@ -426,11 +487,17 @@ impl Model {
         index: usize,
         p: DVec3,
         out: &mut [f64],
+        inside: bool,
     ) -> Result<(), AttributeError> {
         let Some(a) = &self.attrs else {
             return Ok(());
         };
-        if self.root.contains(p) && a.root.eval(index, p, p, out)? {
+        let found = if inside {
+            a.root.eval_inside(index, p, out)?
+        } else {
+            self.root.contains(p) && a.root.eval(index, p, p, out)?
+        };
+        if found {
             return Ok(());
         }
         out.fill(f64::NAN);
@@ -448,7 +515,7 @@ impl Model {
         self.attribute_checked(index, out.len(), pts.len())?;
         let w = self.attributes()[index].kind.width();
         for (i, o) in out.chunks_exact_mut(w).enumerate() {
-            self.attribute_unchecked(index, pts.get(i), o)?;
+            self.attribute_unchecked(index, pts.get(i), o, false)?;
         }
         Ok(())
     }
@@ -481,6 +548,7 @@ impl Model {
             if !seen.insert(std::sync::Arc::as_ptr(n)) {
                 continue;
             }
+            out.extend(n.grade.as_ref().and_then(|g| g.warning()));
             for o in &n.own {
                 if let OwnSrc::Convert {
                     from,

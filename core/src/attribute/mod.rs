@@ -16,20 +16,28 @@
 mod convert;
 mod describe;
 mod eval;
+mod mix;
 mod moves;
 mod names;
 mod order;
+mod pick_grid;
+mod points;
 mod prepared;
 mod resolve;
+mod to_fractions;
 
 use std::sync::Arc;
 
-pub use convert::{ConvMap, FRACTIONS, Table};
+pub use convert::{ConvMap, FRACTIONS, Table, csv_cells, csv_rows};
 pub use describe::{column_names, describe_tree, value_text};
+pub use mix::MixTable;
 pub use names::{COMMON, Common, check_kind, range, range_text};
+pub use points::{NEIGHBOURS, PointCloud};
 pub use prepared::Evaluator;
 pub use resolve::Resolver;
+pub(crate) use to_fractions::{FractionSource, fraction_materials};
 
+use crate::material::MaterialId;
 use crate::node::Origin;
 use crate::simfield::SimField;
 
@@ -108,6 +116,14 @@ pub enum AttrSource {
         /// The column's name, for messages.
         column_name: String,
     },
+    /// A value column of scattered points (`PointsField`), interpolated by
+    /// inverse-distance weighting of the nearest points.
+    Points {
+        /// The points.
+        cloud: Arc<PointCloud>,
+        /// The column's index in [`PointCloud::names`].
+        column: usize,
+    },
     /// Another scalar attribute mapped by a table or a math string
     /// (`Convert`): the node's own value of `from`, else the one below it.
     Convert {
@@ -138,6 +154,22 @@ pub struct NodeAttributes {
     pub defs: Vec<AttrDef>,
     /// Overlap resolvers by attribute name.
     pub resolvers: Vec<(String, Resolver, Option<Origin>)>,
+    /// Fractions from a scalar by a mix table (`Convert(child, from,
+    /// fractions([a, b]), table)`): they replace the child's fractions.
+    pub to_fractions: Option<FracConv>,
+}
+
+/// A scalar -> fractions conversion a node carries.
+#[derive(Clone, Debug)]
+pub struct FracConv {
+    /// The scalar attribute read from the child.
+    pub from: String,
+    /// The two materials mixed: the table's share is the second's.
+    pub materials: [MaterialId; 2],
+    /// The mix table.
+    pub table: Arc<MixTable>,
+    /// The script position of the `Convert` call.
+    pub origin: Option<Origin>,
 }
 
 impl NodeAttributes {
@@ -165,3 +197,7 @@ impl NodeAttributes {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_fractions;
+#[cfg(test)]
+mod tests_points;

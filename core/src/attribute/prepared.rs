@@ -49,6 +49,10 @@ pub(super) enum OwnSrc {
         field: Arc<crate::simfield::SimField>,
         column: usize,
     },
+    Points {
+        cloud: Arc<super::PointCloud>,
+        column: usize,
+    },
     Convert {
         /// Design index of the input attribute.
         from: usize,
@@ -96,6 +100,8 @@ pub(super) enum Op {
     Pick {
         children: Vec<Arc<ANode>>,
         smooth: f64,
+        /// Which children may hold a point (sharp unions of many).
+        grid: Option<super::pick_grid::PickGrid>,
     },
 }
 
@@ -109,6 +115,8 @@ pub(super) struct ANode {
     pub defines: Vec<bool>,
     pub resolvers: Vec<(usize, Resolver)>,
     pub dist: SubDistance,
+    /// The node's scalar -> fractions conversion (for its warning).
+    pub grade: Option<Arc<super::FractionSource>>,
     pub op: Op,
     depth: u32,
 }
@@ -324,13 +332,15 @@ impl Builder<'_> {
             })
             .unwrap_or_default();
         debug_assert_eq!(defines.len(), count);
+        let dist = self.sub.distance(n)?;
         Ok(Some(Arc::new(ANode {
+            grade: dist.fraction_source(),
             describe: n.describe(),
             own,
             own_of,
             defines,
             resolvers,
-            dist: self.sub.distance(n)?,
+            dist,
             op,
             depth,
         })))
@@ -402,7 +412,13 @@ impl Builder<'_> {
         if children.is_empty() {
             Op::Leaf
         } else {
-            Op::Pick { children, smooth }
+            Op::Pick {
+                grid: (smooth <= 0.0)
+                    .then(|| super::pick_grid::PickGrid::build(&children))
+                    .flatten(),
+                children,
+                smooth,
+            }
         }
     }
 
@@ -444,6 +460,10 @@ impl Builder<'_> {
                 ),
                 AttrSource::Data { field, column, .. } => OwnSrc::Data {
                     field: field.clone(),
+                    column: *column,
+                },
+                AttrSource::Points { cloud, column } => OwnSrc::Points {
+                    cloud: cloud.clone(),
                     column: *column,
                 },
                 AttrSource::Convert { from, map } => self.convert(n, a, d, from, map)?,

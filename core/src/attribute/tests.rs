@@ -7,12 +7,12 @@ use crate::aabb::Aabb;
 use crate::model::Points;
 use crate::script::{ScriptOptions, model_of};
 
-fn try_model(src: &str) -> Result<Model, String> {
+pub(super) fn try_model(src: &str) -> Result<Model, String> {
     let src = format!("let m = default_materials();\n{src}");
     model_of(&src, "t.rhai", &ScriptOptions::default()).map_err(|e| e.to_string())
 }
 
-fn model(src: &str) -> Model {
+pub(super) fn model(src: &str) -> Model {
     try_model(src).unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -313,7 +313,9 @@ fn data_from_a_simulation_field_column() {
                let s = Sphere(Vec3(2, 2, 2), 1.5, m.id(\"red\")); s.set_attribute(\"modulus\", f, \"e\"); s";
     let m = model_of(src, "t.rhai", &opts).unwrap();
     assert!((at(&m, "modulus", [2.0, 2.0, 2.0]) - 120.0).abs() < 1e-9);
-    let e = model_of(&src.replace("\"e\"", "\"E2\""), "t.rhai", &opts).unwrap_err();
+    let e = model_of(&src.replace("\"e\"", "\"E2\""), "t.rhai", &opts)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("no column \"E2\""), "{e}");
 }
 
@@ -390,4 +392,37 @@ fn convert_fractions_by_voigt_and_reuss() {
     ))
     .unwrap_err();
     assert!(e.contains("above 0"), "{e}");
+}
+
+#[test]
+fn many_children_first_wins_and_resolvers_fold_the_near_ones() {
+    // 40 overlapping spheres along x (radius 1, 1.5 apart), each with its
+    // index: a union that large looks its children up in a grid.
+    let spheres = "let u = Union(); for i in 0..40 { let s = Sphere(Vec3(1.5 * i, 0, 0), 1.0, m.id(\"red\")); s.set_attribute(\"temperature\", 1.0 * i); u.add_child(s); }";
+    let first = model(&format!("{spheres} u"));
+    let most = model(&format!(
+        "{spheres} u.set_attribute_conflict_resolver(\"temperature\", \"max\"); u"
+    ));
+    let i = first.attribute_index("temperature").unwrap();
+    for k in 0..=1200 {
+        let x = -1.0 + 60.0 * f64::from(k) / 1200.0;
+        let p = DVec3::new(x, 0.2, 0.0);
+        let holds = |j: i32| (x - 1.5 * f64::from(j)).hypot(0.2) <= 1.0;
+        let (lo, hi) = (
+            (0..40).find(|j| holds(*j)),
+            (0..40).rev().find(|j| holds(*j)),
+        );
+        let (mut a, mut b, mut c) = ([0.0], [0.0], [0.0]);
+        first.attribute_at(i, p, &mut a).unwrap();
+        most.attribute_at(i, p, &mut b).unwrap();
+        match (lo, hi) {
+            (Some(lo), Some(hi)) => {
+                assert_eq!(a[0], f64::from(lo), "{x}");
+                assert_eq!(b[0], f64::from(hi), "{x}");
+                first.attribute_inside(i, p, &mut c).unwrap();
+                assert_eq!(c[0], a[0]);
+            }
+            _ => assert!(a[0].is_nan() && b[0].is_nan(), "{x}"),
+        }
+    }
 }

@@ -27,7 +27,7 @@ mod tests;
 
 use std::fmt;
 
-pub use set::ExprSet;
+pub(crate) use set::ExprSet;
 
 use crate::interval::Interval;
 
@@ -47,7 +47,8 @@ pub const COORD_VARS: [&str; 9] = ["x", "y", "z", "rho", "phic", "r", "theta", "
 /// # Panics
 /// If `slots` has fewer than 8 elements.
 #[inline]
-pub fn fill_derived_coords(slots: &mut [f64]) {
+#[cfg(test)]
+pub(crate) fn fill_derived_coords(slots: &mut [f64]) {
     fill_derived_coords_used(slots, u64::MAX);
 }
 
@@ -56,7 +57,7 @@ pub fn fill_derived_coords(slots: &mut [f64]) {
 /// `atan2` and the polar angle's `acos` cost more than the rest of a graded
 /// primitive's evaluation, so an expression of `rho` alone skips them.
 #[inline]
-pub fn fill_derived_coords_used(slots: &mut [f64], used: u64) {
+pub(crate) fn fill_derived_coords_used(slots: &mut [f64], used: u64) {
     let (x, y, z) = (slots[0], slots[1], slots[2]);
     if used & (1 << 3) != 0 {
         slots[3] = (x * x + y * y).sqrt();
@@ -80,7 +81,7 @@ pub fn fill_derived_coords_used(slots: &mut [f64], used: u64) {
 ///
 /// # Panics
 /// If `slots` has fewer than 8 elements.
-pub fn fill_derived_coord_intervals(slots: &mut [Interval]) {
+pub(crate) fn fill_derived_coord_intervals(slots: &mut [Interval]) {
     let (x, y, z) = (slots[0], slots[1], slots[2]);
     let rho2 = x.square() + y.square();
     let azimuth = ops::Op::Atan2.apply_interval(y, x, x, 0.0);

@@ -365,25 +365,27 @@ impl Parser<'_> {
                 }
                 self.node(pos, op, args)
             }
-            _ if n == 0 => Err(self.error(
-                pos,
-                format!("function '{}' expects at least 1 argument, got 0", f.name),
-            )),
-            (_, FnKind::Fold(op)) => {
+            (_, kind) => {
+                // A fold, or `avg` (a sum over the count, as ExprTk has it).
+                let (op, fold) = match kind {
+                    FnKind::Fold(op) => (op, true),
+                    _ => (Op::Add, false),
+                };
                 let mut it = args.into_iter();
-                let mut acc = it.next().expect("n >= 1");
+                let Some(mut acc) = it.next() else {
+                    return Err(self.error(
+                        pos,
+                        format!("function '{}' expects at least 1 argument, got 0", f.name),
+                    ));
+                };
                 for a in it {
                     acc = self.node(pos, op, vec![acc, a])?;
                 }
-                Ok(acc)
-            }
-            (_, _) => {
-                let mut it = args.into_iter();
-                let mut acc = it.next().expect("n >= 1");
-                for a in it {
-                    acc = self.node(pos, Op::Add, vec![acc, a])?;
+                if fold {
+                    Ok(acc)
+                } else {
+                    self.node(pos, Op::Div, vec![acc, Node::Num(n as f64)])
                 }
-                self.node(pos, Op::Div, vec![acc, Node::Num(n as f64)])
             }
         }
     }

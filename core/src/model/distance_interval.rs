@@ -148,6 +148,7 @@ impl PNode {
             | PNode::Blend { child, .. }
             | PNode::Mirror { child, .. } => child.is_lipschitz(),
             PNode::FGrade(g) => g.child.is_lipschitz(),
+            PNode::AttrGrade { child, .. } => child.is_lipschitz(),
             PNode::Affine(a) => a.child.is_lipschitz(),
             PNode::Union(n) | PNode::Intersection(n) => n.lipschitz,
             PNode::Difference { a, b, smooth } => {
@@ -243,6 +244,7 @@ impl PNode {
             }
             PNode::Tile { cell, child } => child.interval(&tile_box(b, *cell)),
             PNode::FGrade(g) => g.child.interval(b),
+            PNode::AttrGrade { child, .. } => child.interval(b),
             PNode::Blend { child, .. } => child.interval(b),
         }
     }
@@ -281,7 +283,7 @@ impl PNode {
                     }
                 }),
             },
-            PNode::Blend { .. } | PNode::Sum { .. } => false,
+            PNode::Blend { .. } | PNode::Sum { .. } | PNode::AttrGrade { .. } => false,
             _ => true, // leaves: above
         }
     }

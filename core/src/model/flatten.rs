@@ -117,8 +117,13 @@ pub(super) fn shape(n: &Node) -> Shape<'_> {
         | NodeKind::Rotate { child: Some(_), .. }
         | NodeKind::Scale { child: Some(_), .. } => moves(n),
         NodeKind::Offset { child: Some(_), .. } => offsets(n),
-        // Identity only marks a frame in the script's tree.
-        NodeKind::Identity { child: Some(c) } => Shape::Same(c),
+        // Identity only marks a frame in the script's tree, unless it
+        // converts a scalar to fractions (then it is built as written).
+        NodeKind::Identity { child: Some(c) }
+            if crate::attribute::fraction_materials(n).is_empty() =>
+        {
+            Shape::Same(c)
+        }
         NodeKind::Difference {
             smooth,
             left: Some(_),

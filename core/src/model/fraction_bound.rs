@@ -125,6 +125,7 @@ impl PNode {
             PNode::Sum { children, .. } => children.iter().any(|c| c.averages_fractions()),
             PNode::Difference { a, .. } => a.averages_fractions(),
             PNode::FGrade(g) => g.child.averages_fractions(),
+            PNode::AttrGrade { child, .. } => child.averages_fractions(),
             PNode::Blend { .. } => true,
             _ => false,
         }

@@ -73,6 +73,13 @@ impl PNode {
             PNode::Offset { child, .. } | PNode::Shell { child, .. } => child.frac(p, out),
             PNode::Tile { cell, child } => child.frac(tile_local(p, *cell), out),
             PNode::FGrade(g) => g.frac(p, out),
+            PNode::AttrGrade { child, src } => {
+                // Where the attribute has no value, the child's own.
+                let converted = src.frac(p, out);
+                if !converted {
+                    child.frac(p, out);
+                }
+            }
             PNode::Blend { r, child } => blend_frac(child, *r, p, out),
             PNode::SimField(s) => s.frac(p, out),
             // pyvcad: the first child containing p, whatever the sum.

@@ -14,13 +14,15 @@ mod fractions;
 mod pnode;
 pub mod polygon2d;
 mod prepare;
-pub mod sdf;
+pub(crate) mod sdf;
 mod shapes;
 mod strut_grid;
+mod thin_sampled;
 mod thinnest;
 mod tpms;
 mod union_index;
 
+pub use thin_sampled::{Sampled, SampledFeature};
 pub use thinnest::{Feature, Thinnest};
 
 #[cfg(test)]
@@ -41,7 +43,7 @@ pub use flatten::rotation;
 
 /// Check a `PolygonRevolve` half-profile as prepare will (for errors at
 /// the script call): the reason it is refused, if it is.
-pub fn check_revolve(
+pub(crate) fn check_revolve(
     vertices: &[DVec3],
     axis_start: DVec3,
     axis_end: DVec3,
@@ -77,6 +79,9 @@ pub struct Model {
     /// The attribute evaluator, only when some node carries an attribute
     /// (kept apart from `root` so distances and fractions never look at it).
     pub(crate) attrs: Option<Arc<crate::attribute::Evaluator>>,
+    /// The sampled thin-feature estimate, made on first use and shared by
+    /// clones (see [`Model::sampled_thinnest`]).
+    sampled: Arc<std::sync::OnceLock<Option<Sampled>>>,
 }
 
 /// The distance of one script subtree in its own frame (the attribute
@@ -105,6 +110,14 @@ impl SubDistance {
     /// Bounds of the distance over `b`.
     pub(crate) fn interval(&self, b: &Aabb) -> Interval {
         self.node.interval(b)
+    }
+
+    /// The scalar -> fractions conversion of the subtree's top node.
+    pub(crate) fn fraction_source(&self) -> Option<Arc<crate::attribute::FractionSource>> {
+        match &*self.node {
+            PNode::AttrGrade { src, .. } => Some(src.clone()),
+            _ => None,
+        }
     }
 
     /// Fractions at `p` into `out` (the design's materials, dense).
@@ -183,6 +196,7 @@ impl Model {
             table,
             node_count: root.count_nodes(),
             prepare_time: start.elapsed(),
+            sampled: Arc::default(),
         })
     }
 

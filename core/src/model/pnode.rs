@@ -180,6 +180,13 @@ pub enum PNode {
         child: Arc<PNode>,
     },
     FGrade(Box<Grade>),
+    /// Fractions from a scalar attribute of the child through a mix table
+    /// (`Convert(child, from, fractions([a, b]), table)`); the child's
+    /// distance.
+    AttrGrade {
+        child: Arc<PNode>,
+        src: Arc<crate::attribute::FractionSource>,
+    },
     Blend {
         r: f64,
         child: Arc<PNode>,
@@ -370,6 +377,7 @@ impl PNode {
             }
             PNode::Tile { cell, child } => child.dist(tile_local(p, *cell)),
             PNode::FGrade(g) => g.child.dist(p),
+            PNode::AttrGrade { child, .. } => child.dist(p),
             PNode::Blend { child, .. } => child.dist(p),
             PNode::Mesh { mesh, .. } => mesh.signed_distance(p),
             PNode::SimField(s) => s.field.signed_distance(p),

@@ -59,7 +59,8 @@ pub(super) fn collect_materials(root: &Node) -> Vec<MaterialId> {
         if !seen.insert(n.ptr()) {
             continue;
         }
-        set.extend(n.kind().own_materials().iter().copied());
+        let converted = crate::attribute::fraction_materials(n);
+        set.extend(n.kind().own_materials().iter().chain(converted).copied());
         // FGrade replaces its child's materials (pyvcad's material_list
         // leaves them out too), so its child is not visited.
         if !matches!(n.kind(), NodeKind::FGrade { .. }) {

@@ -4,12 +4,15 @@
 
 use glam::DVec3;
 
-use super::super::PrepareError;
+use std::sync::Arc;
+
 use super::super::pnode::PNode;
 use super::super::shapes::Capsule;
 use super::super::shapes::{Beam, Cone, Revolve, Shape};
+use super::super::{PrepareError, SubPreparer};
 use super::{Preparer, err};
 use crate::aabb::Aabb;
+use crate::attribute::FractionSource;
 use crate::material::MaterialId;
 use crate::node::{CapMode, Node, NodeKind};
 
@@ -103,30 +106,7 @@ impl Preparer {
                     b.transformed(&m, *point),
                 )
             }
-            NodeKind::Sum { iso, children } => {
-                if children.is_empty() {
-                    return Err(err(
-                        n,
-                        "has no children; add some with add_child or pass a list",
-                    ));
-                }
-                let mut nodes = Vec::with_capacity(children.len());
-                let mut bbox = Aabb::EMPTY;
-                for c in children {
-                    let p = self.get(c)?;
-                    nodes.push(p.node.clone());
-                    bbox = bbox.union(&p.bbox);
-                }
-                // Outside every child's box each dᵢ > 0, so Σdᵢ + iso ≤ 0
-                // needs every dᵢ ≤ −iso: within −iso of every box.
-                (
-                    PNode::Sum {
-                        iso: *iso,
-                        children: nodes,
-                    },
-                    bbox.expand((-iso).max(0.0)),
-                )
-            }
+            NodeKind::Sum { iso, children } => self.build_sum(n, *iso, children)?,
             NodeKind::Text {
                 shape,
                 depth,
@@ -144,7 +124,9 @@ impl Preparer {
                     Aabb::new(DVec3::new(lo.x, lo.y, -hz), DVec3::new(hi.x, hi.y, hz)),
                 )
             }
-            // Identity with a child is read as its child (`flatten::shape`).
+            // Identity with a child is read as its child (`flatten::shape`)
+            // unless it converts a scalar to fractions.
+            NodeKind::Identity { child: Some(c) } => self.attr_grade(n, c)?,
             NodeKind::Identity { child: None } => {
                 return Err(err(
                     n,
@@ -153,5 +135,64 @@ impl Preparer {
             }
             _ => return Err(err(n, "is not a leaf (a bug in volcad)")),
         })
+    }
+
+    /// `Sum`: the children's distances added, with `iso` added to the sum.
+    fn build_sum(
+        &self,
+        n: &Node,
+        iso: f64,
+        children: &[Node],
+    ) -> Result<(PNode, Aabb), PrepareError> {
+        if children.is_empty() {
+            return Err(err(
+                n,
+                "has no children; add some with add_child or pass a list",
+            ));
+        }
+        let mut nodes = Vec::with_capacity(children.len());
+        let mut bbox = Aabb::EMPTY;
+        for c in children {
+            let p = self.get(c)?;
+            nodes.push(p.node.clone());
+            bbox = bbox.union(&p.bbox);
+        }
+        // Outside every child's box each dᵢ > 0, so Σdᵢ + iso ≤ 0
+        // needs every dᵢ ≤ −iso: within −iso of every box.
+        Ok((
+            PNode::Sum {
+                iso,
+                children: nodes,
+            },
+            bbox.expand((-iso).max(0.0)),
+        ))
+    }
+}
+
+impl Preparer {
+    /// `Convert(child, from, fractions([a, b]), table)`: the child's
+    /// distance, fractions from its attribute `from` (an attribute
+    /// evaluator of the child's subtree, whose distances come from this
+    /// preparer's cache: the child is prepared already).
+    fn attr_grade(&self, n: &Node, c: &Node) -> Result<(PNode, Aabb), PrepareError> {
+        let Some(conv) = n.attributes().and_then(|a| a.to_fractions.as_ref()) else {
+            return Err(err(n, "was not read as its child (a bug in volcad)"));
+        };
+        let child = self.get(c)?.clone();
+        let mut materials: Vec<(MaterialId, u16)> =
+            self.slots.iter().map(|(m, s)| (*m, *s)).collect();
+        materials.sort_by_key(|(_, s)| *s);
+        let materials: Vec<MaterialId> = materials.into_iter().map(|(m, _)| m).collect();
+        let sub = SubPreparer(Preparer {
+            slots: self.slots.clone(),
+            cache: self.cache.clone(),
+        });
+        let slots = conv.materials.map(|m| self.slot(m));
+        let src = FractionSource::build(n, conv, c, &materials, slots, sub)?;
+        let node = PNode::AttrGrade {
+            child: child.node,
+            src: Arc::new(src),
+        };
+        Ok((node, child.bbox))
     }
 }

@@ -9,8 +9,9 @@
 //! their cell size before sampling.
 //!
 //! Geometry whose thickness the tree does not state (meshes, `Function`s,
-//! simulation fields) is reported as unknown rather than guessed, and gaps
-//! between separate primitives are not measured.
+//! simulation fields) is listed as unknown here and measured by sampling
+//! ([`Model::sampled_thinnest`]); gaps between separate primitives are not
+//! measured.
 
 use std::collections::HashSet;
 use std::sync::Arc;
@@ -90,6 +91,7 @@ impl Model {
                 | PNode::Tile { child, .. }
                 | PNode::Blend { child, .. } => stack.push((child, k, off)),
                 PNode::FGrade(g) => stack.push((&g.child, k, off)),
+                PNode::AttrGrade { child, .. } => stack.push((child, k, off)),
                 PNode::Scale { k: s, child, .. } => stack.push((child, k * s, off / s)),
                 // A composed chain of moves scales by at least `a.k`.
                 PNode::Affine(a) => stack.push((&a.child, k * a.k, off / a.k)),

@@ -6,22 +6,22 @@
 //! [`Slab`] (a few z layers) in parallel: each layer is cut into rows of
 //! tiles, and each tile is refined quadtree-style with the model's interval
 //! bound. A tile whose interval is beyond ± one voxel diagonal (beyond 0
-//! for [`Sampler::with_signs_only`]) is filled without evaluating its voxels
-//! (empty space, or solid interior); a solid tile with constant fractions
-//! gets one fraction evaluation, and so do the inside voxels of an open
-//! tile where the fractions are fixed or proved constant (see `Shared`). Two consumer options use fraction bounds
-//! (`Model::fraction_bounds`) on solid tiles: [`Sampler::with_uniform`]
-//! (meshes: one evaluation where the segment label is proved constant) and
-//! [`Sampler::with_lazy_fractions`] (random dithering: `NaN` fractions that
-//! the consumer evaluates only where its bounds leave a pick open; for
-//! blended designs also in tiles a surface crosses). Memory is proportional
-//! to the slab, never to the volume.
+//! for a [`Consumer`] that reads signs only) is filled without evaluating
+//! its voxels (empty space, or solid interior); a solid tile with constant
+//! fractions gets one fraction evaluation, and so do the inside voxels of
+//! an open tile where the fractions are fixed or proved constant (see
+//! `Shared`). Two consumers use fraction bounds (`Model::fraction_bounds`)
+//! on solid tiles: [`Consumer::MeshContour`] (one evaluation where the
+//! segment label is proved constant) and [`Consumer::PngStackRandom`]
+//! (`NaN` fractions that the consumer evaluates only where its bounds leave
+//! a pick open; for blended designs also in tiles a surface crosses).
+//! Memory is proportional to the slab, never to the volume.
 //!
 //! Skipped voxels store the interval end (`lo` outside, `hi` inside): the
-//! sign is exact and the magnitude is a valid bound. Without
-//! `with_signs_only` a skipped voxel is farther than one voxel diagonal
-//! from the surface, so no surface crossing lies on a grid edge that
-//! touches it, and meshers never interpolate it.
+//! sign is exact and the magnitude is a valid bound. For consumers that
+//! read distances, a skipped voxel is farther than one voxel diagonal from
+//! the surface, so no surface crossing lies on a grid edge that touches it,
+//! and meshers never interpolate it.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
@@ -31,8 +31,10 @@ use crate::aabb::Aabb;
 use crate::interval::Interval;
 use crate::model::{MAX_MATERIALS, Model};
 
+mod consumer;
 mod grid;
 mod slab;
+pub use consumer::{Consumer, UniformTest};
 pub use grid::{Grid, GridError};
 use slab::{Counts, Rect, Rows, merge_rects, row_blocks, x_tiles};
 pub use slab::{Slab, SolidRect, fill_pattern};
@@ -45,7 +47,7 @@ pub struct SampleStats {
     /// Voxels filled from an interval bound without evaluation.
     pub skipped: AtomicU64,
     /// Of those, solid voxels filled by a block through several layers
-    /// ([`Sampler::with_blocks`]).
+    /// ([`Consumer::MeshContour`]).
     pub solid_blocks: AtomicU64,
     /// Evaluated inside voxels whose fractions were not evaluated: shared
     /// over a tile where they are fixed or proved constant.
@@ -69,10 +71,6 @@ impl SampleStats {
         self.shared.fetch_add(sum.shared, Ordering::Relaxed);
     }
 }
-
-/// A consumer's test on fraction bounds: true when every fraction vector
-/// within them means the same to it (a mesh export's segment label).
-pub type UniformTest<'a> = &'a (dyn Fn(&[Interval]) -> bool + Sync);
 
 /// What bounds settle about a box of voxel centres ([`Sampler::settle`]).
 enum Settled {
@@ -169,8 +167,11 @@ const LEAF: usize = 4;
 const LEARN: u64 = 4096;
 
 impl<'a> Sampler<'a> {
-    /// A sampler of `model` on `grid`; `with_fracs` also fills fractions.
-    pub fn new(model: &'a Model, grid: Grid, with_fracs: bool) -> Self {
+    /// A sampler of `model` on `grid` for `consumer` (which decides what
+    /// is written: see [`Consumer`]).
+    pub fn new(model: &'a Model, grid: Grid, consumer: Consumer<'a>) -> Self {
+        let needs = consumer.needs();
+        let with_fracs = needs.fracs;
         let mut f = [0.0f64; MAX_MATERIALS];
         let k = model.materials().len();
         let fixed = (with_fracs && k > 0 && model.fixed_fractions(&mut f[..k])).then(|| {
@@ -180,6 +181,8 @@ impl<'a> Sampler<'a> {
             }
             one
         });
+        // Piecewise-constant designs have nothing to leave lazy.
+        let lazy = needs.lazy && model.varying_fractions();
         Self {
             fixed,
             constant_asked: AtomicU64::new(0),
@@ -187,61 +190,14 @@ impl<'a> Sampler<'a> {
             model,
             grid,
             with_fracs,
-            uniform: None,
-            lazy: false,
-            solid_rects: false,
-            blocks: false,
-            signs_only: false,
-            lazy_open: false,
+            uniform: needs.uniform,
+            lazy,
+            solid_rects: needs.solid_rects,
+            blocks: needs.blocks,
+            signs_only: needs.signs_only,
+            lazy_open: lazy && model.averages_fractions(),
             stats: SampleStats::default(),
         }
-    }
-
-    /// For consumers that read only a function of the fractions (`test`
-    /// says where it is constant): a solid tile whose fraction bounds, over
-    /// the tile grown by one voxel on every side, pass `test` gets its
-    /// centre's fractions in every voxel (one evaluation instead of one per
-    /// voxel). Growing the box makes every neighbour of such a voxel agree
-    /// too, so a mesher never interpolates across it: the mesh is the same
-    /// as with every voxel sampled. Not for slice stacks, which dither the
-    /// fractions themselves.
-    pub fn with_uniform(mut self, test: UniformTest<'a>) -> Self {
-        self.uniform = Some(test);
-        self
-    }
-
-    /// Solid tiles whose voxels all get one fraction vector (fixed mixes,
-    /// and tiles [`Sampler::with_uniform`] proves uniform) are reported as
-    /// [`SolidRect`]s in `Slab::rects` instead of being written voxel by
-    /// voxel into `Slab::fracs`: a consumer that reads rectangles can treat
-    /// each with one classification. Distances are still written.
-    pub fn with_solid_rects(mut self) -> Self {
-        self.solid_rects = true;
-        self
-    }
-
-    /// Tiles are first tried as blocks through every layer of the slab: a
-    /// block that is empty, or solid with one fraction vector (fixed, or
-    /// uniform for [`Sampler::with_uniform`]), is filled in every layer from
-    /// one analysis instead of one per layer. Its skipped voxels store the
-    /// block's (looser) interval end, so this is for consumers that read
-    /// skipped voxels' signs only (meshes), not for distance bakes.
-    pub fn with_blocks(mut self) -> Self {
-        self.blocks = true;
-        self
-    }
-
-    /// For consumers that read only the sign of a voxel's distance (slice
-    /// stacks): a tile is settled as soon as its bound excludes zero, instead
-    /// of one voxel diagonal beyond it. The default margin exists for
-    /// meshers, which interpolate distances along grid edges; a sign never
-    /// needs it. On a tiled FCC lattice at 0.093 mm this leaves 2.9 M of
-    /// 10 M voxels to evaluate instead of 4.0 M. Skipped voxels still hold
-    /// a bound with the exact sign, and evaluated voxels are evaluated as
-    /// before, so what a slice stack writes does not change.
-    pub fn with_signs_only(mut self) -> Self {
-        self.signs_only = true;
-        self
     }
 
     /// The grid.
@@ -291,7 +247,7 @@ impl<'a> Sampler<'a> {
     }
 
     /// [`Self::sample_layers`] with tasks of TILE rows through every layer
-    /// (see [`Sampler::with_blocks`]); `slab` is sized.
+    /// (see [`Consumer::MeshContour`]); `slab` is sized.
     fn sample_blocks(
         &self,
         z0: usize,
@@ -377,21 +333,6 @@ impl<'a> Sampler<'a> {
         for (x0, w) in x_tiles(nx) {
             self.tile(Rect { z, x0, y0, w, h }, out, &mut self.shared());
         }
-    }
-
-    /// For consumers that bound the fractions and evaluate them only where
-    /// the bounds do not settle what they need (random dithering): a solid
-    /// tile whose fractions vary, and which `Model::fraction_bounds` can
-    /// bound, gets `NaN` fractions instead of one evaluation per voxel (see
-    /// `Slab::fracs`). Where fractions are averages (`Blend`), so are the
-    /// inside voxels of bounded tiles that a surface crosses. Nothing
-    /// changes for a design whose fractions never vary
-    /// (`Model::varying_fractions`).
-    pub fn with_lazy_fractions(mut self) -> Self {
-        // Piecewise-constant designs have nothing to leave lazy.
-        self.lazy = self.model.varying_fractions();
-        self.lazy_open = self.lazy && self.model.averages_fractions();
-        self
     }
 
     /// Refine tile `r` into `out`.

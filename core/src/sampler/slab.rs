@@ -15,12 +15,12 @@ pub struct Slab {
     pub dist: Vec<f32>,
     /// Fractions per voxel, `k` consecutive values in model material order
     /// (empty when fractions were not asked for). Zero outside. `NaN` in a
-    /// solid tile whose fractions vary, when the sampler was made
-    /// [`super::Sampler::with_lazy_fractions`]: the consumer evaluates them.
+    /// solid tile whose fractions vary, for
+    /// [`super::Consumer::PngStackRandom`]: the consumer evaluates them.
     pub fracs: Vec<f32>,
     /// Fractions per voxel (`Model::materials().len()`).
     pub k: usize,
-    /// With [`super::Sampler::with_solid_rects`]: rectangles of solid voxels that
+    /// For [`super::Consumer::MeshContour`]: rectangles of solid voxels that
     /// share one fraction vector, by layer then row block. Their voxels'
     /// entries in `fracs` are not written (they hold whatever the buffer
     /// held); their fractions are `rect_fracs[at..at + k]`.
@@ -153,7 +153,7 @@ pub(super) struct Rows<'b> {
     pub dist: &'b mut [f32],
     pub fracs: &'b mut [f32],
     pub k: usize,
-    /// Solid rectangles found (with [`super::Sampler::with_solid_rects`]), with
+    /// Solid rectangles found (for [`super::Consumer::MeshContour`]), with
     /// their fractions `k` apiece (`at` counts from this task's first).
     pub rects: Vec<SolidRect>,
     pub rect_fracs: Vec<f32>,

@@ -28,8 +28,8 @@ fn signs_only_keeps_signs_and_fractions_and_evaluates_less() {
                [m.id("cyan"), m.id("white")], true, Intersection(false, [Tile(cell), body]))"#,
     );
     let grid = Grid::covering(&m.bbox(), DVec3::splat(0.1), 1 << 30).unwrap();
-    let (plain, plain_evaluated) = sample_all(&Sampler::new(&m, grid, true));
-    let (signs, signs_evaluated) = sample_all(&Sampler::new(&m, grid, true).with_signs_only());
+    let (plain, plain_evaluated) = sample_all(&Sampler::new(&m, grid, Consumer::ViewportBake));
+    let (signs, signs_evaluated) = sample_all(&Sampler::new(&m, grid, Consumer::PngStackDiffusion));
     let k = plain.k;
     let mut inside = 0;
     for v in 0..plain.dist.len() {
@@ -76,7 +76,7 @@ fn shared_fractions_are_the_evaluated_ones() {
     ] {
         let m = model(&src);
         let grid = Grid::covering(&m.bbox(), DVec3::splat(0.1), 1 << 30).unwrap();
-        let s = Sampler::new(&m, grid, true).with_signs_only();
+        let s = Sampler::new(&m, grid, Consumer::PngStackDiffusion);
         let (slab, _) = sample_all(&s);
         let k = slab.k;
         let mut f = vec![0.0; k];
@@ -117,8 +117,9 @@ fn tiles_of_one_exact_distance_store_what_evaluating_gives() {
         let m = model(src);
         let grid = Grid::covering(&m.bbox().expand(0.3), DVec3::splat(0.11), 1 << 30).unwrap();
         let margin = grid.voxel.length();
-        for with_fracs in [false, true] {
-            let s = Sampler::new(&m, grid, with_fracs);
+        for consumer in [Consumer::SurfaceContour, Consumer::ViewportBake] {
+            let with_fracs = matches!(consumer, Consumer::ViewportBake);
+            let s = Sampler::new(&m, grid, consumer);
             let (slab, _) = sample_all(&s);
             for z in 0..grid.dims[2] {
                 for y in 0..grid.dims[1] {
@@ -148,7 +149,7 @@ fn tiles_of_one_exact_distance_store_what_evaluating_gives() {
                 let z = (0..grid.dims[2])
                     .find(|&z| m.distance(grid.center(nx / 2, ny / 2, z)) <= 0.0)
                     .expect("a layer inside");
-                let one = Sampler::new(&m, grid, with_fracs);
+                let one = Sampler::new(&m, grid, consumer);
                 let mut layer = Slab::default();
                 one.sample_layers(z, z + 1, &mut layer, &AtomicBool::new(false))
                     .expect("not cancelled");

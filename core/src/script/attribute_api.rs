@@ -85,7 +85,7 @@ pub(super) fn register(engine: &mut Engine, ctx: &super::RunContext) {
 }
 
 /// Refuse names a math string could not tell from a coordinate.
-fn check_name(name: &str, p: Position) -> RResult<()> {
+pub(super) fn check_name(name: &str, p: Position) -> RResult<()> {
     if name.trim().is_empty() {
         return fail(
             p,

@@ -13,6 +13,14 @@ use crate::node::{LatticeType, Node, NodeKind, TpmsType};
 
 /// Register leaf constructors.
 pub fn register_leaves(engine: &mut Engine) {
+    register_sphere_and_box(engine);
+    register_cylinder_and_strut(engine);
+    register_extrude_and_function(engine);
+    register_tpms_and_lattice(engine);
+}
+
+/// `Sphere` and `RectPrism`.
+fn register_sphere_and_box(engine: &mut Engine) {
     // Sphere
     engine.register_fn("Sphere", |c: Ctx| -> RResult<Node> {
         Ok(mk(
@@ -100,7 +108,10 @@ pub fn register_leaves(engine: &mut Engine) {
         "RectPrism",
         move |c: Ctx, a: Dynamic, s: Dynamic, m: Dynamic| prism(&c, &a, &s, Some(&m)),
     );
+}
 
+/// `Cylinder` and `Strut` (pyvcad 3's tapered strut is in `shapes_api`).
+fn register_cylinder_and_strut(engine: &mut Engine) {
     // Cylinder
     engine.register_fn("Cylinder", |c: Ctx| -> RResult<Node> {
         Ok(mk(
@@ -169,7 +180,10 @@ pub fn register_leaves(engine: &mut Engine) {
             }
         },
     );
+}
 
+/// `PolygonExtrude` and `Function` (an implicit expression).
+fn register_extrude_and_function(engine: &mut Engine) {
     // PolygonExtrude
     let poly = |c: &Ctx,
                 v: &Dynamic,
@@ -265,7 +279,10 @@ pub fn register_leaves(engine: &mut Engine) {
             func(&c, &e, Some(&m), Some(&lo), Some(&hi))
         },
     );
+}
 
+/// TPMS sheets and `GraphLattice`.
+fn register_tpms_and_lattice(engine: &mut Engine) {
     // TPMS sheets (ours; pyvcad 2.x has none).
     for (name, kind) in [
         ("Gyroid", TpmsType::Gyroid),

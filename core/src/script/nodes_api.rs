@@ -33,6 +33,15 @@ pub(super) fn optional_child(
 
 /// Register transforms, booleans and material nodes.
 pub fn register_composites(engine: &mut Engine) {
+    register_transforms(engine);
+    register_union_intersection(engine);
+    register_difference(engine);
+    register_offset_shell_tile(engine);
+    register_grade_blend(engine);
+}
+
+/// `Translate`, `Scale` and `Rotate`.
+fn register_transforms(engine: &mut Engine) {
     // Translate / Scale: (), (x,y,z), (x,y,z,child)
     type Make = fn(DVec3, Option<Node>) -> NodeKind;
     let translate: Make = |v, child| NodeKind::Translate { offset: v, child };
@@ -125,7 +134,10 @@ pub fn register_composites(engine: &mut Engine) {
             rot(&c, [&x, &y, &z], Some(&a), Some(&ch))
         },
     );
+}
 
+/// `Union` and `Intersection`.
+fn register_union_intersection(engine: &mut Engine) {
     // Union / Intersection: (), (blend), (blend, children), (k, blend), (k, blend, children)
     type MakeN = fn(f64, bool, Vec<Node>) -> NodeKind;
     let union: MakeN = |smooth, blend, children| NodeKind::Union {
@@ -202,7 +214,10 @@ pub fn register_composites(engine: &mut Engine) {
             },
         );
     }
+}
 
+/// `Difference`.
+fn register_difference(engine: &mut Engine) {
     // Difference: (), (L, R), (k), (k, L, R)
     engine.register_fn("Difference", |c: Ctx| -> RResult<Node> {
         Ok(mk(
@@ -253,7 +268,10 @@ pub fn register_composites(engine: &mut Engine) {
             ))
         },
     );
+}
 
+/// `Offset`, `Shell` and `Tile`.
+fn register_offset_shell_tile(engine: &mut Engine) {
     // Offset(o[, child]) and Shell(t[, child]): both signs accepted.
     engine.register_fn("Offset", |c: Ctx| -> RResult<Node> {
         Ok(mk(
@@ -347,7 +365,10 @@ pub fn register_composites(engine: &mut Engine) {
             tile(&c, &x, &y, &z, Some(&ch))
         },
     );
+}
 
+/// `FGrade` and `Blend`.
+fn register_grade_blend(engine: &mut Engine) {
     // FGrade(exprs, materials, prob[, child])
     let fgrade = |c: &Ctx,
                   e: &Dynamic,

@@ -63,26 +63,84 @@ pub fn path_beside(design: &Path) -> PathBuf {
     design.with_file_name(format!("{stem}.params.json"))
 }
 
+/// Why a parameter-set file could not be read or written, or a set not
+/// found.
+#[derive(Debug, thiserror::Error)]
+pub enum ParamSetError {
+    /// The file could not be read or written.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the system said.
+        source: std::io::Error,
+    },
+    /// The file is not JSON of a parameter-set file.
+    #[error("{}:{line}:{column}: not a parameter-set file: {source}", path.display())]
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// Line of the error (from 1).
+        line: usize,
+        /// Column of the error (from 1).
+        column: usize,
+        /// What the JSON reader said.
+        source: serde_json::Error,
+    },
+    /// The sets could not be written as JSON.
+    #[error("{}: {source}", path.display())]
+    Encode {
+        /// The file.
+        path: PathBuf,
+        /// What the JSON writer said.
+        source: serde_json::Error,
+    },
+    /// A value of a set is not a finite number.
+    #[error("{}: set \"{set}\": parameter \"{param}\" is not a number: {value}", path.display())]
+    NotANumber {
+        /// The file.
+        path: PathBuf,
+        /// The set.
+        set: String,
+        /// The parameter.
+        param: String,
+        /// The value as written (debug form).
+        value: String,
+    },
+    /// No set of that name.
+    #[error("no parameter set \"{name}\"; the file has {}", if sets.is_empty() { "none".to_owned() } else { sets.join(", ") })]
+    NoSuchSet {
+        /// The name asked for.
+        name: String,
+        /// The sets there are, in order.
+        sets: Vec<String>,
+    },
+}
+
 impl ParamSets {
     /// Read `path`; errors name the file and say what is wrong.
-    pub fn load(path: &Path) -> Result<ParamSets, String> {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    pub fn load(path: &Path) -> Result<ParamSets, ParamSetError> {
+        let io = |source| ParamSetError::Io {
+            path: path.to_owned(),
+            source,
+        };
+        let text = std::fs::read_to_string(path).map_err(io)?;
         let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
-        let sets: ParamSets = serde_json::from_str(text).map_err(|e| {
-            format!(
-                "{}:{}:{}: not a parameter-set file: {e}",
-                path.display(),
-                e.line(),
-                e.column()
-            )
+        let sets: ParamSets = serde_json::from_str(text).map_err(|e| ParamSetError::Format {
+            path: path.to_owned(),
+            line: e.line(),
+            column: e.column(),
+            source: e,
         })?;
         for (name, set) in &sets.sets {
             for (p, v) in set {
                 if v.number().is_none_or(|x| !x.is_finite()) {
-                    return Err(format!(
-                        "{}: set \"{name}\": parameter \"{p}\" is not a number: {v:?}",
-                        path.display()
-                    ));
+                    return Err(ParamSetError::NotANumber {
+                        path: path.to_owned(),
+                        set: name.clone(),
+                        param: p.clone(),
+                        value: format!("{v:?}"),
+                    });
                 }
             }
         }
@@ -90,26 +148,28 @@ impl ParamSets {
     }
 
     /// Write to `path` (pretty, sets and names in order: diffs stay small).
-    pub fn save(&self, path: &Path) -> Result<(), String> {
+    pub fn save(&self, path: &Path) -> Result<(), ParamSetError> {
         let mut text =
-            serde_json::to_string_pretty(self).map_err(|e| format!("{}: {e}", path.display()))?;
+            serde_json::to_string_pretty(self).map_err(|source| ParamSetError::Encode {
+                path: path.to_owned(),
+                source,
+            })?;
         text.push('\n');
-        std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
+        std::fs::write(path, text).map_err(|source| ParamSetError::Io {
+            path: path.to_owned(),
+            source,
+        })
     }
 
     /// The values of set `name`, or an error listing the sets there are.
-    pub fn values(&self, name: &str) -> Result<HashMap<String, f64>, String> {
-        let set = self.sets.get(name).ok_or_else(|| {
-            let names: Vec<&str> = self.sets.keys().map(String::as_str).collect();
-            format!(
-                "no parameter set \"{name}\"; the file has {}",
-                if names.is_empty() {
-                    "none".to_owned()
-                } else {
-                    names.join(", ")
-                }
-            )
-        })?;
+    pub fn values(&self, name: &str) -> Result<HashMap<String, f64>, ParamSetError> {
+        let set = self
+            .sets
+            .get(name)
+            .ok_or_else(|| ParamSetError::NoSuchSet {
+                name: name.to_owned(),
+                sets: self.sets.keys().cloned().collect(),
+            })?;
         Ok(set
             .iter()
             .filter_map(|(k, v)| v.number().map(|x| (k.clone(), x)))
@@ -147,7 +207,7 @@ mod tests {
         let v = s.values("thin").expect("thin");
         assert_eq!(v["wall"], 0.8);
         assert_eq!(v["r"], 12.0);
-        let e = s.values("thick").unwrap_err();
+        let e = s.values("thick").unwrap_err().to_string();
         assert!(
             e.contains("no parameter set \"thick\"") && e.contains("thin"),
             "{e}"
@@ -168,10 +228,10 @@ mod tests {
         let dir = tempfile::tempdir().expect("temp dir");
         let p = dir.path().join("bad.params.json");
         std::fs::write(&p, "{\"parameterSets\": {\"a\": {\"w\": \"wide\"}}}").expect("write");
-        let e = ParamSets::load(&p).unwrap_err();
+        let e = ParamSets::load(&p).unwrap_err().to_string();
         assert!(e.contains("\"w\" is not a number"), "{e}");
         std::fs::write(&p, "{\"parameterSets\": [1, 2]").expect("write");
-        let e = ParamSets::load(&p).unwrap_err();
+        let e = ParamSets::load(&p).unwrap_err().to_string();
         assert!(e.contains("bad.params.json:1:"), "{e}");
     }
 }

@@ -65,43 +65,7 @@ pub(crate) fn parse(path: &Path, mesh: &InpMesh) -> Result<Columns, SimFieldErro
         let data: Vec<(usize, &str)> = std::iter::once((first_ln, first)).chain(lines).collect();
         (POINTMAP.iter().map(|s| s.to_string()).collect(), None, data)
     } else {
-        let mut names = Vec::with_capacity(first_cells.len());
-        for (k, raw) in first_cells.iter().enumerate() {
-            let unquoted = raw.trim_matches('"').trim();
-            let name = sanitize(unquoted, k);
-            if name != unquoted {
-                warnings.push(format!(
-                    "{}:{first_ln}: column `{raw}` is called `{name}` (names must be identifiers)",
-                    path.display()
-                ));
-            }
-            if names.contains(&name) {
-                return Err(csv_err(
-                    first_ln,
-                    format!("column name `{name}` appears twice"),
-                ));
-            }
-            names.push(name);
-        }
-        let id_col = names
-            .iter()
-            .position(|n| ID_NAMES.iter().any(|id| n.eq_ignore_ascii_case(id)));
-        if names.len() - id_col.is_some() as usize == 0 {
-            return Err(csv_err(first_ln, "the header names no value column".into()));
-        }
-        let values = names
-            .iter()
-            .enumerate()
-            .filter(|&(k, n)| Some(k) != id_col && super::coordinate_axis(n).is_none())
-            .count();
-        if values > MAX_VALUE_COLUMNS {
-            return Err(csv_err(
-                first_ln,
-                format!(
-                    "the header names {values} value columns besides the node id and x, y, z; at most {MAX_VALUE_COLUMNS} are supported"
-                ),
-            ));
-        }
+        let (names, id_col) = header(&first_cells, first_ln, path, &mut warnings)?;
         (names, id_col, lines.collect())
     };
 
@@ -186,6 +150,59 @@ pub(crate) fn parse(path: &Path, mesh: &InpMesh) -> Result<Columns, SimFieldErro
         .map(|(&k, v)| (names[k].clone(), v))
         .collect();
     Ok((out, warnings))
+}
+
+/// The column names of a header line (`cells` of line `ln`) and which of
+/// them is the node id; warnings for renamed columns.
+fn header(
+    first_cells: &[&str],
+    first_ln: usize,
+    path: &Path,
+    warnings: &mut Vec<String>,
+) -> Result<(Vec<String>, Option<usize>), SimFieldError> {
+    let csv_err = |line: usize, msg: String| SimFieldError::Csv {
+        path: path.to_path_buf(),
+        line,
+        msg,
+    };
+    let mut names = Vec::with_capacity(first_cells.len());
+    for (k, raw) in first_cells.iter().enumerate() {
+        let unquoted = raw.trim_matches('"').trim();
+        let name = sanitize(unquoted, k);
+        if name != unquoted {
+            warnings.push(format!(
+                "{}:{first_ln}: column `{raw}` is called `{name}` (names must be identifiers)",
+                path.display()
+            ));
+        }
+        if names.contains(&name) {
+            return Err(csv_err(
+                first_ln,
+                format!("column name `{name}` appears twice"),
+            ));
+        }
+        names.push(name);
+    }
+    let id_col = names
+        .iter()
+        .position(|n| ID_NAMES.iter().any(|id| n.eq_ignore_ascii_case(id)));
+    if names.len() - id_col.is_some() as usize == 0 {
+        return Err(csv_err(first_ln, "the header names no value column".into()));
+    }
+    let values = names
+        .iter()
+        .enumerate()
+        .filter(|&(k, n)| Some(k) != id_col && super::coordinate_axis(n).is_none())
+        .count();
+    if values > MAX_VALUE_COLUMNS {
+        return Err(csv_err(
+            first_ln,
+            format!(
+                "the header names {values} value columns besides the node id and x, y, z; at most {MAX_VALUE_COLUMNS} are supported"
+            ),
+        ));
+    }
+    Ok((names, id_col))
 }
 
 /// Comma-separated cells, trimmed, without a trailing empty cell.

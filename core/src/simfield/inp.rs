@@ -53,21 +53,30 @@ enum Block {
     Ignored { kind: String },
 }
 
-/// Parses the deck at `path`.
+/// Raw elements: (element id, corner node ids, line).
+type RawTets = Vec<(u64, [u64; 4], usize)>;
+
+/// A syntax error at 1-based `line` of `path`.
+fn inp_err(path: &Path, line: usize, msg: String) -> SimFieldError {
+    SimFieldError::Inp {
+        path: path.to_path_buf(),
+        line,
+        msg,
+    }
+}
+
+/// Parses the deck at `path`: keyword lines switch the block, data lines
+/// of `*NODE` and `*ELEMENT` blocks are read, and the elements' node ids
+/// are resolved once every node is known.
 pub(crate) fn parse(path: &Path) -> Result<InpMesh, SimFieldError> {
     let bytes = std::fs::read(path).map_err(|e| SimFieldError::Io {
         path: path.to_path_buf(),
         msg: e.to_string(),
     })?;
     let text = String::from_utf8_lossy(&bytes);
-    let err = |line: usize, msg: String| SimFieldError::Inp {
-        path: path.to_path_buf(),
-        line,
-        msg,
-    };
+    let err = |line: usize, msg: String| inp_err(path, line, msg);
     let mut mesh = InpMesh::default();
-    // Raw elements: (element id, corner node ids, line).
-    let mut raw: Vec<(u64, [u64; 4], usize)> = Vec::new();
+    let mut raw: RawTets = Vec::new();
     let mut ignored: Vec<(String, usize)> = Vec::new();
     let mut c3d10 = 0usize;
     let mut block = Block::Skip;
@@ -93,91 +102,14 @@ pub(crate) fn parse(path: &Path) -> Result<InpMesh, SimFieldError> {
                     ),
                 ));
             }
-            let mut parts = keyword_line.split(',');
-            let keyword = parts
-                .next()
-                .unwrap_or("")
-                .split_whitespace()
-                .collect::<Vec<_>>()
-                .join(" ")
-                .to_ascii_uppercase();
-            let param = |name: &str| {
-                keyword_line.split(',').skip(1).find_map(|p| {
-                    let (k, v) = p.split_once('=')?;
-                    k.trim()
-                        .eq_ignore_ascii_case(name)
-                        .then(|| v.trim().to_ascii_uppercase())
-                })
-            };
-            block = match keyword.as_str() {
-                "NODE" => Block::Node,
-                "ELEMENT" => {
-                    let Some(kind) = param("TYPE") else {
-                        return Err(err(
-                            ln,
-                            "`*ELEMENT` needs a `TYPE=` parameter (e.g. TYPE=C3D4)".into(),
-                        ));
-                    };
-                    if kind.starts_with("C3D4") {
-                        Block::Tets { n: 4 }
-                    } else if kind.starts_with("C3D10") {
-                        Block::Tets { n: 10 }
-                    } else {
-                        Block::Ignored { kind }
-                    }
-                }
-                "INCLUDE" => {
-                    mesh.warnings.push(format!(
-                        "{}:{ln}: `*INCLUDE` is not followed; put the mesh in one file",
-                        path.display()
-                    ));
-                    Block::Skip
-                }
-                _ => Block::Skip,
-            };
+            block = keyword_block(keyword_line, path, ln, &mut mesh.warnings)?;
             continue;
         }
         match &block {
             Block::Skip => {}
             Block::Node => {
                 split_fields_into(line, &mut fields);
-                if fields.len() < 4 {
-                    return Err(err(
-                        ln,
-                        format!("expected a node line `id, x, y, z`, found `{line}`"),
-                    ));
-                }
-                let id = parse_id(fields[0]).ok_or_else(|| {
-                    err(
-                        ln,
-                        format!("node id `{}` is not a positive integer", fields[0]),
-                    )
-                })?;
-                let mut xyz = [0.0; 3];
-                for (k, f) in fields[1..4].iter().enumerate() {
-                    xyz[k] = f
-                        .parse::<f64>()
-                        .ok()
-                        .filter(|v| v.is_finite())
-                        .ok_or_else(|| {
-                            err(
-                                ln,
-                                format!("node {id}: coordinate `{f}` is not a finite number"),
-                            )
-                        })?;
-                }
-                if let Some(&prev) = mesh.index_of.get(&id) {
-                    return Err(SimFieldError::DuplicateNode {
-                        path: path.to_path_buf(),
-                        line: ln,
-                        id,
-                        first_line: mesh.node_lines[prev as usize],
-                    });
-                }
-                mesh.index_of.insert(id, mesh.nodes.len() as u32);
-                mesh.node_ids.push(id);
-                mesh.nodes.push(DVec3::from_array(xyz));
-                mesh.node_lines.push(ln);
+                node_line(&mut mesh, &fields, line, path, ln)?;
             }
             Block::Tets { n } => {
                 let n = *n;
@@ -216,12 +148,121 @@ pub(crate) fn parse(path: &Path) -> Result<InpMesh, SimFieldError> {
             "the last element ends with a comma but the file ends".into(),
         ));
     }
+    finish(mesh, raw, &ignored, c3d10, path)
+}
+
+/// The block a keyword line (without its `*`) at line `ln` opens; a
+/// warning for what is not followed.
+fn keyword_block(
+    keyword_line: &str,
+    path: &Path,
+    ln: usize,
+    warnings: &mut Vec<String>,
+) -> Result<Block, SimFieldError> {
+    let mut parts = keyword_line.split(',');
+    let keyword = parts
+        .next()
+        .unwrap_or("")
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ")
+        .to_ascii_uppercase();
+    let param = |name: &str| {
+        keyword_line.split(',').skip(1).find_map(|p| {
+            let (k, v) = p.split_once('=')?;
+            k.trim()
+                .eq_ignore_ascii_case(name)
+                .then(|| v.trim().to_ascii_uppercase())
+        })
+    };
+    Ok(match keyword.as_str() {
+        "NODE" => Block::Node,
+        "ELEMENT" => {
+            let Some(kind) = param("TYPE") else {
+                return Err(inp_err(
+                    path,
+                    ln,
+                    "`*ELEMENT` needs a `TYPE=` parameter (e.g. TYPE=C3D4)".into(),
+                ));
+            };
+            if kind.starts_with("C3D4") {
+                Block::Tets { n: 4 }
+            } else if kind.starts_with("C3D10") {
+                Block::Tets { n: 10 }
+            } else {
+                Block::Ignored { kind }
+            }
+        }
+        "INCLUDE" => {
+            warnings.push(format!(
+                "{}:{ln}: `*INCLUDE` is not followed; put the mesh in one file",
+                path.display()
+            ));
+            Block::Skip
+        }
+        _ => Block::Skip,
+    })
+}
+
+/// One `*NODE` data line (`fields` of `line`, at line `ln`) into `mesh`.
+fn node_line(
+    mesh: &mut InpMesh,
+    fields: &[&str],
+    line: &str,
+    path: &Path,
+    ln: usize,
+) -> Result<(), SimFieldError> {
+    let err = |msg: String| inp_err(path, ln, msg);
+    if fields.len() < 4 {
+        return Err(err(format!(
+            "expected a node line `id, x, y, z`, found `{line}`"
+        )));
+    }
+    let id = parse_id(fields[0])
+        .ok_or_else(|| err(format!("node id `{}` is not a positive integer", fields[0])))?;
+    let mut xyz = [0.0; 3];
+    for (k, f) in fields[1..4].iter().enumerate() {
+        xyz[k] = f
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| {
+                err(format!(
+                    "node {id}: coordinate `{f}` is not a finite number"
+                ))
+            })?;
+    }
+    if let Some(&prev) = mesh.index_of.get(&id) {
+        return Err(SimFieldError::DuplicateNode {
+            path: path.to_path_buf(),
+            line: ln,
+            id,
+            first_line: mesh.node_lines[prev as usize],
+        });
+    }
+    mesh.index_of.insert(id, mesh.nodes.len() as u32);
+    mesh.node_ids.push(id);
+    mesh.nodes.push(DVec3::from_array(xyz));
+    mesh.node_lines.push(ln);
+    Ok(())
+}
+
+/// After the last line: the warnings for ignored and quadratic elements,
+/// the errors for a deck without nodes or tetrahedra, and each raw
+/// element's node ids resolved to node indices.
+fn finish(
+    mut mesh: InpMesh,
+    raw: RawTets,
+    ignored: &[(String, usize)],
+    c3d10: usize,
+    path: &Path,
+) -> Result<InpMesh, SimFieldError> {
     if mesh.nodes.is_empty() {
         return Err(SimFieldError::NoNodes {
             path: path.to_path_buf(),
         });
     }
-    for (kind, count) in &ignored {
+    for (kind, count) in ignored {
         mesh.warnings.push(format!(
             "{}: ignored {count} data lines of element type {kind} (only C3D4 and C3D10 tetrahedra are used)",
             path.display()

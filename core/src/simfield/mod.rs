@@ -184,7 +184,7 @@ pub enum SimFieldError {
 
 /// Most tetrahedra [`SimField::bounds`] gathers before giving up (a box
 /// that large is too coarse for its bounds to decide anything).
-pub const MAX_BOUND_TETS: usize = 512;
+pub(crate) const MAX_BOUND_TETS: usize = 512;
 
 /// A tetrahedral mesh with nodal values, sampled by barycentric
 /// interpolation. Immutable and `Sync`.
@@ -328,7 +328,8 @@ impl SimField {
     /// the points of `b` inside the mesh, into `out`: the nodal ranges over
     /// the tetrahedra whose boxes meet `b` (linear interpolation stays
     /// within them), and for `len` the magnitude of the component ranges.
-    /// False when no tetrahedron or more than [`MAX_BOUND_TETS`] meet `b`.
+    /// False when no tetrahedron or more than `MAX_BOUND_TETS` (512) meet
+    /// `b`.
     pub fn bounds(&self, b: &Aabb, out: &mut [Interval]) -> bool {
         let s = self.stride;
         if s > 64 {
@@ -463,33 +464,7 @@ fn build(
         }
     }
     let mut warnings = Vec::new();
-    let mut names: Vec<String> = Vec::new();
-    let mut stored: Vec<Vec<f64>> = Vec::new();
-    let mut coords: [Option<Vec<f64>>; 3] = [None, None, None];
-    for (name, vals) in columns {
-        if vals.len() != nodes.len() {
-            return Err(other(format!(
-                "column `{name}` has {} values for {} nodes",
-                vals.len(),
-                nodes.len()
-            )));
-        }
-        if name.is_empty() || names.iter().any(|n| n.eq_ignore_ascii_case(&name)) {
-            return Err(other(format!("column name `{name}` is empty or repeated")));
-        }
-        if let Some(i) = vals.iter().position(|v| !v.is_finite()) {
-            return Err(other(format!(
-                "column `{name}`: value of node {i} is not finite"
-            )));
-        }
-        match coordinate_axis(&name) {
-            Some(a) => coords[a] = Some(vals),
-            None => {
-                names.push(name);
-                stored.push(vals);
-            }
-        }
-    }
+    let (mut names, stored, coords) = value_columns(columns, nodes.len())?;
     check_coordinates(&nodes, &coords, &mut warnings);
 
     // Degenerate tetrahedra: |V| ≤ 1e−12 · mean |V|.
@@ -575,6 +550,43 @@ fn build(
         boundary,
         warnings,
     })
+}
+
+/// Value columns (names and values) and coordinate columns (by axis) of
+/// `columns`, each checked: one finite value per node, a unique name.
+type Sorted = (Vec<String>, Vec<Vec<f64>>, [Option<Vec<f64>>; 3]);
+
+/// Sorts `columns` (`nodes` values each) into value and coordinate
+/// columns, refusing wrong lengths, repeated names and non-finite values.
+fn value_columns(columns: Vec<(String, Vec<f64>)>, nodes: usize) -> Result<Sorted, BuildError> {
+    let other = |m: String| BuildError::Other(m);
+    let mut names: Vec<String> = Vec::new();
+    let mut stored: Vec<Vec<f64>> = Vec::new();
+    let mut coords: [Option<Vec<f64>>; 3] = [None, None, None];
+    for (name, vals) in columns {
+        if vals.len() != nodes {
+            return Err(other(format!(
+                "column `{name}` has {} values for {nodes} nodes",
+                vals.len(),
+            )));
+        }
+        if name.is_empty() || names.iter().any(|n| n.eq_ignore_ascii_case(&name)) {
+            return Err(other(format!("column name `{name}` is empty or repeated")));
+        }
+        if let Some(i) = vals.iter().position(|v| !v.is_finite()) {
+            return Err(other(format!(
+                "column `{name}`: value of node {i} is not finite"
+            )));
+        }
+        match coordinate_axis(&name) {
+            Some(a) => coords[a] = Some(vals),
+            None => {
+                names.push(name);
+                stored.push(vals);
+            }
+        }
+    }
+    Ok((names, stored, coords))
 }
 
 /// The axis of a coordinate column (`x`, `y`, `z` in any case): compared

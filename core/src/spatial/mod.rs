@@ -7,8 +7,8 @@
 //! `f32` (`round`).
 
 pub(crate) mod bvh;
-pub mod cells;
-pub mod order;
+pub(crate) mod cells;
+pub(crate) mod order;
 pub(crate) mod recent;
 pub(crate) mod round;
 pub(crate) mod wide;

@@ -19,13 +19,11 @@ mod kerning;
 use glam::DVec2;
 use ttf_parser::OutlineBuilder;
 
-pub use font::BUNDLED_FAMILY;
-
 /// Curves are flattened to within this fraction of the text height
 /// (Wang's bound on the chord error of uniformly split Béziers): 5 µm for a
 /// 10 mm label, a fifth of the thinnest inkjet layer, so the polygon's
 /// distance is the font's to well within a voxel.
-pub const FLATTEN_TOLERANCE: f64 = 5e-4;
+pub(crate) const FLATTEN_TOLERANCE: f64 = 5e-4;
 
 /// Most characters one `Text` node lays out.
 pub const MAX_CHARS: usize = 10_000;
@@ -110,31 +108,61 @@ pub struct TextOutline {
     pub warnings: Vec<String>,
 }
 
+/// Why a text could not be laid out.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum TextError {
+    /// The text has no characters.
+    #[error("the text is empty; give at least one character")]
+    Empty,
+    /// More than [`MAX_CHARS`] characters.
+    #[error(
+        "the text has {chars} characters; at most {MAX_CHARS} fit in one Text (split it into several)"
+    )]
+    TooLong {
+        /// Characters in the text.
+        chars: usize,
+    },
+    /// The height is not a positive number.
+    #[error("height must be > 0, got {0}")]
+    Height(f64),
+    /// The font's data could not be used.
+    #[error("{0}")]
+    Font(String),
+    /// No character of the text has a visible glyph.
+    #[error("{text:?} has no visible glyph in {family}; give letters, digits or symbols")]
+    NoGlyph {
+        /// The text.
+        text: String,
+        /// The font family used.
+        family: String,
+    },
+}
+
 /// Lay out `text` and flatten its glyphs. Errors: empty text, too long, a
 /// non-positive height, an unreadable font, no visible glyph.
-pub fn outline(text: &str, style: &TextStyle) -> Result<TextOutline, String> {
+pub fn outline(text: &str, style: &TextStyle) -> Result<TextOutline, TextError> {
     if text.is_empty() {
-        return Err("the text is empty; give at least one character".into());
+        return Err(TextError::Empty);
     }
     let chars = text.chars().count();
     if chars > MAX_CHARS {
-        return Err(format!(
-            "the text has {chars} characters; at most {MAX_CHARS} fit in one Text (split it into several)"
-        ));
+        return Err(TextError::TooLong { chars });
     }
     if !(style.height.is_finite() && style.height > 0.0) {
-        return Err(format!("height must be > 0, got {}", style.height));
+        return Err(TextError::Height(style.height));
     }
     let mut warnings = Vec::new();
     let out = font::with_font(&style.font, style.aspect, &mut warnings, |face, family| {
         layout(face, family, text, style)
-    })??;
+    })
+    .and_then(|laid| laid)
+    .map_err(TextError::Font)?;
     warnings.extend(out.warnings);
     if out.contours.is_empty() {
-        return Err(format!(
-            "{:?} has no visible glyph in {}; give letters, digits or symbols",
-            text, out.family
-        ));
+        return Err(TextError::NoGlyph {
+            text: text.to_owned(),
+            family: out.family,
+        });
     }
     Ok(TextOutline { warnings, ..out })
 }

@@ -20,8 +20,6 @@ mod translate;
 use std::path::Path;
 use std::sync::Arc;
 
-pub use translate::CONSTRUCTS;
-
 use crate::material::MaterialTable;
 use crate::script::{Design, RunContext, ScriptError, ScriptOptions};
 
@@ -44,7 +42,7 @@ impl VcadError {
 }
 
 /// Whether `name` (a path or file name) is a `.vcad` design.
-pub fn is_vcad(name: impl AsRef<Path>) -> bool {
+pub(crate) fn is_vcad(name: impl AsRef<Path>) -> bool {
     name.as_ref()
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("vcad"))
@@ -53,7 +51,11 @@ pub fn is_vcad(name: impl AsRef<Path>) -> bool {
 /// Read a `.vcad` design: `name` is the file name errors carry; `opts`
 /// gives the folder `mesh("...")` paths resolve in (parameters do not
 /// apply: the language has none).
-pub fn run_vcad(source: &str, name: &str, opts: &ScriptOptions) -> Result<Design, ScriptError> {
+pub(crate) fn run_vcad(
+    source: &str,
+    name: &str,
+    opts: &ScriptOptions,
+) -> Result<Design, ScriptError> {
     let to_err = |e: VcadError| ScriptError {
         file: name.to_owned(),
         line: Some(e.line),

@@ -1,6 +1,8 @@
 //! Shared helpers for the render tests and benchmarks: test designs, image
 //! output, pixel lookups.
 #![allow(dead_code)]
+// A failed setup step (a scratch folder, a file read) fails the test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::path::PathBuf;
 

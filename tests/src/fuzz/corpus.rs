@@ -1,5 +1,5 @@
 //! The regression corpus: every case that ever failed, one JSON file each
-//! in `tests/fuzz-corpus/`, replayed by `cargo test` (app/tests/fuzz.rs).
+//! in `tests/fuzz-corpus/`, replayed by `cargo test` (tests/tests/fuzz.rs).
 //! Files are stored as text where they are UTF-8 (readable in a review),
 //! else as hex.
 

@@ -92,17 +92,9 @@ pub struct Report {
 }
 
 /// The `volcad` binary: `$VOLCAD_BIN`, else beside this executable in the
-/// target folder (`target/<profile>/volcad`, tests run from `deps/`).
+/// target folder ([`crate::bins::find`]).
 pub fn find_binary() -> Option<PathBuf> {
-    if let Some(p) = std::env::var_os("VOLCAD_BIN") {
-        return Some(PathBuf::from(p));
-    }
-    let exe = std::env::current_exe().ok()?;
-    exe.ancestors()
-        .skip(1)
-        .take(3)
-        .map(|d| d.join(format!("volcad{}", std::env::consts::EXE_SUFFIX)))
-        .find(|p| p.is_file())
+    crate::bins::find("volcad")
 }
 
 /// Run `case` with `bin` under `limits` in a fresh folder below `scratch`.

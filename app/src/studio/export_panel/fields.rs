@@ -13,12 +13,16 @@ use volcad_core::Model;
 
 use super::ExportPanels;
 
+/// The PNG printer choice without a preset: any voxel, the design's own
+/// material table.
+const GENERIC: &str = "Generic (custom voxel)";
+
 impl ExportPanels {
     pub(super) fn png_ui(&mut self, ui: &mut egui::Ui) {
         let presets = png_stack::presets();
         egui::Grid::new("png-params").num_columns(2).show(ui, |ui| {
             let label = ui.label("Printer").id;
-            let current = self.preset.map_or("Custom voxel", |i| presets[i].name);
+            let current = self.preset.map_or(GENERIC, |i| presets[i].name);
             egui::ComboBox::from_id_salt("png-preset")
                 .selected_text(current)
                 .show_ui(ui, |ui| {
@@ -33,7 +37,8 @@ impl ExportPanels {
                         }
                     }
                     if ui
-                        .selectable_label(self.preset.is_none(), "Custom voxel")
+                        .selectable_label(self.preset.is_none(), GENERIC)
+                        .on_hover_text("Any voxel, the design's own materials and colours")
                         .clicked()
                     {
                         self.preset = None;
@@ -42,6 +47,9 @@ impl ExportPanels {
                 .response
                 .labelled_by(label);
             ui.end_row();
+            if self.png_j750() {
+                self.printers.map_row(ui);
+            }
             let label = ui.label("Voxel (mm)").id;
             ui.horizontal(|ui| {
                 let mut changed = false;

@@ -1,5 +1,6 @@
-//! Export panels: PNG slice stack (inkjet), segmented meshes (STL/OBJ/3MF)
-//! and FEA meshes (.inp). Each has its parameters with defaults (printer
+//! Export panels: PNG slice stack (inkjet), segmented meshes (STL/OBJ/3MF),
+//! FEA meshes (.inp), GrabCAD packages (.gcvf, one file) and vat printer
+//! stacks (printer fields in `printer_fields.rs`). Each has its parameters with defaults (printer
 //! presets for slice stacks, fields in `fields.rs`), an output folder, an
 //! estimate computed on a worker (`worker.rs`), and a Start button. What
 //! happens before and at the start is `volcad_compilers::plan`, the same
@@ -13,6 +14,7 @@
 //! never used.
 
 mod fields;
+mod printer_fields;
 mod worker;
 
 use std::collections::BTreeMap;
@@ -24,8 +26,9 @@ use volcad_compilers::fea::{Element, FeaParams, Sizing, StepParams};
 use volcad_compilers::job::design_hash;
 use volcad_compilers::mesh::MeshParams;
 use volcad_compilers::plan::folder::{self, Folder};
-use volcad_compilers::plan::{self, ExportParams, Opt, Severity, Verdict};
-use volcad_compilers::png_stack::PngParams;
+use volcad_compilers::plan::{ExportParams, Opt, Severity, Verdict};
+use volcad_compilers::png_stack::{self, PngParams};
+use volcad_compilers::printer_table::{is_j750_preset, j750_model, parse_map};
 use volcad_core::Model;
 
 use super::files::Document;
@@ -65,6 +68,10 @@ pub enum Kind {
     Mesh,
     /// FEA mesh.
     Fea,
+    /// GrabCAD Voxel Print package (one file).
+    Gcvf,
+    /// Vat photopolymer stack.
+    Vat,
 }
 
 impl Kind {
@@ -73,6 +80,8 @@ impl Kind {
             Kind::Png => "PNG stack",
             Kind::Mesh => "Meshes / 3MF",
             Kind::Fea => "FEA (.inp)",
+            Kind::Gcvf => "GCVF (.gcvf)",
+            Kind::Vat => "Vat stack",
         }
     }
 
@@ -81,6 +90,16 @@ impl Kind {
             Kind::Png => "png",
             Kind::Mesh => "mesh",
             Kind::Fea => "fea",
+            Kind::Gcvf => "gcvf",
+            Kind::Vat => "vat",
+        }
+    }
+
+    /// The output field's label: a GCVF package is one file.
+    fn out_label(self) -> &'static str {
+        match self {
+            Kind::Gcvf => "Output file",
+            _ => "Output folder",
         }
     }
 }
@@ -116,12 +135,27 @@ impl Place {
         }
     }
 
-    /// `<folder>/<design>_<kind>`.
+    /// `<folder>/<design>_<kind>`, or `<folder>/<design>.gcvf` for a
+    /// GrabCAD package.
     fn default_dir(&self, kind: Kind) -> PathBuf {
-        let stem = Path::new(&self.name)
+        match kind {
+            Kind::Gcvf => self.folder.join(self.file_name(kind)),
+            _ => self
+                .folder
+                .join(format!("{}_{}", self.stem(), kind.suffix())),
+        }
+    }
+
+    /// The design's name without its extension.
+    fn stem(&self) -> String {
+        Path::new(&self.name)
             .file_stem()
-            .map_or_else(|| "design".into(), |s| s.to_string_lossy().into_owned());
-        self.folder.join(format!("{stem}_{}", kind.suffix()))
+            .map_or_else(|| "design".into(), |s| s.to_string_lossy().into_owned())
+    }
+
+    /// `<design>.<kind>`: the file a one-file export writes in a folder.
+    fn file_name(&self, kind: Kind) -> String {
+        format!("{}.{}", self.stem(), kind.suffix())
     }
 
     /// The settings key of its folder for `kind`.
@@ -155,6 +189,13 @@ pub struct ExportPanels {
     fea: FeaParams,
     fea_expr: String,
     fea_step: Option<f64>,
+    /// GrabCAD package and vat stack fields (`printer_fields.rs`).
+    printers: printer_fields::PrinterFields,
+    /// The file a one-file export gets in a picked folder.
+    file_name: String,
+    /// The design as the PNG printer choice prints it (a J750 relabels it
+    /// with resins), by model and resin map.
+    printed: Option<(usize, String, Result<Arc<Model>, String>)>,
     estimate: EstimateWorker,
     pending: Option<Pending>,
     /// Why the last Start did not start, shown until the next.
@@ -170,7 +211,7 @@ impl ExportPanels {
             shown: None,
             kind: Kind::Png,
             png: PngParams::default(),
-            preset: Some(0),
+            preset: None,
             mesh: MeshParams {
                 voxel: DVec3::splat(0.25),
                 ..MeshParams::default()
@@ -181,6 +222,9 @@ impl ExportPanels {
             },
             fea_expr: String::new(),
             fea_step: None,
+            printers: printer_fields::PrinterFields::default(),
+            file_name: String::new(),
+            printed: None,
             estimate: EstimateWorker::default(),
             pending: None,
             refusal: None,
@@ -198,8 +242,14 @@ impl ExportPanels {
     }
 
     /// Set the output folder of the design and kind shown (the same as
-    /// typing it).
+    /// typing it); a folder picked for a one-file export gets the
+    /// design's file name in it.
     pub fn set_dir(&mut self, dir: PathBuf) {
+        let dir = if self.kind == Kind::Gcvf && dir.is_dir() && !self.file_name.is_empty() {
+            dir.join(&self.file_name)
+        } else {
+            dir
+        };
         self.dir = dir.display().to_string();
         self.remember();
     }
@@ -215,6 +265,7 @@ impl ExportPanels {
 
     /// Show the remembered or default folder of `place` and the kind.
     fn follow(&mut self, place: &Place) {
+        self.file_name = place.file_name(self.kind);
         let key = place.dir_key(self.kind);
         if self.shown.as_ref() != Some(&key) {
             let dir = self
@@ -228,10 +279,44 @@ impl ExportPanels {
         }
     }
 
-    fn params(&self) -> ExportParams {
-        match self.kind {
+    /// True when the PNG printer choice is a J750 (its material table).
+    fn png_j750(&self) -> bool {
+        self.preset
+            .and_then(|i| png_stack::presets().get(i))
+            .is_some_and(|p| is_j750_preset(p.name))
+    }
+
+    /// The design as the export writes it: for a PNG stack on a J750, its
+    /// materials as J750 resins through the resin map (refused, naming
+    /// the nearest resins, when one is not); otherwise `model`.
+    fn printed_model(&mut self, model: &Arc<Model>) -> Result<Arc<Model>, String> {
+        if !(self.kind == Kind::Png && self.png_j750()) {
+            return Ok(model.clone());
+        }
+        let key = (
+            Arc::as_ptr(model) as usize,
+            self.printers.map_text().to_owned(),
+        );
+        match &self.printed {
+            Some((ptr, map, m)) if (*ptr, map) == (key.0, &key.1) => m.clone(),
+            _ => {
+                let m = parse_map(&key.1)
+                    .and_then(|map| j750_model(model, &map))
+                    .map_err(|e| in_panel_words(&e.to_string()));
+                self.printed = Some((key.0, key.1, m.clone()));
+                m
+            }
+        }
+    }
+
+    /// The parameters of the kind shown; an error (in the panel's words)
+    /// for a field that does not parse.
+    fn params(&self) -> Result<ExportParams, String> {
+        Ok(match self.kind {
             Kind::Png => ExportParams::Png(self.png.clone()),
             Kind::Mesh => ExportParams::Mesh(self.mesh.clone()),
+            Kind::Gcvf => ExportParams::Gcvf(self.printers.gcvf()?),
+            Kind::Vat => ExportParams::Vat(self.printers.vat()?),
             Kind::Fea => {
                 let mut p = self.fea.clone();
                 p.sizing = if self.fea_expr.trim().is_empty() {
@@ -244,7 +329,7 @@ impl ExportPanels {
                 });
                 ExportParams::Fea(p)
             }
-        }
+        })
     }
 
     /// Show the panels; `place` says where the design's folders go,
@@ -258,7 +343,7 @@ impl ExportPanels {
     ) -> Action {
         let mut action = Action::None;
         ui.horizontal(|ui| {
-            for k in [Kind::Png, Kind::Mesh, Kind::Fea] {
+            for k in [Kind::Png, Kind::Mesh, Kind::Fea, Kind::Gcvf, Kind::Vat] {
                 ui.selectable_value(&mut self.kind, k, k.title());
             }
         });
@@ -268,9 +353,11 @@ impl ExportPanels {
             Kind::Png => self.png_ui(ui),
             Kind::Mesh => self.mesh_ui(ui, design.map(|(m, _)| m)),
             Kind::Fea => self.fea_ui(ui),
+            Kind::Gcvf => self.printers.gcvf_ui(ui),
+            Kind::Vat => self.printers.vat_ui(ui, design.map(|(m, _)| m)),
         }
         ui.horizontal(|ui| {
-            let label = ui.label("Output folder").id;
+            let label = ui.label(self.kind.out_label()).id;
             ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
                 if ui.button("Browse…").clicked() {
                     action = Action::PickFolder(0);
@@ -291,8 +378,17 @@ impl ExportPanels {
             ui.weak("No design to export yet.");
             return action;
         };
-        self.estimate.update(ui.ctx(), model, &self.params());
-        self.estimate_ui(ui);
+        let printed = self.printed_model(model);
+        let params = printed.and_then(|m| self.params().map(|p| (m, p)));
+        match &params {
+            Ok((model, p)) => {
+                self.estimate.update(ui.ctx(), model, p);
+                self.estimate_ui(ui);
+            }
+            Err(e) => {
+                ui.colored_label(ui.visuals().error_fg_color, e);
+            }
+        }
         let dest = self.dir();
         if let Some(d) = &dest {
             ui.weak(format!("Writes {}", d.display()));
@@ -300,16 +396,17 @@ impl ExportPanels {
         if let Some(r) = &self.refusal {
             ui.colored_label(ui.visuals().error_fg_color, r);
         }
-        let ok = dest.is_some() && matches!(self.estimate.answer, Some(Ok(_)));
+        let ok = dest.is_some() && params.is_ok() && matches!(self.estimate.answer, Some(Ok(_)));
         let start = ui.add_enabled(
             ok,
             egui::Button::new(format!("Export {}", self.kind.title())),
         );
         if start.clicked()
             && let Some(dest) = dest
+            && let Ok((model, params)) = params
         {
             let hash = design_hash(&[source.as_bytes()]);
-            action = self.start(model, dest, hash, &place.name, jobs);
+            action = self.start(params, &model, dest, hash, &place.name, jobs);
         }
         action
     }
@@ -338,6 +435,7 @@ impl ExportPanels {
     /// now, after a question, or not at all.
     fn start(
         &mut self,
+        params: ExportParams,
         model: &Arc<Model>,
         dest: PathBuf,
         hash: String,
@@ -349,7 +447,7 @@ impl ExportPanels {
         };
         let title = self.kind.title();
         let mut verdicts = a.verdicts.clone();
-        verdicts.extend(plan::preflight(a.disk_bytes, &dest));
+        verdicts.extend(params.preflight(a.disk_bytes, &dest));
         if let Some(v) = verdicts.iter().find(|v| v.severity == Severity::Refuse) {
             let line = format!("{title} export not started: {}", in_panel_words(&v.message));
             self.refusal = Some(line.clone());
@@ -362,7 +460,7 @@ impl ExportPanels {
             .map(|v| question_text(v, &dest))
             .collect();
         let pending = Pending {
-            params: self.params(),
+            params,
             model: model.clone(),
             dest,
             hash,
@@ -425,6 +523,11 @@ fn question_text(v: &Verdict, dest: &Path) -> String {
             "{} holds a finished export: {}. Exporting replaces all of it.",
             dest.display(),
             e.describe()
+        ),
+        (Opt::Out, Folder::NotAFolder) if dest.is_file() => format!(
+            "{} is already there ({:.1} MB). Exporting replaces it.",
+            dest.display(),
+            std::fs::metadata(dest).map_or(0.0, |m| m.len() as f64 / 1e6)
         ),
         _ => in_panel_words(&v.message),
     }

@@ -1,9 +1,9 @@
 //! Attributes in the CLI: `volcad info` lists them per node, `volcad eval`
 //! prints each at the point, `volcad sample --attributes` adds columns.
 
-mod common;
+mod cli_common;
 
-use common::{fails, ok, tmp, volcad};
+use cli_common::{fails, ok, tmp, volcad};
 
 /// A bar 20 mm long in x whose modulus rises along x, with a colour, and a
 /// ball on top whose modulus the union averages where they overlap.

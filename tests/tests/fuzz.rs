@@ -1,14 +1,14 @@
-//! The fuzzing harness (volcad-tests' `fuzz` module) against this crate's
+//! The fuzzing harness (volcad-tests' `fuzz` module) against the
 //! `volcad` binary: every corpus case replayed, and a bounded generated run
 //! (a fixed seed and case count, so every run tries the same cases).
 
-use std::path::Path;
+use std::path::PathBuf;
 use std::time::Duration;
 
 use volcad_tests::fuzz::{Limits, Verdict, corpus, run_case, session};
 
-fn bin() -> &'static Path {
-    Path::new(env!("CARGO_BIN_EXE_volcad"))
+fn bin() -> PathBuf {
+    volcad_tests::bin("volcad")
 }
 
 /// Generous caps: the debug binary on a busy machine is slow (the slowest
@@ -39,7 +39,7 @@ fn every_corpus_case_is_clean() {
         } else {
             LIMITS
         };
-        let r = run_case(bin(), &case, limits, scratch.path()).unwrap();
+        let r = run_case(&bin(), &case, limits, scratch.path()).unwrap();
         match (&entry.open, r.verdict == Verdict::Clean) {
             (_, true) => {}
             // A fault another part of issue 39 owns, not fixed on this
@@ -65,7 +65,7 @@ fn a_bounded_generated_run_is_clean() {
         time: None,
         skip_open: true,
     };
-    let t = session::run(bin(), 7, stop, LIMITS, scratch.path(), |_, _, _| {}).unwrap();
+    let t = session::run(&bin(), 7, stop, LIMITS, scratch.path(), |_, _, _| {}).unwrap();
     eprintln!("{}", t.summary());
     let faults: Vec<String> = t
         .faults

@@ -3,9 +3,9 @@
 //! before any work.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed step fails the test
 
-mod common;
+mod cli_common;
 
-use common::{example, fails, ok, tmp, volcad};
+use cli_common::{example, fails, ok, tmp, volcad};
 
 /// A 2 × 2 × 0.1 mm plate of a default material, coloured orange.
 const PLATE: &str = r#"let m = default_materials();

@@ -3,13 +3,16 @@
 //! folder is byte for byte the single export's; `volcad merge` refuses
 //! shards that do not belong together, before writing anything.
 
-mod common;
+// A failed setup step (a scratch folder, a file read) fails the test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+mod cli_common;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use common::{example, fails, ok, runtime_dir, tmp, volcad};
+use cli_common::{example, fails, ok, runtime_dir, tmp, volcad};
 
 /// Graded bar at 0.25 mm: 60 × 40 × 20 voxels; diffusion and per-material
 /// bitmaps, so a shard cut inside a diffusion block and every kind of
@@ -88,7 +91,7 @@ fn assert_same_tree(merged: &Path, single: &Path) {
 
 fn run_script(cmd: &mut Command) -> String {
     let o = cmd
-        .env("VOLCAD", env!("CARGO_BIN_EXE_volcad"))
+        .env("VOLCAD", volcad_tests::bin("volcad"))
         .env("XDG_RUNTIME_DIR", runtime_dir())
         .output()
         .unwrap_or_else(|e| panic!("{cmd:?}: {e} (GNU parallel: apt-get install parallel)"));
@@ -271,7 +274,10 @@ fn bad_shard_options_are_refused_before_any_work() {
         s(&mesh),
     ]));
     let e = merge_fails(&out, &[&mesh]);
-    assert!(e.contains("a mesh export; only layer stacks (png)"), "{e}");
+    assert!(
+        e.contains("a mesh export; only layer stacks (png, vat)"),
+        "{e}"
+    );
     let e = merge_fails(&out, &[dir.path()]);
     assert!(e.contains("holds no readable manifest.json"), "{e}");
 }

@@ -7,6 +7,9 @@
 //! Needs `xvfb-run` (Debian: xvfb, xauth). Missing → the test fails, unless
 //! `VOLCAD_SKIP_XVFB=1`.
 
+// A failed setup step (a scratch folder, a file read) fails the test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -48,7 +51,7 @@ impl XvfbRun {
         let shot: PathBuf = dir.join("studio.png");
         let out = Command::new("xvfb-run")
             .args(["-a", "-s", "-screen 0 1280x800x24"])
-            .arg(env!("CARGO_BIN_EXE_volcad-studio"))
+            .arg(volcad_tests::bin("volcad-studio"))
             .args(args)
             .arg("--screenshot")
             .arg(&shot)

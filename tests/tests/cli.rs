@@ -1,12 +1,15 @@
 //! The `volcad` binary end to end: every command, and bad input giving a
 //! clear message and a non-zero exit (never a panic).
 
-mod common;
+// A failed setup step (a scratch folder, a file read) fails the test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+mod cli_common;
 
 use std::path::Path;
 use std::process::Command;
 
-use common::{example, fails, ok, runtime_dir, tmp, volcad};
+use cli_common::{example, fails, ok, runtime_dir, tmp, volcad};
 
 #[test]
 fn info_reports_box_materials_and_params() {
@@ -144,7 +147,7 @@ fn bad_input_is_a_clear_error() {
     )
     .unwrap();
     let run = |budget: &str| {
-        Command::new(env!("CARGO_BIN_EXE_volcad"))
+        Command::new(volcad_tests::bin("volcad"))
             .args(["info", runaway.to_str().unwrap()])
             .env("VOLCAD_SCRIPT_MEMORY_MB", budget)
             .output()
@@ -473,7 +476,7 @@ fn signals_cancel_exports_and_leave_nothing() {
         let d = scratch.path();
         let dest = d.join("stack");
         // Fine enough to run for many seconds: a debug build at 0.01 mm.
-        let mut child = Command::new(env!("CARGO_BIN_EXE_volcad"))
+        let mut child = Command::new(volcad_tests::bin("volcad"))
             .args(["export", "png", &example("graded_bar.rhai"), "--out"])
             .arg(&dest)
             .args(["--voxel", "0.01"])
@@ -545,7 +548,7 @@ fn scripts_read_inside_their_project_and_allow_read_adds_folders() {
     let run = |extra: &[&str]| {
         let mut args = vec!["info", design.to_str().unwrap()];
         args.extend_from_slice(extra);
-        Command::new(env!("CARGO_BIN_EXE_volcad"))
+        Command::new(volcad_tests::bin("volcad"))
             .args(&args)
             .env("XDG_RUNTIME_DIR", runtime_dir())
             .env("HOME", home.path())

@@ -3,13 +3,16 @@
 //! sizes, exit statuses and option values. Each failed on the command line
 //! before the fix.
 
-mod common;
+// A failed setup step (a scratch folder, a file read) fails the test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+mod cli_common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use common::{example, fails, ok, runtime_dir, tmp, volcad};
+use cli_common::{example, fails, ok, runtime_dir, tmp, volcad};
 
 /// A one-material cube (10 mm, red), the cheapest design to load.
 fn cube() -> String {
@@ -32,7 +35,7 @@ fn entries(dir: &Path) -> Vec<String> {
 
 /// `volcad ARGS`, killed after `limit` (a hang is a failure, not a stuck test).
 fn volcad_within(args: &[&str], limit: Duration) -> std::process::Output {
-    let child = Command::new(env!("CARGO_BIN_EXE_volcad"))
+    let child = Command::new(volcad_tests::bin("volcad"))
         .args(args)
         .env("XDG_RUNTIME_DIR", runtime_dir())
         .stdout(Stdio::piped())
@@ -80,7 +83,7 @@ fn a_closed_pipe_ends_every_command_quietly() {
         vec!["sample", &bar, "--points", s(&pts), "--out", "-"],
     ];
     for args in runs {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_volcad"))
+        let mut child = Command::new(volcad_tests::bin("volcad"))
             .args(&args)
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
@@ -102,7 +105,7 @@ fn out_dash_is_standard_output() {
     let scratch = tmp("stdout");
     let d = scratch.path();
     let pts = points(d, "x,y,z\n0,0,0\n");
-    let o = Command::new(env!("CARGO_BIN_EXE_volcad"))
+    let o = Command::new(volcad_tests::bin("volcad"))
         .current_dir(d)
         .args(["sample", &cube(), "--points", "points.csv", "--out", "-"])
         .output()

@@ -1,74 +1,8 @@
-//! The language reference: every script function a design can call, its
-//! forms with argument names and types, a one-line description and an
-//! example; and the math strings' variables, operators and functions.
-//!
-//! The studio's Help window, its hover tooltips and its completion read
-//! this table. It cannot drift from the engine: a test lists every
-//! function the engine registers and fails for one without an entry (and
-//! for an entry the engine does not have), and runs every example.
+//! The reference's table of script functions, in reference order: one
+//! `f!` entry a function (name, group, forms, summary, completion
+//! skeleton, example).
 
-/// What kind of thing a reference entry is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Group {
-    /// A solid: distance and a material.
-    Geometry,
-    /// Lattices and periodic structures.
-    Lattice,
-    /// Combining children.
-    Boolean,
-    /// Moving, scaling, offsetting a child.
-    Transform,
-    /// Materials and grading.
-    Material,
-    /// Files beside the design.
-    Data,
-    /// A method called on a node (`node.add_child(x)`).
-    Method,
-    /// Vectors, parameters and other values.
-    Value,
-}
-
-impl Group {
-    /// The heading in the reference.
-    pub fn title(self) -> &'static str {
-        match self {
-            Group::Geometry => "Geometry",
-            Group::Lattice => "Lattices",
-            Group::Boolean => "Booleans",
-            Group::Transform => "Transforms",
-            Group::Material => "Materials",
-            Group::Data => "Data",
-            Group::Method => "Node methods",
-            Group::Value => "Values",
-        }
-    }
-}
-
-/// One script function.
-#[derive(Clone, Copy, Debug)]
-pub struct FnDoc {
-    /// The name a script calls.
-    pub name: &'static str,
-    /// Its group.
-    pub group: Group,
-    /// Every form, with argument names and types.
-    pub forms: &'static [&'static str],
-    /// One line on what it does.
-    pub summary: &'static str,
-    /// What completion inserts.
-    pub skeleton: &'static str,
-    /// A complete script that uses it (the test runs it).
-    pub example: &'static str,
-}
-
-/// One name a math string may use.
-#[derive(Clone, Copy, Debug)]
-pub struct MathDoc {
-    /// The variable, operator or function.
-    pub name: &'static str,
-    /// What it is.
-    pub summary: &'static str,
-}
+use super::{FnDoc, Group};
 
 macro_rules! f {
     ($name:literal, $group:ident, [$($form:literal),+], $summary:literal, $skeleton:literal, $example:literal) => {
@@ -519,7 +453,8 @@ pub static FUNCTIONS: &[FnDoc] = &[
         Method,
         [
             "node.set_attribute(name: string, value: float | string | Vec3 | Vec4 | array)",
-            "node.set_attribute(name: string, field: SimulationField, column: string)"
+            "node.set_attribute(name: string, field: SimulationField, column: string)",
+            "node.set_attribute(name: string, points: PointsField)"
         ],
         "Sets a property field (modulus MPa, poissons_ratio, density g/cm^3, shore_hardness, infill_density %, temperature, color Vec4, or any name): a number, a math string of x y z rho phic r theta phis d and the node's other attributes, a vector, or an FEA column; a parent's overrides its children's.",
         "n.set_attribute(\"modulus\", 2850.0)",
@@ -530,11 +465,28 @@ pub static FUNCTIONS: &[FnDoc] = &[
         Material,
         [
             "Convert(child: Node, from: string, to: string, table: [[float, float]] | string)",
-            "Convert(child: Node, \"fractions\", to: string, rule: \"voigt\" | \"reuss\", values: [[int, float]])"
+            "Convert(child: Node, \"fractions\", to: string, rule: \"voigt\" | \"reuss\", values: [[int, float]])",
+            "Convert(child: Node, from: string, to: Fractions, table: [[float, float]] | string)"
         ],
         "Sets attribute `to` from `from` below it (pyvcad 3's AttributeModifier): a piecewise-linear table of [input, output] rows (inline or a two-column .csv; inputs rising; clamped at the ends, counted in a warning) or a math string of x y z ... d and `from`; from \"fractions\", a Voigt or Reuss mix of one value per material.",
         "Convert(part, \"shore_hardness\", \"modulus\", [[30, 1.0], [85, 20.0]])",
         "let m = default_materials(); let s = Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\")); s.set_attribute(\"shore_hardness\", \"60 + 4*x\"); Convert(s, \"shore_hardness\", \"modulus\", [[30, 1.0], [85, 20.0]])"
+    ),
+    f!(
+        "fractions",
+        Material,
+        ["fractions(materials: [int, int]) -> Fractions"],
+        "The two materials a Convert to fractions mixes: its table's rows are [share of the second material 0..1, value], inverted for the child's value of `from`; these fractions replace the child's.",
+        "fractions([m.id(\"a\"), m.id(\"b\")])",
+        "let m = default_materials(); let s = Sphere(Vec3(0, 0, 0), 5.0, m.id(\"red\")); s.set_attribute(\"shore_hardness\", \"60 + 4*x\"); Convert(s, \"shore_hardness\", fractions([m.id(\"red\"), m.id(\"blue\")]), [[0, 30], [1, 95]])"
+    ),
+    f!(
+        "PointsField",
+        Data,
+        ["PointsField(csv: string, column: string) -> PointsField"],
+        "A value column of scattered points (CSV columns x, y, z and named values) for set_attribute: inverse-distance weighting of the 8 nearest points.",
+        "PointsField(\"points.csv\", \"temperature\")",
+        ""
     ),
     f!(
         "set_attribute_conflict_resolver",
@@ -668,142 +620,3 @@ pub static FUNCTIONS: &[FnDoc] = &[
         "let m = default_materials(); let b = blob(4); Sphere(Vec3(0, 0, 0), 1.0, m.id(\"red\"))"
     ),
 ];
-
-/// The names math strings (FGrade, Function, SimulationField) understand.
-pub static MATH: &[MathDoc] = &[
-    MathDoc {
-        name: "x y z",
-        summary: "the point, in the node's local frame (mm)",
-    },
-    MathDoc {
-        name: "rho phic",
-        summary: "cylindrical radius and angle about z",
-    },
-    MathDoc {
-        name: "r theta phis",
-        summary: "spherical radius, polar and azimuth angles",
-    },
-    MathDoc {
-        name: "d",
-        summary: "the child's signed distance (FGrade)",
-    },
-    MathDoc {
-        name: "dx dy dz len",
-        summary: "interpolated displacement and its length (SimulationField; every CSV column too)",
-    },
-    MathDoc {
-        name: "+ - * / % ^",
-        summary: "arithmetic; ^ is power, right-associative",
-    },
-    MathDoc {
-        name: "< <= > >= == !=",
-        summary: "comparisons (1 or 0)",
-    },
-    MathDoc {
-        name: "and or not",
-        summary: "logic",
-    },
-    MathDoc {
-        name: "c ? a : b, if(c, a, b)",
-        summary: "choice",
-    },
-    MathDoc {
-        name: "min max sum avg",
-        summary: "of any number of arguments",
-    },
-    MathDoc {
-        name: "clamp(lo, x, hi)",
-        summary: "x limited to [lo, hi]",
-    },
-    MathDoc {
-        name: "sin cos tan asin acos atan atan2",
-        summary: "trigonometry (radians)",
-    },
-    MathDoc {
-        name: "sinh cosh tanh",
-        summary: "hyperbolic functions",
-    },
-    MathDoc {
-        name: "exp log log10 log2 sqrt abs",
-        summary: "exponentials, logarithms, roots",
-    },
-    MathDoc {
-        name: "floor ceil round trunc frac sgn",
-        summary: "rounding",
-    },
-    MathDoc {
-        name: "pi e epsilon inf",
-        summary: "constants",
-    },
-];
-
-/// The entry for `name`, if it is a script function.
-pub fn lookup(name: &str) -> Option<&'static FnDoc> {
-    FUNCTIONS.iter().find(|f| f.name == name)
-}
-
-/// Entries whose name or summary contains `query` (case-insensitive).
-pub fn search(query: &str) -> impl Iterator<Item = &'static FnDoc> {
-    let q = query.to_lowercase();
-    FUNCTIONS.iter().filter(move |f| {
-        q.is_empty() || f.name.to_lowercase().contains(&q) || f.summary.to_lowercase().contains(&q)
-    })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::script::{ScriptOptions, registered_functions, run_script};
-
-    /// Rhai's own functions (operators, string and array methods) are not
-    /// ours to document.
-    fn ours(name: &str) -> bool {
-        !matches!(
-            name,
-            "to_string" | "to_debug" | "+" | "-" | "*" | "/" | "%" | "**" | "/=" | "%=" | "**="
-                | "==" | "!=" | "x" | "y" | "z"
-                // Rhai's own math and `range`, given Python's integer forms.
-                | "sqrt" | "exp" | "ln" | "log" | "sin" | "cos" | "tan" | "asin" | "acos"
-                | "atan" | "sinh" | "cosh" | "tanh" | "range"
-        ) && !name.starts_with("get$")
-            && !name.starts_with("set$")
-    }
-
-    #[test]
-    fn every_registered_function_has_an_entry_and_no_entry_is_stale() {
-        let names = registered_functions();
-        let missing: Vec<_> = names
-            .iter()
-            .filter(|n| ours(n) && lookup(n).is_none())
-            .collect();
-        assert!(
-            missing.is_empty(),
-            "functions without a reference entry: {missing:?}"
-        );
-        let stale: Vec<_> = FUNCTIONS
-            .iter()
-            .filter(|f| !names.iter().any(|n| n == f.name))
-            .map(|f| f.name)
-            .collect();
-        assert!(
-            stale.is_empty(),
-            "entries the engine does not have: {stale:?}"
-        );
-    }
-
-    #[test]
-    fn every_example_runs() {
-        for f in FUNCTIONS.iter().filter(|f| !f.example.is_empty()) {
-            if let Err(e) = run_script(f.example, "example.rhai", &ScriptOptions::default()) {
-                panic!("{}'s example fails: {e}", f.name);
-            }
-        }
-    }
-
-    #[test]
-    fn search_finds_by_name_and_summary() {
-        assert!(search("sphere").any(|f| f.name == "Sphere"));
-        assert!(search("rounds the joins").any(|f| f.name == "Union"));
-        assert_eq!(search("").count(), FUNCTIONS.len());
-    }
-}

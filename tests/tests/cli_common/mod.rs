@@ -1,11 +1,13 @@
 //! Helpers shared by the `volcad` binary's end-to-end tests.
 #![allow(dead_code)]
+// A failed setup step (a scratch folder, a file read) fails the test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
 pub fn volcad(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_volcad"))
+    Command::new(volcad_tests::bin("volcad"))
         .args(args)
         .env("XDG_RUNTIME_DIR", runtime_dir())
         .output()

@@ -1,0 +1,147 @@
+//! Scalar -> fractions through an inverted mix table, on small designs
+//! with known answers.
+
+use glam::DVec3;
+
+use super::tests::{model, try_model};
+use crate::Model;
+use crate::model::Points;
+
+/// The fraction of material `name` at p.
+fn frac(m: &Model, name: &str, p: [f64; 3]) -> f64 {
+    let id = m.table().id(name).unwrap();
+    let (d, pairs) = m.eval_point(DVec3::from_array(p));
+    assert!(d <= 0.0, "{p:?} is outside");
+    pairs
+        .iter()
+        .find(|(i, _)| *i == id)
+        .map_or(0.0, |(_, f)| *f)
+}
+
+/// A 20 mm bar along x (x in −10..10) whose hardness rises 30 + 4(x + 10)
+/// from 30 to 110, converted by `table` to a red/blue mix.
+fn bar(table: &str) -> String {
+    format!(
+        "let b = RectPrism(Vec3(0, 0, 0), Vec3(20, 4, 4), m.id(\"gray\"));
+         b.set_attribute(\"hardness\", \"30 + 4 * (x + 10)\");
+         Convert(b, \"hardness\", fractions([m.id(\"red\"), m.id(\"blue\")]), {table})"
+    )
+}
+
+#[test]
+fn two_rows_give_the_linear_mix() {
+    let m = model(&bar("[[0.0, 30.0], [1.0, 90.0]]"));
+    // Hardness 30 + 4·(x + 10): at x = −2.5 it is 60, half way.
+    assert!((frac(&m, "blue", [-2.5, 0.0, 0.0]) - 0.5).abs() < 1e-12);
+    assert!((frac(&m, "red", [-2.5, 0.0, 0.0]) - 0.5).abs() < 1e-12);
+    // At x = −7 it is 42: share (42 − 30)/60 = 0.2.
+    assert!((frac(&m, "blue", [-7.0, 0.0, 0.0]) - 0.2).abs() < 1e-12);
+    // The child's own material is replaced.
+    assert_eq!(frac(&m, "gray", [-7.0, 0.0, 0.0]), 0.0);
+    assert!(m.attribute_warnings().is_empty());
+}
+
+#[test]
+fn a_kink_and_clamping_with_its_count() {
+    // Shares 0, 0.5, 1 measure 30, 50, 90.
+    let m = model(&bar("[[0.0, 30.0], [0.5, 50.0], [1.0, 90.0]]"));
+    // x = −7.5: hardness 40, a quarter of the way.
+    assert!((frac(&m, "blue", [-7.5, 0.0, 0.0]) - 0.25).abs() < 1e-12);
+    // x = 0: hardness 70, half way along the second segment.
+    assert!((frac(&m, "blue", [0.0, 0.0, 0.0]) - 0.75).abs() < 1e-12);
+    assert!(m.attribute_warnings().is_empty());
+    // x = 6 and 9: hardness 94 and 106, above the table: pure blue, counted.
+    assert_eq!(frac(&m, "blue", [6.0, 0.0, 0.0]), 1.0);
+    assert_eq!(frac(&m, "blue", [9.0, 0.0, 0.0]), 1.0);
+    let w = m.attribute_warnings();
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(w[0].contains("2 samples of \"hardness\""), "{w:?}");
+    assert!(w[0].contains("30..90"), "{w:?}");
+}
+
+#[test]
+fn batch_equals_single_point() {
+    let m = model(&bar("[[0.0, 30.0], [0.4, 50.0], [1.0, 90.0]]"));
+    let xs: Vec<f64> = (0..41).map(|i| -10.5 + 0.5 * f64::from(i)).collect();
+    let (ys, zs) = (vec![0.3; xs.len()], vec![-0.2; xs.len()]);
+    let pts = Points {
+        x: &xs,
+        y: &ys,
+        z: &zs,
+    };
+    let k = m.materials().len();
+    let mut dist = vec![0.0; xs.len()];
+    let mut fr = vec![0.0f32; xs.len() * k];
+    m.eval_batch(pts, &mut dist, &mut fr);
+    for (i, x) in xs.iter().enumerate() {
+        let mut one = vec![0.0; k];
+        let d = m.eval_into(DVec3::new(*x, 0.3, -0.2), &mut one);
+        assert_eq!(d, dist[i]);
+        for (a, b) in one.iter().zip(&fr[i * k..(i + 1) * k]) {
+            assert_eq!(*a as f32, *b);
+        }
+    }
+}
+
+#[test]
+fn the_outermost_fractions_win() {
+    // The conversion replaces an FGrade below it...
+    let m = model(
+        "let b = FGrade([\"1\"], [m.id(\"green\")], true, RectPrism(Vec3(0, 0, 0), Vec3(20, 4, 4), m.id(\"gray\")));
+         b.set_attribute(\"hardness\", 60.0);
+         Convert(b, \"hardness\", fractions([m.id(\"red\"), m.id(\"blue\")]), [[0.0, 30.0], [1.0, 90.0]])",
+    );
+    assert!((frac(&m, "blue", [0.0, 0.0, 0.0]) - 0.5).abs() < 1e-12);
+    assert_eq!(frac(&m, "green", [0.0, 0.0, 0.0]), 0.0);
+    // ...and an FGrade over it replaces its mix.
+    let m = model(&format!(
+        "let c = {{ {} }}; FGrade([\"1\"], [m.id(\"green\")], true, c)",
+        bar("[[0.0, 30.0], [1.0, 90.0]]")
+    ));
+    assert_eq!(frac(&m, "green", [0.0, 0.0, 0.0]), 1.0);
+    assert_eq!(frac(&m, "blue", [0.0, 0.0, 0.0]), 0.0);
+}
+
+#[test]
+fn where_the_attribute_is_missing_the_child_keeps_its_fractions() {
+    let m = model(
+        "let a = Sphere(Vec3(-5, 0, 0), 3.0, m.id(\"gray\"));
+         a.set_attribute(\"hardness\", 90.0);
+         let b = Sphere(Vec3(5, 0, 0), 3.0, m.id(\"green\"));
+         Convert(Union(false, [a, b]), \"hardness\", fractions([m.id(\"red\"), m.id(\"blue\")]), [[0.0, 30.0], [1.0, 90.0]])",
+    );
+    assert_eq!(frac(&m, "blue", [-5.0, 0.0, 0.0]), 1.0);
+    assert_eq!(frac(&m, "green", [5.0, 0.0, 0.0]), 1.0);
+}
+
+#[test]
+fn a_table_that_turns_back_is_an_error_at_the_line() {
+    let e = try_model(&bar("[[0.0, 30.0], [0.4, 60.0], [0.7, 55.0], [1.0, 90.0]]")).unwrap_err();
+    assert!(e.contains("rows 2 and 3 (values 60 then 55)"), "{e}");
+    assert!(e.contains("t.rhai:4:"), "{e}");
+}
+
+#[test]
+fn bad_conversions_are_refused() {
+    let e = try_model(
+        "let b = RectPrism(Vec3(0, 0, 0), Vec3(20, 4, 4), m.id(\"gray\"));
+         b.set_attribute(\"modulus\", 5.0);
+         Convert(b, \"hardness\", fractions([m.id(\"red\"), m.id(\"blue\")]), [[0.0, 30.0], [1.0, 90.0]])",
+    )
+    .unwrap_err();
+    assert!(e.contains("no node below it sets \"hardness\""), "{e}");
+    assert!(e.contains("modulus"), "{e}");
+    let e = try_model(
+        "let b = RectPrism(Vec3(0, 0, 0), Vec3(20, 4, 4), m.id(\"gray\"));
+         b.set_attribute(\"color\", Vec4(1, 0, 0, 1));
+         Convert(b, \"color\", fractions([m.id(\"red\"), m.id(\"blue\")]), [[0.0, 30.0], [1.0, 90.0]])",
+    )
+    .unwrap_err();
+    assert!(e.contains("a Vec4"), "{e}");
+    let e = try_model(&bar("[[0.0, 30.0]]")).unwrap_err();
+    assert!(e.contains("at least 2"), "{e}");
+    let e = try_model("fractions([m.id(\"red\"), m.id(\"blue\"), m.id(\"green\")])").unwrap_err();
+    assert!(e.contains("mixes 2 materials, got 3"), "{e}");
+    let e = try_model(&bar("\"mix.txt\"")).unwrap_err();
+    assert!(e.contains(".csv"), "{e}");
+}

@@ -1,0 +1,339 @@
+//! The thinnest feature of geometry whose thickness the tree does not state
+//! (a mesh, a `Function`, a simulation field, text, a cone), estimated by
+//! sampling the design's signed distance.
+//!
+//! A wall's thickness is twice the radius of the largest ball inside it,
+//! whose centre lies on the medial surface, where the depth `-d` has a
+//! ridge. The estimate:
+//!
+//! 1. samples `d` on a grid of spacing `h` over the design's box, `h` the
+//!    smallest that keeps the grid within [`SAMPLE_BUDGET`] samples;
+//! 2. keeps the ridge points: inside samples with no deeper sample among
+//!    their 26 neighbours and at least one inside neighbour (a lone inside
+//!    sample is a speck or the tip of a sharp edge, not a wall or strut);
+//! 3. through the [`CANDIDATES`] shallowest ridge points, measures chords
+//!    of the solid (from exit to exit, each exit refined by bisection)
+//!    along the distance's gradient and 13 fixed directions; the shortest
+//!    chord through a medial point is the wall's thickness (along the
+//!    normal), any other chord is longer, so the minimum never understates
+//!    it by more than the bisection's tolerance;
+//! 4. reports the shortest chord through a ridge point at least `h` from
+//!    the surface (its nearest exit). The last inside sample before a cut
+//!    (a sheet clipped by a box, meeting it at a shallow angle) is a ridge
+//!    of the grid at any depth under `h`, where the sheet thins to a sharp
+//!    edge; deeper ridge points lie on walls and struts. A wall thicker
+//!    than `3 h` always has a sample within `h / 2` of its middle, so it is
+//!    measured; a thinner one only when a sample falls near its middle,
+//!    and nothing thinner than `2 h` is reported: the note says so.
+//!
+//! Chords step by the distance where it is a bound (1-Lipschitz) and by
+//! `h / 4` elsewhere, so a math-string field is crossed, not jumped over.
+//! Every stage collects in index order and ties break by index: the result
+//! is the same on any number of threads.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::Model;
+use crate::aabb::Aabb;
+
+/// Most samples of the distance on the grid (the chords add at most a few
+/// hundred thousand more).
+pub const SAMPLE_BUDGET: usize = 1 << 21;
+
+/// Ridge points whose chords are measured, shallowest first.
+pub const CANDIDATES: usize = 2048;
+
+/// Most steps of one half-chord; past them the chord counts as thick.
+const MAX_STEPS: usize = 256;
+
+/// Bisection steps refining each exit: to within `h / 4 / 2^12`, far
+/// below `h` (an exit is crossed by a step of at most `h / 4`).
+const BISECT: usize = 12;
+
+/// The thinnest feature sampling found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SampledFeature {
+    /// Its thickness in mm: the shortest chord through a ridge point.
+    pub thickness: f64,
+    /// The ridge point the chord passes through, in mm.
+    pub at: DVec3,
+}
+
+/// What sampling the design found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sampled {
+    /// The grid spacing `h` in mm: features thinner than `2 h` are not
+    /// reported, and those thinner than `3 h` only where a sample falls
+    /// near their middle.
+    pub spacing: f64,
+    /// The thinnest feature of at least `2 spacing`, if the design has
+    /// one at this spacing.
+    pub feature: Option<SampledFeature>,
+}
+
+/// The sampling grid: `dims` samples from `origin`, `h` apart.
+struct Grid {
+    origin: DVec3,
+    h: f64,
+    dims: [usize; 3],
+}
+
+impl Grid {
+    /// The grid over `b` within the budget, one sample beyond each side;
+    /// `None` for an empty or unbounded box.
+    fn over(b: &Aabb) -> Option<Grid> {
+        if b.is_empty() || !b.is_finite() {
+            return None;
+        }
+        let s = b.size();
+        let longest = s.max_element();
+        if !(longest > 0.0 && longest.is_finite()) {
+            return None;
+        }
+        // A flat box has no volume to spread the budget over: at most 1024
+        // samples along its longest side.
+        let mut h = (s.x * s.y * s.z / SAMPLE_BUDGET as f64)
+            .cbrt()
+            .max(longest / 1024.0);
+        loop {
+            let dims = s.to_array().map(|v| (v / h).ceil() as usize + 3);
+            if dims.iter().map(|&n| n as f64).product::<f64>() <= SAMPLE_BUDGET as f64 {
+                return Some(Grid {
+                    origin: b.min - DVec3::splat(h),
+                    h,
+                    dims,
+                });
+            }
+            h *= 1.05;
+        }
+    }
+
+    fn at(&self, i: usize, j: usize, k: usize) -> DVec3 {
+        self.origin + DVec3::new(i as f64, j as f64, k as f64) * self.h
+    }
+
+    fn point(&self, idx: usize) -> DVec3 {
+        let [nx, ny, _] = self.dims;
+        self.at(idx % nx, (idx / nx) % ny, idx / (nx * ny))
+    }
+}
+
+impl Model {
+    /// The spacing `h` (mm) that [`Model::sampled_thinnest`] samples at,
+    /// without sampling; `None` when the design's box is unbounded. Every
+    /// feature it reports is at least `2 h` thick, so cells of `h` or less
+    /// resolve whatever it could find.
+    pub fn thin_sampling_spacing(&self) -> Option<f64> {
+        Grid::over(&self.bbox).map(|g| g.h)
+    }
+
+    /// The design's thinnest feature estimated by sampling (see the module
+    /// doc); `None` when the design's box is unbounded. Computed once per
+    /// model and kept.
+    pub fn sampled_thinnest(&self) -> Option<&Sampled> {
+        self.sampled
+            .get_or_init(|| {
+                let g = Grid::over(&self.bbox)?;
+                let d = sample(self, &g);
+                let ridges = ridge_points(&g, &d);
+                let bound = self.distance_is_bound();
+                let feature = ridges
+                    .par_iter()
+                    .filter_map(|&(_, idx)| {
+                        let (chord, near) = thinnest_chord(self, g.point(idx), g.h, bound);
+                        (near >= g.h).then_some((chord, idx))
+                    })
+                    .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
+                    .map(|(thickness, idx)| SampledFeature {
+                        thickness,
+                        at: g.point(idx),
+                    });
+                Some(Sampled {
+                    spacing: g.h,
+                    feature,
+                })
+            })
+            .as_ref()
+    }
+}
+
+/// Samples per side of the blocks that [`sample`] bounds before sampling.
+const BLOCK: usize = 8;
+
+/// The distance at every grid point, x fastest. A block of samples whose
+/// distance interval lies wholly outside is filled with the interval's
+/// lower end instead: ridge points are inside samples compared with their
+/// neighbours, and any positive value outside compares the same.
+fn sample(model: &Model, g: &Grid) -> Vec<f64> {
+    let [nx, ny, nz] = g.dims;
+    let [bx, by, bz] = g.dims.map(|n| n.div_ceil(BLOCK));
+    let blocks: Vec<Vec<f64>> = (0..bx * by * bz)
+        .into_par_iter()
+        .map(|b| {
+            let (i0, j0, k0) = (b % bx * BLOCK, b / bx % by * BLOCK, b / (bx * by) * BLOCK);
+            let (i1, j1, k1) = (
+                (i0 + BLOCK).min(nx),
+                (j0 + BLOCK).min(ny),
+                (k0 + BLOCK).min(nz),
+            );
+            let bounds = Aabb::new(g.at(i0, j0, k0), g.at(i1 - 1, j1 - 1, k1 - 1));
+            let lo = model.interval(&bounds).lo;
+            let at = |(i, j, k)| {
+                if lo > 0.0 {
+                    lo
+                } else {
+                    model.distance(g.at(i, j, k))
+                }
+            };
+            (k0..k1)
+                .flat_map(|k| (j0..j1).flat_map(move |j| (i0..i1).map(move |i| (i, j, k))))
+                .map(at)
+                .collect()
+        })
+        .collect();
+    let mut d = vec![0.0; nx * ny * nz];
+    for (b, vals) in blocks.iter().enumerate() {
+        let (i0, j0, k0) = (b % bx * BLOCK, b / bx % by * BLOCK, b / (bx * by) * BLOCK);
+        let w = (i0 + BLOCK).min(nx) - i0;
+        let h = (j0 + BLOCK).min(ny) - j0;
+        for (r, row) in vals.chunks(w).enumerate() {
+            let (j, k) = (j0 + r % h, k0 + r / h);
+            let start = i0 + nx * (j + ny * k);
+            d[start..start + w].copy_from_slice(row);
+        }
+    }
+    d
+}
+
+/// The [`CANDIDATES`] shallowest ridge points as (depth, index), ordered
+/// by depth then index.
+fn ridge_points(g: &Grid, d: &[f64]) -> Vec<(f64, usize)> {
+    let [nx, ny, nz] = g.dims;
+    let (sx, sy) = (1isize, nx as isize);
+    let sz = (nx * ny) as isize;
+    let mut offsets = Vec::with_capacity(26);
+    for dz in -1..=1 {
+        for dy in -1..=1 {
+            for dx in -1..=1 {
+                if (dx, dy, dz) != (0, 0, 0) {
+                    offsets.push(dx * sx + dy * sy + dz * sz);
+                }
+            }
+        }
+    }
+    let mut ridges: Vec<(f64, usize)> = (1..nz.saturating_sub(1))
+        .into_par_iter()
+        .flat_map_iter(|k| {
+            let offsets = &offsets;
+            (1..ny - 1).flat_map(move |j| {
+                (1..nx - 1).filter_map(move |i| {
+                    let idx = i + nx * (j + ny * k);
+                    let v = d[idx];
+                    if v >= 0.0 {
+                        return None;
+                    }
+                    let mut inside_neighbour = false;
+                    for &o in offsets {
+                        let w = d[(idx as isize + o) as usize];
+                        if w < v {
+                            return None;
+                        }
+                        inside_neighbour |= w <= 0.0;
+                    }
+                    inside_neighbour.then_some((-v, idx))
+                })
+            })
+        })
+        .collect();
+    ridges.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    ridges.truncate(CANDIDATES);
+    ridges
+}
+
+/// The shortest chord of the solid through `p` (inside) along the
+/// distance's gradient and the 13 directions of a cube's axes, face and
+/// body diagonals (a strut's axis point has no gradient; some of them lie
+/// within 20° of any wall's normal), and the nearest exit along them.
+fn thinnest_chord(model: &Model, p: DVec3, h: f64, bound: bool) -> (f64, f64) {
+    let e = h / 4.0;
+    let grad = DVec3::new(
+        model.distance(p + DVec3::X * e) - model.distance(p - DVec3::X * e),
+        model.distance(p + DVec3::Y * e) - model.distance(p - DVec3::Y * e),
+        model.distance(p + DVec3::Z * e) - model.distance(p - DVec3::Z * e),
+    );
+    let mut dirs: Vec<DVec3> = Vec::with_capacity(14);
+    if let Some(u) = grad.try_normalize() {
+        dirs.push(u);
+    }
+    for z in -1i8..=1 {
+        for y in -1i8..=1 {
+            for x in -1i8..=1 {
+                let v = DVec3::new(f64::from(x), f64::from(y), f64::from(z));
+                // One of each opposite pair: the first non-zero component
+                // positive.
+                let first = [x, y, z].into_iter().find(|&c| c != 0);
+                if first == Some(1) {
+                    dirs.push(v.normalize());
+                }
+            }
+        }
+    }
+    dirs.iter()
+        .map(|&u| (exit(model, p, u, h, bound), exit(model, p, -u, h, bound)))
+        .fold((f64::INFINITY, f64::INFINITY), |(chord, near), (a, b)| {
+            (chord.min(a + b), near.min(a).min(b))
+        })
+}
+
+/// How far from `p` (inside) along `u` the solid ends: the first sample
+/// outside, refined by bisection; the distance travelled when no exit is
+/// found within [`MAX_STEPS`].
+fn exit(model: &Model, p: DVec3, u: DVec3, h: f64, bound: bool) -> f64 {
+    let min_step = h / 8.0;
+    let (mut inside, mut t) = (0.0, 0.0);
+    for _ in 0..MAX_STEPS {
+        let v = model.distance(p + u * t);
+        if v > 0.0 {
+            let mut outside = t;
+            for _ in 0..BISECT {
+                let mid = 0.5 * (inside + outside);
+                if model.distance(p + u * mid) > 0.0 {
+                    outside = mid;
+                } else {
+                    inside = mid;
+                }
+            }
+            return 0.5 * (inside + outside);
+        }
+        inside = t;
+        t += if bound { (-v).max(min_step) } else { h / 4.0 };
+    }
+    t
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::script::{ScriptOptions, model_of};
+
+    fn sampled(src: &str) -> super::Sampled {
+        model_of(src, "t.rhai", &ScriptOptions::default())
+            .expect("design prepares")
+            .sampled_thinnest()
+            .cloned()
+            .expect("a bounded design")
+    }
+
+    #[test]
+    fn a_thin_function_plate_is_measured_and_a_fat_sphere_is_not_thin() {
+        let s = sampled(
+            r#"let m = default_materials();
+Intersection(false, [Function("abs(z) - 0.15", m.id("gray")), RectPrism(Vec3(0,0,0), Vec3(10,10,2), m.id("gray"))])"#,
+        );
+        let f = s.feature.expect("the plate");
+        assert!((f.thickness - 0.3).abs() < 0.01, "{f:?} at h {}", s.spacing);
+        let s = sampled(r#"Function("x*x+y*y+z*z-25", default_materials().id("gray"))"#);
+        let f = s.feature.expect("the ball");
+        assert!(f.thickness > 9.0, "{f:?}");
+    }
+}
