@@ -21,7 +21,7 @@ pub mod profile;
 use std::ops::Range;
 
 use rayon::prelude::*;
-use volcad_core::sampler::{Grid, Sampler, Slab};
+use volcad_core::sampler::{Consumer, Grid, Sampler, Slab};
 use volcad_core::{Model, Points};
 
 use crate::design::palette;
@@ -211,7 +211,7 @@ pub(crate) fn for_each_slab(
     let layer = grid.layer_len();
     let k = model.materials().len();
     // Fractions only where `color` is not set everywhere they are needed.
-    let sampler = Sampler::new(model, grid, true).with_signs_only();
+    let sampler = Sampler::new(model, grid, Consumer::PngStackFullColor);
     let mut slab = Slab::default();
     let mut codes = vec![0u8; est.slab_layers * layer];
     let mut wanted = vec![[0.0f32; CHANNELS]; est.slab_layers * layer];

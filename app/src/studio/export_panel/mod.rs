@@ -573,7 +573,7 @@ mod tests {
         panels.png.per_material_bitmaps = true;
         panels.png.bitmap_format = BitmapFormat::Bmp;
         panels.png.bitmap_width = Some(volcad_compilers::bitmaps::MYERSON_WIDTH);
-        assert_eq!(panels.params(), ExportParams::Png(want));
+        assert_eq!(panels.params(), Ok(ExportParams::Png(want)));
     }
 
     #[test]
