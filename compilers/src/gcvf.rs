@@ -92,6 +92,7 @@ impl GcvfParams {
             per_material_bitmaps: false,
             threads: self.threads,
             liquid_keep_out: self.liquid_keep_out,
+            ..PngParams::default()
         }
     }
 }

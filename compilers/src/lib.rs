@@ -18,6 +18,8 @@ pub mod job;
 pub mod keep_out;
 pub mod lazy_random;
 
+pub mod bitmaps;
+pub mod color;
 pub mod design;
 pub mod dither;
 mod estimate;
@@ -26,6 +28,7 @@ pub mod par_deflate;
 pub mod plan;
 pub mod png_io;
 pub mod png_stack;
+mod png_summary;
 mod presets;
 pub mod printer_table;
 pub mod resources;

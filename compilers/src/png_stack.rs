@@ -37,14 +37,16 @@
 //! option; fractions are normalised by their sum.
 
 use std::ops::Range;
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::DVec3;
 use rayon::prelude::*;
-use serde_json::json;
 use volcad_core::Model;
 use volcad_core::sampler::{Consumer, Grid, Sampler, Slab};
 
+use crate::bitmaps::{self, BitmapFolder, BitmapFormat, BitmapStyle};
+use crate::color::{self, ColorPlan};
 use crate::design::{grid_for, palette};
 use crate::dither::{self, Diffuser};
 use crate::estimate::{Look, coarse_estimate, sampled_layers};
@@ -52,9 +54,12 @@ use crate::job::{ExportError, JobContext, Summary};
 use crate::keep_out;
 use crate::lazy_random;
 use crate::png_io::{self, PixelsPerMetre};
+pub use crate::png_summary::grid_span_note;
+pub(crate) use crate::png_summary::merged_notes;
+use crate::png_summary::summary;
 pub use crate::presets::{Preset, preset, presets};
 use crate::resources::{check_disk, check_memory, run_with_threads};
-use crate::shard::{Part, Shard};
+use crate::shard::Shard;
 use crate::slice_image::{ImageStyle, Orientation, bitmap_png, rgba_png};
 
 /// How each voxel's material is chosen from its fractions.
@@ -98,6 +103,15 @@ pub struct PngParams {
     /// Remove the liquid material within this distance (mm) of the
     /// surface (see [`crate::keep_out`]).
     pub liquid_keep_out: Option<f64>,
+    /// One colour resin per voxel reproducing the design's `color` (see
+    /// [`crate::color`]) instead of its materials.
+    pub full_color: bool,
+    /// Measured resin colours for `full_color` (see [`crate::color::profile`]).
+    pub color_profile: Option<PathBuf>,
+    /// File format of the per-material bitmaps.
+    pub bitmap_format: BitmapFormat,
+    /// Fixed width (px) of BMP bitmaps, the layer at the left.
+    pub bitmap_width: Option<usize>,
 }
 
 impl Default for PngParams {
@@ -112,6 +126,10 @@ impl Default for PngParams {
             per_material_bitmaps: false,
             threads: None,
             liquid_keep_out: None,
+            full_color: false,
+            color_profile: None,
+            bitmap_format: BitmapFormat::Png,
+            bitmap_width: None,
         }
     }
 }
@@ -157,6 +175,7 @@ fn estimate_with(model: &Model, p: &PngParams, look: Look) -> Result<Estimate, E
     let pal = palette(model)?;
     keep_out::plan(model, p.liquid_keep_out)?;
     let grid = grid_for(model, p.voxel, 0.0)?;
+    let inks = check_options(model, p, &grid)?;
     let [nx, ny, nz] = grid.dims;
     let layers = match (&p.layers, p.shard) {
         (Some(_), Some(s)) => {
@@ -180,8 +199,13 @@ fn estimate_with(model: &Model, p: &PngParams, look: Look) -> Result<Estimate, E
     };
     let k = model.materials().len();
     let layer = nx * ny;
-    // Per layer held in a slab: distance (4) + fractions (4k) + code (1).
-    let per_layer = layer * (5 + 4 * k);
+    // Per layer held in a slab: distance (4) + fractions (4k) + code (1);
+    // full colour adds the wanted colours.
+    let per_layer = if p.full_color {
+        layer * color::bytes_per_voxel(k)
+    } else {
+        layer * (5 + 4 * k)
+    };
     let slab_layers = (SLAB_BUDGET / per_layer.max(1))
         .clamp(1, MAX_SLAB_LAYERS)
         .min(layers.len() + dither::BLOCK_LAYERS);
@@ -211,20 +235,34 @@ fn estimate_with(model: &Model, p: &PngParams, look: Look) -> Result<Estimate, E
         Dither::Random => 0.7,
         Dither::Diffusion => 0.85,
     };
-    let per_voxel = 0.02 * pr.inside + mixed_bytes * pr.mixed;
+    // A full-colour part is dithered everywhere.
+    let per_voxel = match p.full_color {
+        true => FULL_COLOR_BYTES * pr.inside,
+        false => 0.02 * pr.inside + mixed_bytes * pr.mixed,
+    };
     let mut files = layers.len() as u64;
     let mut disk = voxels as f64 * per_voxel + files as f64 * (200.0 + ny as f64);
     if p.per_material_bitmaps {
-        files += (layers.len() * k) as u64;
-        disk += voxels as f64 * (0.01 * pr.inside + 0.12 * pr.mixed)
-            + (layers.len() * k) as f64 * (100.0 + ny as f64 / 4.0);
+        let n = (layers.len() * inks) as u64;
+        files += n;
+        disk += match p.bitmap_format {
+            BitmapFormat::Png => {
+                voxels as f64 * (0.01 * pr.inside + 0.12 * pr.mixed)
+                    + n as f64 * (100.0 + ny as f64 / 4.0)
+            }
+            // Uncompressed: exact.
+            BitmapFormat::Bmp => {
+                let w = p.bitmap_width.unwrap_or(nx);
+                n as f64 * (bitmaps::BMP_HEADER + bitmaps::bmp_row_bytes(w) * ny) as f64
+            }
+        };
     }
     // The rule above is rough (0.7 to 2.2 bytes a mixed voxel across the
     // examples); a few layers coded and encoded as the export does see
     // what it cannot.
     let sampled = match look {
-        Look::Layers => sampled_bytes(model, p, grid, &layers, &pal),
-        Look::Coarse => None,
+        Look::Layers if !p.full_color => sampled_bytes(model, p, grid, &layers, &pal),
+        _ => None,
     };
     let disk = match sampled {
         Some(b) => disk.max(b as f64),
@@ -241,6 +279,40 @@ fn estimate_with(model: &Model, p: &PngParams, look: Look) -> Result<Estimate, E
     })
 }
 
+/// Bytes an inside voxel of a full-colour stack's PNGs take: every voxel
+/// is dithered among six colours, which fdeflate's row filter barely
+/// shrinks below one RGBA byte a voxel.
+const FULL_COLOR_BYTES: f64 = 1.2;
+
+/// Check the options that go together (full colour, bitmap format and
+/// width) and the design's colours; returns how many inks (materials or
+/// resins) the stack's voxels take.
+fn check_options(model: &Model, p: &PngParams, grid: &Grid) -> Result<usize, ExportError> {
+    if p.bitmap_width.is_some() && p.bitmap_format != BitmapFormat::Bmp {
+        return Err(ExportError::param(
+            "--bitmap-width",
+            "sets the width of BMP bitmaps; add --bitmaps --bitmap-format bmp",
+        ));
+    }
+    bitmaps::check_width(p.bitmap_width, grid.dims[0], grid.voxel)?;
+    if !p.full_color {
+        if p.color_profile.is_some() {
+            return Err(ExportError::param(
+                "--color-profile",
+                "gives the resins' colours for --full-color; add --full-color",
+            ));
+        }
+        return Ok(model.materials().len());
+    }
+    if p.liquid_keep_out.is_some() {
+        return Err(ExportError::param(
+            "--liquid-keep-out",
+            "removes a material, and a full-colour stack is made of colour resins; leave it out",
+        ));
+    }
+    Ok(color::check(model, p)?.resins.len())
+}
+
 /// Write the slice stack into `ctx.staging()`.
 pub fn export_png_stack(
     model: &Model,
@@ -252,24 +324,37 @@ pub fn export_png_stack(
     run_with_threads(p.threads, || write_stack(model, p, &est, ctx))
 }
 
-/// One material's 1-bit folder.
-struct BitmapFolder {
-    slot: usize,
-    dir: String,
+/// What the stack's voxels are made of: names (with their table ids, for
+/// folder names) and palette by code (0 = void).
+struct Inks {
+    names: Vec<(String, u8)>,
+    pal: Vec<[u8; 4]>,
+    plan: Option<ColorPlan>,
 }
 
-/// Folder names for the per-material bitmaps (a name used twice gets its
-/// id appended).
-fn bitmap_folders(model: &Model) -> Vec<BitmapFolder> {
-    let mut out: Vec<BitmapFolder> = Vec::new();
-    for (slot, id) in model.materials().iter().enumerate() {
-        let mut dir = png_io::folder_name(model.table().name(*id), *id);
-        if out.iter().any(|f| f.dir == dir) {
-            dir = format!("{dir}_{id}");
-        }
-        out.push(BitmapFolder { slot, dir });
+fn inks(model: &Model, p: &PngParams) -> Result<Inks, ExportError> {
+    if p.full_color {
+        let plan = ColorPlan::new(model, p)?;
+        let names = plan.resins.iter().map(|r| (r.name.clone(), 0)).collect();
+        let pal = std::iter::once([0; 4])
+            .chain(plan.resins.iter().map(|r| r.rgba))
+            .collect();
+        return Ok(Inks {
+            names,
+            pal,
+            plan: Some(plan),
+        });
     }
-    out
+    let names = model
+        .materials()
+        .iter()
+        .map(|id| (model.table().name(*id).to_owned(), *id))
+        .collect();
+    Ok(Inks {
+        names,
+        pal: palette(model)?,
+        plan: None,
+    })
 }
 
 /// What writing one layer (or a whole stack) produced.
@@ -281,11 +366,14 @@ pub(crate) struct LayerOut {
 }
 
 /// Run `write` on every layer of the stack (its global index and material
-/// codes, see [`for_each_slab`]), the layers of a slab in parallel, and
-/// gather their files in layer order and their `slots` counts.
+/// codes, see [`for_each_slab`], or the resin codes of a full-colour
+/// `plan`, see [`color::for_each_slab`]), the layers of a slab in
+/// parallel, and gather their files in layer order and their `slots`
+/// counts.
 pub(crate) fn write_layers(
     model: &Model,
     p: &PngParams,
+    plan: Option<&ColorPlan>,
     est: &Estimate,
     ctx: &JobContext,
     slots: usize,
@@ -298,7 +386,7 @@ pub(crate) fn write_layers(
         counts: vec![0; slots],
     };
     let written = AtomicU64::new(0);
-    for_each_slab(model, p, est, ctx, |zs, codes| {
+    let each = |zs: Range<usize>, codes: &[u8]| {
         let outs: Vec<LayerOut> = zs
             .clone()
             .into_par_iter()
@@ -319,7 +407,11 @@ pub(crate) fn write_layers(
             }
         }
         Ok(())
-    })?;
+    };
+    match plan {
+        Some(plan) => color::for_each_slab(model, plan, est, ctx, each)?,
+        None => for_each_slab(model, p, est, ctx, each)?,
+    }
     Ok(all)
 }
 
@@ -330,11 +422,10 @@ fn write_stack(
     ctx: &JobContext,
 ) -> Result<Summary, ExportError> {
     let [nx, ny, nz] = est.grid.dims;
-    let k = model.materials().len();
-    let pal = palette(model)?;
+    let inks = inks(model, p)?;
     let digits = png_io::name_digits(nz);
     let folders = if p.per_material_bitmaps {
-        bitmap_folders(model)
+        bitmaps::folders(&inks.names)
     } else {
         Vec::new()
     };
@@ -343,11 +434,24 @@ fn write_stack(
         std::fs::create_dir_all(&dir).map_err(|e| ExportError::io(&dir, e))?;
     }
     let style = top_view(est.grid.voxel);
-    let out = write_layers(model, p, est, ctx, k, |z, c| {
-        write_layer(ctx, [nx, ny], z, digits, c, &pal, &folders, style)
+    let bits = BitmapStyle {
+        format: p.bitmap_format,
+        width: p.bitmap_width,
+        image: style,
+    };
+    let slots = inks.names.len();
+    let out = write_layers(model, p, inks.plan.as_ref(), est, ctx, slots, |z, c| {
+        write_layer(ctx, [nx, ny], z, digits, c, &inks.pal, &folders, bits)
     })?;
-    let (files, counts) = (out.files, out.counts);
-    Ok(summary(model, p, est, files, counts))
+    let names = inks.names.into_iter().map(|(n, _)| n);
+    Ok(summary(
+        model,
+        p,
+        est,
+        out.files,
+        names.zip(out.counts).collect(),
+        inks.plan.as_ref(),
+    ))
 }
 
 /// The PNG stack's images: top view, with the voxel's size in `pHYs`.
@@ -559,7 +663,7 @@ fn write_layer(
     codes: &[u8],
     pal: &[[u8; 4]],
     folders: &[BitmapFolder],
-    style: ImageStyle,
+    bits: BitmapStyle,
 ) -> Result<LayerOut, ExportError> {
     let name = png_io::slice_name(z, digits);
     let mut counts = vec![0u64; pal.len() - 1];
@@ -569,153 +673,18 @@ fn write_layer(
         }
     }
     let path = ctx.staging().join(&name);
-    let bytes = rgba_png(nx, ny, codes, pal, style)
+    let bytes = rgba_png(nx, ny, codes, pal, bits.image)
         .map_err(|e| ExportError::Other(format!("{}: PNG encoding: {e}", path.display())))?;
     std::fs::write(&path, bytes).map_err(|e| ExportError::io(&path, e))?;
     let mut files = vec![name.clone()];
-    let mut bits = Vec::new();
-    for f in folders {
-        let rel = format!("{}/{name}", f.dir);
-        let path = ctx.staging().join(&f.dir).join(&name);
-        let bytes = bitmap_png(nx, ny, codes, f.slot as u8 + 1, &mut bits, style)
-            .map_err(|e| ExportError::Other(format!("{}: PNG encoding: {e}", path.display())))?;
-        std::fs::write(&path, bytes).map_err(|e| ExportError::io(&path, e))?;
-        files.push(rel);
-    }
+    files.extend(bitmaps::write_layer(
+        ctx,
+        [nx, ny],
+        z,
+        &name,
+        codes,
+        folders,
+        bits,
+    )?);
     Ok(LayerOut { files, counts })
-}
-
-fn summary(
-    model: &Model,
-    p: &PngParams,
-    est: &Estimate,
-    files: Vec<String>,
-    counts: Vec<u64>,
-) -> Summary {
-    let [nx, ny, nz] = est.grid.dims;
-    let table = model.table();
-    let counts: Vec<(String, u64)> = model
-        .materials()
-        .iter()
-        .zip(counts)
-        .map(|(id, c)| (table.name(*id).to_owned(), c))
-        .collect();
-    // What the design and grid alone decide (the same in every shard):
-    // the slices' span against the part's, then thin features.
-    let mut design_notes = vec![grid_span_note(&est.grid, &model.bbox())];
-    design_notes.extend(crate::thin::thin_feature_notes(
-        model,
-        est.grid.voxel.max_element(),
-        "--voxel",
-    ));
-    let g = est.grid;
-    let notes = stack_notes(g.dims, g.voxel, &est.layers, &counts, design_notes);
-    let o = est.grid.origin;
-    let mut parameters = json!({
-        "voxel_mm": est.grid.voxel.to_array(),
-        "seed": p.seed,
-        "dither": p.dither.name(),
-        "layers": [est.layers.start, est.layers.end],
-        "grid": { "dims": [nx, ny, nz], "origin_mm": o.to_array() },
-        "per_material_bitmaps": p.per_material_bitmaps,
-        "liquid_keep_out_mm": p.liquid_keep_out,
-        "orientation": "column 0 = min X, row 0 = max Y, layer 0 = lowest Z",
-    });
-    if let Some(s) = p.shard {
-        parameters["shard"] = s.to_json();
-    }
-    Summary {
-        kind: "png".into(),
-        files,
-        counts,
-        units: est.voxels,
-        unit: "voxels".into(),
-        parameters,
-        notes,
-        seconds: 0.0,
-    }
-}
-
-/// The notes of a stack's manifest: its layer range, orientation and
-/// volume per material, then `design_notes` (what the design alone
-/// decides: thin features), then a warning when every slice is blank.
-/// [`crate::shard`] rebuilds the whole stack's notes from its shards'
-/// with it, so a merged manifest reads as the single export's.
-fn stack_notes(
-    [nx, ny, nz]: [usize; 3],
-    voxel: DVec3,
-    layers: &Range<usize>,
-    counts: &[(String, u64)],
-    design_notes: Vec<String>,
-) -> Vec<String> {
-    let voxel_mm3 = voxel.x * voxel.y * voxel.z;
-    let mut notes = vec![
-        format!(
-            "{} layer(s) {}..{} of {nz}, {nx} × {ny} px each",
-            layers.len(),
-            layers.start,
-            layers.end
-        ),
-        "orientation: column 0 = min X, row 0 = max Y (top view), layer 0 = lowest Z".to_owned(),
-        // No working-memory figure: it grows with the thread count, and
-        // the notes go into the manifest, which must not (the command line
-        // prints the estimate before it starts).
-    ];
-    for (name, c) in counts {
-        notes.push(format!(
-            "{name}: {c} voxels = {:.3} mm³",
-            *c as f64 * voxel_mm3
-        ));
-    }
-    notes.extend(design_notes);
-    if counts.iter().all(|(_, c)| *c == 0) {
-        notes.push(
-            "warning: no voxel centre is inside the design, so every slice is blank (the part is empty, or thinner than a voxel)"
-                .to_owned(),
-        );
-    }
-    notes
-}
-
-/// The notes of `layers` holding `counts`, with the design notes of `part`
-/// (a shard of the same stack); `None` when `part`'s notes are not the ones
-/// this version writes (then its design notes cannot be told apart).
-pub(crate) fn merged_notes(
-    part: &Part,
-    layers: &Range<usize>,
-    counts: &[(String, u64)],
-) -> Option<Vec<String>> {
-    let own = stack_notes(
-        part.dims,
-        part.voxel,
-        &part.layers,
-        &part.summary.counts,
-        Vec::new(),
-    );
-    let notes = &part.summary.notes;
-    let head = 2 + part.summary.counts.len();
-    let tail = own.len().checked_sub(head)?;
-    let design_end = notes.len().checked_sub(tail)?;
-    if design_end < head || notes[..head] != own[..head] || notes[design_end..] != own[head..] {
-        return None;
-    }
-    let design = notes[head..design_end].to_vec();
-    Some(stack_notes(part.dims, part.voxel, layers, counts, design))
-}
-
-/// How the slices' extent relates to the part's: each count is
-/// `ceil(extent / voxel)`, as pyvcad 2.3.4's (its J750 stack of a
-/// 15 × 10 × 5 mm bar is 355 × 119 px and 186 layers), centred on the
-/// part, so the stack is up to one voxel larger than the part per axis.
-pub fn grid_span_note(grid: &Grid, part: &volcad_core::Aabb) -> String {
-    let span = DVec3::new(
-        grid.dims[0] as f64,
-        grid.dims[1] as f64,
-        grid.dims[2] as f64,
-    ) * grid.voxel;
-    let size = part.size();
-    format!(
-        "slices span {:.4} × {:.4} × {:.4} mm for a part of {:.4} × {:.4} × {:.4} mm: each count is ceil(extent / voxel), as in pyvcad, centred on the part (up to one voxel more per axis)",
-        span.x, span.y, span.z, size.x, size.y, size.z
-    )
 }

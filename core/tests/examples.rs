@@ -276,3 +276,34 @@ fn color_gradient() {
         .unwrap();
     assert!(near(c, [0.5, 0.975, 0.5, 1.0]), "{c:?}");
 }
+
+/// The colour wheel: white at the centre, the pure hue at the rim (red
+/// at +x, green at 120°, blue at 240°).
+#[test]
+fn color_wheel() {
+    let m = example("color_wheel.rhai");
+    let i = m.attribute_index("color").unwrap();
+    let mut c = [0.0; 4];
+    let near = |a: [f64; 4], b: [f64; 4]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-9);
+    m.attribute_at(i, DVec3::ZERO, &mut c).unwrap();
+    assert!(near(c, [1.0, 1.0, 1.0, 1.0]), "{c:?}");
+    let at = |deg: f64| {
+        DVec3::new(
+            19.9 * deg.to_radians().cos(),
+            19.9 * deg.to_radians().sin(),
+            0.0,
+        )
+    };
+    m.attribute_at(i, at(0.0), &mut c).unwrap();
+    assert!(near(c, [1.0, 0.005, 0.005, 1.0]), "{c:?}");
+    m.attribute_at(i, at(120.0), &mut c).unwrap();
+    assert!(near(c, [0.005, 1.0, 0.005, 1.0]), "{c:?}");
+    m.attribute_at(i, at(240.0), &mut c).unwrap();
+    assert!(near(c, [0.005, 0.005, 1.0, 1.0]), "{c:?}");
+    // Half way out at 60°: yellow at half saturation.
+    m.attribute_at(i, at(60.0) * 0.5, &mut c).unwrap();
+    assert!(
+        (c[0] - 1.0).abs() < 1e-9 && (c[1] - 1.0).abs() < 1e-6 && (c[2] - 0.5025).abs() < 1e-9,
+        "{c:?}"
+    );
+}

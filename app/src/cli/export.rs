@@ -9,6 +9,7 @@ use std::time::Duration;
 
 use anyhow::{Context, bail};
 use glam::DVec3;
+use volcad_compilers::bitmaps::BitmapFormat;
 use volcad_compilers::fea::{Element, EndSets, FeaParams, Sizing, StepParams};
 use volcad_compilers::job::{self, design_hash};
 use volcad_compilers::mesh::{MeshFormats, MeshParams, SegmentBy};
@@ -77,6 +78,18 @@ pub struct ExportArgs {
     /// png: also write 1-bit stacks, one folder per material.
     #[arg(long)]
     pub bitmaps: bool,
+    /// png with --bitmaps: png (default) or bmp (pyvcad's MyersonCompiler layout: material black on white).
+    #[arg(long)]
+    pub bitmap_format: Option<String>,
+    /// png with --bitmap-format bmp: fixed image width in pixels, the layer at the left (Myerson: 880).
+    #[arg(long)]
+    pub bitmap_width: Option<usize>,
+    /// png: each voxel one J750 colour resin (cyan, magenta, yellow, black, white, clear) reproducing the design's `color` attribute (else its materials' colours) by error diffusion in OKLab.
+    #[arg(long)]
+    pub full_color: bool,
+    /// png with --full-color: measured resin colours, a CSV `name,L,a,b` (CIELAB D50) or `name,r,g,b` (sRGB 0-255).
+    #[arg(long)]
+    pub color_profile: Option<PathBuf>,
     /// gcvf, and png with --preset j750: design material = J750 resin, e.g. red=VeroMgnt,blue=VeroCyan.
     #[arg(long)]
     pub map: Option<String>,
@@ -242,6 +255,10 @@ fn foreign_options(a: &ExportArgs) -> Vec<&'static str> {
             Kind::Png,
         ),
         ("--bitmaps", a.bitmaps, Kind::Png),
+        ("--bitmap-format", a.bitmap_format.is_some(), Kind::Png),
+        ("--bitmap-width", a.bitmap_width.is_some(), Kind::Png),
+        ("--full-color", a.full_color, Kind::Png),
+        ("--color-profile", a.color_profile.is_some(), Kind::Png),
         ("--map", a.map.is_some() && a.kind != Kind::Gcvf, Kind::Png),
         (
             "--liquid-keep-out",
@@ -385,9 +402,10 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
         Kind::Fea => ExportParams::Fea(fea_params(a, voxel, &model)?),
         Kind::Vat => ExportParams::Vat(super::vat::vat_params(a, &model)?),
     };
-    // `--preset j750` relabels the design with the printer's resins.
+    // `--preset j750` relabels the design with the printer's resins (a
+    // full-colour stack is made of them whatever the design's materials).
     let model = match params {
-        ExportParams::Png(_) => super::gcvf::printer_model(a, model)?,
+        ExportParams::Png(_) if !a.full_color => super::gcvf::printer_model(a, model)?,
         _ => model,
     };
     let verdicts = preflight(&params, &model, &dest)?;
@@ -432,11 +450,16 @@ fn preflight(
 }
 
 /// The slice stack's parameters from the options (`voxel` as parsed).
-fn png_params(a: &ExportArgs, voxel: Option<DVec3>) -> anyhow::Result<PngParams> {
+pub(crate) fn png_params(a: &ExportArgs, voxel: Option<DVec3>) -> anyhow::Result<PngParams> {
     let dither = match a.dither.as_deref().unwrap_or("random") {
         "random" => Dither::Random,
         "diffusion" => Dither::Diffusion,
         d => bail!("--dither {d}: expected random or diffusion"),
+    };
+    check_color_options(a)?;
+    let bitmap_format = match &a.bitmap_format {
+        Some(f) => BitmapFormat::parse(f)?,
+        None => BitmapFormat::Png,
     };
     Ok(PngParams {
         voxel: voxel.context(
@@ -449,7 +472,33 @@ fn png_params(a: &ExportArgs, voxel: Option<DVec3>) -> anyhow::Result<PngParams>
         per_material_bitmaps: a.bitmaps,
         threads: a.threads,
         liquid_keep_out: a.liquid_keep_out,
+        full_color: a.full_color,
+        color_profile: a.color_profile.clone(),
+        bitmap_format,
+        bitmap_width: a.bitmap_width,
     })
+}
+
+/// Options that would do nothing with the full-colour and bitmap options
+/// given (the plan refuses the rest: a profile without --full-color, a
+/// width without BMP, keep-out in colour).
+fn check_color_options(a: &ExportArgs) -> anyhow::Result<()> {
+    if a.bitmap_format.is_some() && !a.bitmaps {
+        bail!("--bitmap-format: chooses the format of the 1-bit bitmaps; add --bitmaps");
+    }
+    if a.full_color {
+        if let Some(d) = &a.dither {
+            bail!(
+                "--dither {d}: a full-colour stack always diffuses colour error in OKLab; leave --dither out with --full-color"
+            );
+        }
+        if let Some(m) = &a.map {
+            bail!(
+                "--map {m}: a full-colour stack is made of the J750 colour resins whatever the design's materials; leave --map out with --full-color"
+            );
+        }
+    }
+    Ok(())
 }
 
 /// The mesh export's parameters from the options (`voxel` as parsed).

@@ -23,7 +23,7 @@ macro_rules! note {
 mod bench;
 mod design;
 mod eval;
-mod export;
+pub(crate) mod export;
 mod fea_result;
 mod gcvf;
 mod info;

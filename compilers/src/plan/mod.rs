@@ -80,6 +80,14 @@ pub enum Opt {
     Shard,
     /// Override the refusals that protect the user.
     Force,
+    /// One colour resin per voxel from the design's colours.
+    FullColor,
+    /// Measured resin colours of a full-colour stack.
+    ColorProfile,
+    /// File format of per-material bitmaps.
+    BitmapFormat,
+    /// Fixed width of BMP bitmaps.
+    BitmapWidth,
     /// The printer preset (voxel size, screen, material table).
     Preset,
     /// Design material = printer resin pairs.
@@ -101,7 +109,7 @@ pub enum Opt {
 impl Opt {
     /// Every key. No flag starts another, so a message can be rewritten
     /// flag by flag.
-    pub const ALL: [Opt; 23] = [
+    pub const ALL: [Opt; 27] = [
         Opt::MinCell,
         Opt::MaxCell,
         Opt::Sizing,
@@ -117,6 +125,10 @@ impl Opt {
         Opt::PropertyBins,
         Opt::Shard,
         Opt::Force,
+        Opt::FullColor,
+        Opt::ColorProfile,
+        Opt::BitmapFormat,
+        Opt::BitmapWidth,
         Opt::Preset,
         Opt::Map,
         Opt::Intensity,
@@ -145,6 +157,10 @@ impl Opt {
             Opt::PropertyBins => "--property-bins",
             Opt::Shard => "--shard",
             Opt::Force => "--force",
+            Opt::FullColor => "--full-color",
+            Opt::ColorProfile => "--color-profile",
+            Opt::BitmapFormat => "--bitmap-format",
+            Opt::BitmapWidth => "--bitmap-width",
             Opt::Preset => "--preset",
             Opt::Map => "--map",
             Opt::Intensity => "--intensity",

@@ -99,6 +99,10 @@ impl VatParams {
             per_material_bitmaps: false,
             threads: self.threads,
             liquid_keep_out: None,
+            full_color: false,
+            color_profile: None,
+            bitmap_format: Default::default(),
+            bitmap_width: None,
         }
     }
 }

@@ -53,9 +53,15 @@ pub(super) fn write_stack(
         pixel: PixelsPerMetre::from_mm(p.printer.pixel[0], p.printer.pixel[1]),
         folders,
     };
-    let out = png_stack::write_layers(model, &p.stack(), &est.stack, ctx, est.vats, |z, c| {
-        write_layer(&layout, ctx, z, c)
-    })?;
+    let out = png_stack::write_layers(
+        model,
+        &p.stack(),
+        None,
+        &est.stack,
+        ctx,
+        est.vats,
+        |z, c| write_layer(&layout, ctx, z, c),
+    )?;
     let (files, counts) = (out.files, out.counts);
     Ok(summary(model, p, est, files, counts))
 }

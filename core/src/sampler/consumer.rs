@@ -58,6 +58,9 @@ pub enum Consumer<'a> {
     /// For a design whose fractions never vary
     /// (`Model::varying_fractions`) this is [`Consumer::PngStackDiffusion`].
     PngStackRandom,
+    /// A full-colour slice stack: signs, and every voxel's fractions (the
+    /// materials' colours mix by them where no `color` attribute is set).
+    PngStackFullColor,
     /// An FEA brick mesh: a brick is kept by the sign at its centre and
     /// takes its fractions there.
     FeaBricks,
@@ -115,7 +118,10 @@ impl<'a> Consumer<'a> {
                 fracs: false,
                 ..signs
             },
-            Consumer::PngStackDiffusion | Consumer::FeaBricks | Consumer::Estimate => signs,
+            Consumer::PngStackDiffusion
+            | Consumer::PngStackFullColor
+            | Consumer::FeaBricks
+            | Consumer::Estimate => signs,
             Consumer::PngStackRandom => Needs {
                 lazy: true,
                 ..signs

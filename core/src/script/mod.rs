@@ -39,11 +39,11 @@ use rhai::{Dynamic, Engine, EvalAltResult, NativeCallContext as Ctx, Position, S
 use crate::material::MaterialTable;
 use crate::node::{LatticeType, Node};
 pub use attribute_api::Vec4;
-pub use fractions_api::FractionsTarget;
-pub use points_api::PointsValue;
 pub use errors::clip;
 use errors::{HEAP_STOP, MAX_MESSAGE, to_script_error};
+pub use fractions_api::FractionsTarget;
 pub use one_shot::{DesignError, model_of, model_of_file};
+pub use points_api::PointsValue;
 pub use values::Vec3;
 use values::{RResult, fail};
 

@@ -1,9 +1,11 @@
 //! The export panels' parameter fields, one function per kind (the
 //! output folder, estimate and Start button are shared, in `mod.rs`).
 
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use glam::DVec3;
+use volcad_compilers::bitmaps::{BitmapFormat, MYERSON_WIDTH};
 use volcad_compilers::fea::{Element, property_bins};
 use volcad_compilers::mesh::{MeshFormats, SegmentBy};
 use volcad_compilers::png_stack::{self, Dither};
@@ -81,13 +83,84 @@ impl ExportPanels {
             ui.add(egui::DragValue::new(&mut self.png.seed))
                 .labelled_by(label);
             ui.end_row();
+            // One row for both switches: a taller panel would push a
+            // running job's Cancel out of view.
             ui.label("");
-            ui.checkbox(
-                &mut self.png.per_material_bitmaps,
-                "1-bit bitmaps per material",
-            );
+            ui.horizontal(|ui| {
+                ui.checkbox(
+                    &mut self.png.per_material_bitmaps,
+                    "1-bit bitmaps per material",
+                );
+                ui.checkbox(&mut self.png.full_color, "Full colour")
+                    .on_hover_text(
+                        "Each voxel a J750 colour resin reproducing the design's colour",
+                    );
+            });
             ui.end_row();
+            if self.png.per_material_bitmaps {
+                self.bitmap_ui(ui);
+            }
+            self.full_color_ui(ui);
         });
+    }
+
+    /// Bitmap format and BMP width (`--bitmap-format`, `--bitmap-width`).
+    fn bitmap_ui(&mut self, ui: &mut egui::Ui) {
+        ui.label("Bitmap format");
+        ui.horizontal(|ui| {
+            ui.selectable_value(&mut self.png.bitmap_format, BitmapFormat::Png, "PNG");
+            ui.selectable_value(
+                &mut self.png.bitmap_format,
+                BitmapFormat::Bmp,
+                "BMP (Myerson)",
+            )
+            .on_hover_text("1-bit BMPs, material black on white, <100000+layer>_100000_<name>.bmp");
+        });
+        ui.end_row();
+        if self.png.bitmap_format != BitmapFormat::Bmp {
+            self.png.bitmap_width = None;
+            return;
+        }
+        let label = ui.label("Bitmap width").id;
+        ui.horizontal(|ui| {
+            let mut fixed = self.png.bitmap_width.is_some();
+            ui.checkbox(&mut fixed, "fixed");
+            if fixed {
+                let w = self.png.bitmap_width.get_or_insert(MYERSON_WIDTH);
+                ui.add(egui::DragValue::new(w).range(1..=100_000).suffix(" px"))
+                    .labelled_by(label);
+            } else {
+                self.png.bitmap_width = None;
+            }
+        });
+        ui.end_row();
+    }
+
+    /// The profile of a full-colour stack (`--color-profile`).
+    fn full_color_ui(&mut self, ui: &mut egui::Ui) {
+        if !self.png.full_color {
+            self.png.color_profile = None;
+            return;
+        }
+        let label = ui.label("Colour profile").id;
+        let mut text = self
+            .png
+            .color_profile
+            .as_ref()
+            .map(|p| p.display().to_string())
+            .unwrap_or_default();
+        if ui
+            .add(
+                egui::TextEdit::singleline(&mut text)
+                    .hint_text("CSV of measured resins (optional)")
+                    .desired_width(180.0),
+            )
+            .labelled_by(label)
+            .changed()
+        {
+            self.png.color_profile = (!text.is_empty()).then(|| PathBuf::from(text));
+        }
+        ui.end_row();
     }
 
     pub(super) fn mesh_ui(&mut self, ui: &mut egui::Ui, model: Option<&Arc<Model>>) {

@@ -537,6 +537,45 @@ fn question_text(v: &Verdict, dest: &Path) -> String {
 mod tests {
     use super::*;
 
+    /// The PNG panel's full-colour and bitmap fields make the parameters
+    /// the command line makes from the same choices.
+    #[test]
+    fn png_fields_build_the_command_lines_plan() {
+        use clap::Parser;
+        use volcad_compilers::bitmaps::BitmapFormat;
+        let args = [
+            "volcad",
+            "export",
+            "png",
+            "d.rhai",
+            "--out",
+            "o",
+            "--preset",
+            "j750",
+            "--full-color",
+            "--color-profile",
+            "resins.csv",
+            "--bitmaps",
+            "--bitmap-format",
+            "bmp",
+            "--bitmap-width",
+            "880",
+        ];
+        let cli = crate::cli::Cli::try_parse_from(args).unwrap();
+        let crate::cli::Command::Export(a) = cli.command else {
+            panic!("an export command");
+        };
+        let voxel = volcad_compilers::png_stack::preset("j750").map(|p| p.voxel);
+        let want = crate::cli::export::png_params(&a, voxel).unwrap();
+        let mut panels = ExportPanels::new(BTreeMap::new());
+        panels.png.full_color = true;
+        panels.png.color_profile = Some(PathBuf::from("resins.csv"));
+        panels.png.per_material_bitmaps = true;
+        panels.png.bitmap_format = BitmapFormat::Bmp;
+        panels.png.bitmap_width = Some(volcad_compilers::bitmaps::MYERSON_WIDTH);
+        assert_eq!(panels.params(), Ok(ExportParams::Png(want)));
+    }
+
     #[test]
     fn default_folders_are_named_by_design_and_kind() {
         let place = Place {
