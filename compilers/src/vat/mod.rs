@@ -2,7 +2,7 @@
 //! screen per layer (and per vat on multi-vat printers), for masked-LCD
 //! (MSLA) printers and grayscale-exposure research printers.
 //!
-//! Pipeline: the PNG stack's slab loop ([`crate::png_stack::for_each_slab`]:
+//! Pipeline: the PNG stack's slab loop (`png_stack::for_each_slab`:
 //! sampling, the seeded material draw or error diffusion, layer range and
 //! shard) gives each voxel a material; each material belongs to one vat;
 //! per layer, in parallel, each vat's image is the screen, black, with the

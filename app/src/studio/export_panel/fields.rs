@@ -87,10 +87,8 @@ impl ExportPanels {
             // running job's Cancel out of view.
             ui.label("");
             ui.horizontal(|ui| {
-                ui.checkbox(
-                    &mut self.png.per_material_bitmaps,
-                    "1-bit bitmaps per material",
-                );
+                ui.checkbox(&mut self.png.per_material_bitmaps, "1-bit bitmaps")
+                    .on_hover_text("Also one 1-bit image per material per layer");
                 ui.checkbox(&mut self.png.full_color, "Full colour")
                     .on_hover_text(
                         "Each voxel a J750 colour resin reproducing the design's colour",

@@ -342,7 +342,7 @@ impl ExportPanels {
         jobs: &mut Jobs,
     ) -> Action {
         let mut action = Action::None;
-        ui.horizontal(|ui| {
+        ui.horizontal_wrapped(|ui| {
             for k in [Kind::Png, Kind::Mesh, Kind::Fea, Kind::Gcvf, Kind::Vat] {
                 ui.selectable_value(&mut self.kind, k, k.title());
             }
