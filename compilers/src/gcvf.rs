@@ -98,12 +98,14 @@ impl GcvfParams {
 }
 
 /// The package's grid and size, and its resins; refuses what GrabCAD
-/// cannot take: a material the J750 table lacks (unless mapped), more
+/// cannot take: a part larger than the tray, a material the J750 table
+/// lacks (unless mapped), more
 /// than [`MAX_RESINS`] resins, more layers than a 16-bit z-buffer holds.
 pub fn estimate(
     model: &Model,
     p: &GcvfParams,
 ) -> Result<(Estimate, Vec<PrinterMaterial>), ExportError> {
+    crate::printer_table::check_j750_tray(model)?;
     let mats = resolve(model, &MaterialTable::j750(), &p.map, "J750")?;
     if mats.len() > MAX_RESINS {
         let names: Vec<&str> = mats.iter().map(|m| m.name.as_str()).collect();

@@ -160,13 +160,38 @@ pub fn is_j750_preset(name: &str) -> bool {
     name.eq_ignore_ascii_case("j750") || name.eq_ignore_ascii_case("j750-hq")
 }
 
+/// The J750's net build size (mm, X × Y × Z): 490 × 390 × 200 (Stratasys
+/// J750 specifications, "net build size").
+pub const J750_TRAY_MM: [f64; 3] = [490.0, 390.0, 200.0];
+
+/// Refuses a part larger than the J750's tray ([`J750_TRAY_MM`]) on any
+/// axis, naming both sizes, before any work.
+pub fn check_j750_tray(model: &Model) -> Result<(), ExportError> {
+    let size = model.bbox().size().to_array();
+    // NaN sizes (an unbounded design) count as too large.
+    let fits = size.iter().zip(J750_TRAY_MM).all(|(s, t)| *s <= t);
+    if !fits {
+        let [x, y, z] = size;
+        let [tx, ty, tz] = J750_TRAY_MM;
+        return Err(ExportError::param(
+            "--preset",
+            format!(
+                "the part is {x:.1} × {y:.1} × {z:.1} mm; a J750 builds at most {tx} × {ty} × {tz} mm: scale the design down or split it"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// `model` as a J750 stack writes it: relabelled with J750 resins through
 /// `map`, or refused naming each material the table lacks with the
-/// nearest resins (what `--preset j750` and the studio's J750 choice do).
+/// nearest resins (what `--preset j750` and the studio's J750 choice do);
+/// a part larger than the tray is refused ([`check_j750_tray`]).
 pub fn j750_model(
     model: &std::sync::Arc<Model>,
     map: &[(String, String)],
 ) -> Result<std::sync::Arc<Model>, ExportError> {
+    check_j750_tray(model)?;
     let table = MaterialTable::j750();
     let mats = resolve(model, &table, map, "J750")?;
     Ok(std::sync::Arc::new(relabel(model, &mats, &table, "J750")))

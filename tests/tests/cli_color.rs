@@ -141,3 +141,42 @@ fn option_combinations_that_would_do_nothing_are_refused() {
         "{err}"
     );
 }
+
+/// A part larger than the J750's tray (490 × 390 × 200 mm) is refused with
+/// both sizes by every J750 export, before any work and leaving nothing.
+#[test]
+fn a_part_larger_than_the_j750_tray_is_refused_with_both_sizes() {
+    let d = tmp("tray");
+    let design = d.path().join("slab.rhai");
+    std::fs::write(
+        &design,
+        r#"let m = j750_materials();
+RectPrism(Vec3(0, 0, 0), Vec3(500, 100, 1), m.id("VeroCyan"))"#,
+    )
+    .unwrap();
+    let design = design.to_str().unwrap();
+    let png = d.path().join("png");
+    let gcvf = d.path().join("slab.gcvf");
+    let runs: [Vec<&str>; 3] = [
+        vec![
+            "export", "png", design, "--preset", "j750", "--layers", "0..1",
+        ],
+        vec!["export", "png", design, "--preset", "j750", "--full-color"],
+        vec!["export", "gcvf", design],
+    ];
+    for (args, out) in runs.iter().zip([&png, &png, &gcvf]) {
+        let mut args = args.clone();
+        args.extend(["--out", out.to_str().unwrap()]);
+        let err = fails(&volcad(&args));
+        assert!(
+            err.contains("500.0 × 100.0 × 1.0 mm") && err.contains("490 × 390 × 200 mm"),
+            "{args:?}: {err}"
+        );
+        assert!(!out.exists(), "{args:?} left {}", out.display());
+    }
+    assert_eq!(
+        std::fs::read_dir(d.path()).unwrap().count(),
+        1,
+        "only the design"
+    );
+}

@@ -153,7 +153,7 @@ fn mesh_and_fea_exports_run_from_their_panels() {
     wait_idle(&mut h);
 
     // Segmented meshes by dominant material (red and blue), every format.
-    h.get_by_label("Meshes / 3MF").click();
+    h.get_by_label("Mesh").click();
     h.run_steps(2);
     let meshes = dir.join("meshes");
     set_output_folder(&mut h, &meshes);
@@ -172,7 +172,7 @@ fn mesh_and_fea_exports_run_from_their_panels() {
     assert_eq!(manifest["kind"], "mesh");
 
     // An FEA deck of tetrahedra (the panel's default).
-    h.get_by_label("FEA (.inp)").click();
+    h.get_by_label("FEA").click();
     h.run_steps(2);
     let fea = dir.join("fea");
     set_output_folder(&mut h, &fea);
@@ -214,18 +214,18 @@ fn export_folders_default_to_the_design_and_kind() {
     let (_, mut h) = studio_with_file(dir, "bar.rhai", BAR);
     wait_idle(&mut h);
     assert_eq!(h.state().export_dir(), Some(dir.join("bar_png")));
-    h.get_by_label("Meshes / 3MF").click();
+    h.get_by_label("Mesh").click();
     h.run_steps(2);
     assert_eq!(h.state().export_dir(), Some(dir.join("bar_mesh")));
-    h.get_by_label("FEA (.inp)").click();
+    h.get_by_label("FEA").click();
     h.run_steps(2);
     assert_eq!(h.state().export_dir(), Some(dir.join("bar_fea")));
     // A folder typed for one kind stays with it.
     set_output_folder(&mut h, &dir.join("deck"));
-    h.get_by_label("PNG stack").click();
+    h.get_by_label("PNG").click();
     h.run_steps(2);
     assert_eq!(h.state().export_dir(), Some(dir.join("bar_png")));
-    h.get_by_label("FEA (.inp)").click();
+    h.get_by_label("FEA").click();
     h.run_steps(2);
     assert_eq!(h.state().export_dir(), Some(dir.join("deck")));
     drop(h);
@@ -242,7 +242,7 @@ fn the_spheres_fea_deck_does_not_land_in_the_bars_folder() {
     let dir = scratch.path();
     let (_, mut h) = studio_with_file(dir, "bar.rhai", BAR);
     wait_idle(&mut h);
-    h.get_by_label("FEA (.inp)").click();
+    h.get_by_label("FEA").click();
     h.run_steps(2);
     wait_label(&mut h, "Estimate: about");
     export_to_the_end(&mut h, "Export FEA (.inp)");

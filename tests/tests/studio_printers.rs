@@ -79,7 +79,7 @@ fn export_to_the_end(h: &mut Harness<'static, StudioApp>, button: &str) {
 #[test]
 fn j750_refuses_default_materials_until_mapped_and_writes_a_gcvf() {
     let (dir, mut h) = studio("gcvf");
-    h.get_by_label("GCVF (.gcvf)").click();
+    h.get_by_label("GCVF").click();
     h.run_steps(2);
     // red and blue are not J750 resins: refused with the nearest ones.
     let e = wait_label(&mut h, "is not a J750 material");
@@ -144,7 +144,7 @@ fn the_png_printer_choice_j750_brings_its_resin_table() {
 #[test]
 fn a_vat_stack_from_its_panel() {
     let (dir, mut h) = studio("vat");
-    h.get_by_label("Vat stack").click();
+    h.get_by_label("Vat").click();
     h.run_steps(2);
     h.get_by_label("Vat printer").click();
     h.run_steps(2);

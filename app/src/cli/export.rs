@@ -15,6 +15,7 @@ use volcad_compilers::job::{self, design_hash};
 use volcad_compilers::mesh::{MeshFormats, MeshParams, SegmentBy};
 use volcad_compilers::plan::{ExportParams, Severity, Verdict, blocking};
 use volcad_compilers::png_stack::{self, Dither, PngParams};
+use volcad_compilers::printer_table::{check_j750_tray, is_j750_preset};
 use volcad_compilers::shard;
 
 use super::DesignArgs;
@@ -406,6 +407,10 @@ pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
     // full-colour stack is made of them whatever the design's materials).
     let model = match params {
         ExportParams::Png(_) if !a.full_color => super::gcvf::printer_model(a, model)?,
+        ExportParams::Png(_) if a.preset.as_deref().is_some_and(is_j750_preset) => {
+            check_j750_tray(&model)?;
+            model
+        }
         _ => model,
     };
     let verdicts = preflight(&params, &model, &dest)?;

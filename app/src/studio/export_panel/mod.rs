@@ -85,6 +85,19 @@ impl Kind {
         }
     }
 
+    /// The tab's label: short, so the five tabs keep one row in the side
+    /// panel's default width (a second row pushes a running job's Cancel
+    /// out of view); the hover gives [`Kind::title`].
+    fn tab(self) -> &'static str {
+        match self {
+            Kind::Png => "PNG",
+            Kind::Mesh => "Mesh",
+            Kind::Fea => "FEA",
+            Kind::Gcvf => "GCVF",
+            Kind::Vat => "Vat",
+        }
+    }
+
     fn suffix(self) -> &'static str {
         match self {
             Kind::Png => "png",
@@ -344,7 +357,8 @@ impl ExportPanels {
         let mut action = Action::None;
         ui.horizontal_wrapped(|ui| {
             for k in [Kind::Png, Kind::Mesh, Kind::Fea, Kind::Gcvf, Kind::Vat] {
-                ui.selectable_value(&mut self.kind, k, k.title());
+                ui.selectable_value(&mut self.kind, k, k.tab())
+                    .on_hover_text(k.title());
             }
         });
         ui.add_space(4.0);
