@@ -307,3 +307,25 @@ fn color_wheel() {
         "{c:?}"
     );
 }
+
+#[test]
+fn thermal_plate() {
+    let m = example("thermal_plate.rhai");
+    let names: Vec<&str> = m.attributes().iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(names, ["modulus", "temperature"]);
+    // At a thermocouple the reading itself (assets/examples/data/
+    // plate_temperatures.csv: 88 °C at the centre of the top face).
+    let hot = DVec3::new(0.0, 0.0, 1.5);
+    assert!((attr(&m, "temperature", hot) - 88.0).abs() < 1e-9);
+    assert!((attr(&m, "modulus", hot) - (2850.0 - 20.0 * 68.0)).abs() < 1e-6);
+    // Between readings, a weighted mean of them: inside their range, and
+    // nearer the closer one.
+    let between = DVec3::new(-15.0, 0.0, 1.5);
+    let t = attr(&m, "temperature", between);
+    assert!(t > 47.0 && t < 88.0, "{t}");
+    let near_edge = attr(&m, "temperature", DVec3::new(-27.0, 0.0, 1.5));
+    assert!(
+        (near_edge - 47.0).abs() < (t - 47.0).abs(),
+        "{near_edge} {t}"
+    );
+}

@@ -109,3 +109,14 @@ fn a_value_out_of_range_names_node_point_and_value() {
         "{err}"
     );
 }
+
+#[test]
+fn info_names_the_materials_a_mix_table_converts_to() {
+    let out = ok(&volcad(&["info", &cli_common::example("shore_grip.rhai")]));
+    assert!(
+        out.contains(
+            "attribute:   fractions = Agilus30Clr and VeroClear mixed for \"shore_hardness\" through a mix table over 30..95"
+        ),
+        "{out}"
+    );
+}

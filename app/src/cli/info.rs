@@ -39,7 +39,7 @@ pub fn info(args: &DesignArgs) -> anyhow::Result<()> {
             p.max
         );
     }
-    for line in volcad_core::attribute::describe_tree(&l.design.root) {
+    for line in volcad_core::attribute::describe_tree(&l.design.root, m.table()) {
         outln!("attribute:   {line}");
     }
     outln!("script time: {:.3} s", l.script_time.as_secs_f64());

@@ -2,11 +2,13 @@
 //! studio's probe), and of a value at a point (`volcad eval`).
 
 use super::{AttrSource, AttributeInfo, AttributeKind, Component};
+use crate::material::MaterialTable;
 use crate::node::Node;
 
 /// "modulus = 2850 on Sphere (made at line 3:9)" and "resolver modulus =
-/// average on Union (...)" lines, parents before children, each node once.
-pub fn describe_tree(root: &Node) -> Vec<String> {
+/// average on Union (...)" lines, parents before children, each node once;
+/// materials are named from `table`.
+pub fn describe_tree(root: &Node, table: &MaterialTable) -> Vec<String> {
     let mut out = Vec::new();
     let mut seen = std::collections::HashSet::new();
     let mut stack = vec![root];
@@ -27,9 +29,9 @@ pub fn describe_tree(root: &Node) -> Vec<String> {
             if let Some(c) = &a.to_fractions {
                 let (lo, hi) = c.table.value_range();
                 out.push(format!(
-                    "fractions = materials {} and {} mixed for \"{}\" through a mix table over {lo}..{hi} on {}",
-                    c.materials[0],
-                    c.materials[1],
+                    "fractions = {} and {} mixed for \"{}\" through a mix table over {lo}..{hi} on {}",
+                    table.name(c.materials[0]),
+                    table.name(c.materials[1]),
                     c.from,
                     n.describe()
                 ));
