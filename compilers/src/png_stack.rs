@@ -491,36 +491,57 @@ pub(crate) fn for_each_slab(
     } else {
         est.layers.start
     };
-    let mut slab = Slab::default();
     let mut codes = vec![0u8; est.slab_layers * layer];
-    let mut z0 = first;
-    while z0 < est.layers.end {
+    sample_slabs(
+        &sampler,
+        first..est.layers.end,
+        est.slab_layers,
+        ctx,
+        |z0, z1, slab| {
+            if let Some(keep) = &keep {
+                keep_out::apply(keep, model, &grid, z0, &mut slab.dist, &mut slab.fracs);
+            }
+            let codes = &mut codes[..(z1 - z0) * layer];
+            match diffuser.as_mut() {
+                Some(d) => {
+                    for (l, c) in codes.chunks_mut(layer).enumerate() {
+                        let v = l * layer;
+                        d.layer(
+                            z0 + l,
+                            &slab.dist[v..v + layer],
+                            &slab.fracs[v * k..(v + layer) * k],
+                            c,
+                        );
+                    }
+                }
+                None => pick_codes(model, grid, p.seed, single, z0, slab, codes),
+            }
+            ctx.check_cancel()?;
+            let from = z0.max(est.layers.start);
+            f(from..z1, &codes[(from - z0) * layer..])
+        },
+    )
+}
+
+/// Sample `layers` with `sampler`, `slab_layers` at a time, checking for
+/// a cancel before each slab, and hand each slab (its first and end
+/// layer) to `each`: the slab loop every stack shares.
+pub(crate) fn sample_slabs(
+    sampler: &Sampler<'_>,
+    layers: Range<usize>,
+    slab_layers: usize,
+    ctx: &JobContext,
+    mut each: impl FnMut(usize, usize, &mut Slab) -> Result<(), ExportError>,
+) -> Result<(), ExportError> {
+    let mut slab = Slab::default();
+    let mut z0 = layers.start;
+    while z0 < layers.end {
         ctx.check_cancel()?;
-        let z1 = (z0 + est.slab_layers).min(est.layers.end);
+        let z1 = (z0 + slab_layers).min(layers.end);
         sampler
             .sample_layers(z0, z1, &mut slab, ctx.cancel_flag())
             .map_err(|_| ExportError::Cancelled)?;
-        if let Some(keep) = &keep {
-            keep_out::apply(keep, model, &grid, z0, &mut slab.dist, &mut slab.fracs);
-        }
-        let codes = &mut codes[..(z1 - z0) * layer];
-        match diffuser.as_mut() {
-            Some(d) => {
-                for (l, c) in codes.chunks_mut(layer).enumerate() {
-                    let v = l * layer;
-                    d.layer(
-                        z0 + l,
-                        &slab.dist[v..v + layer],
-                        &slab.fracs[v * k..(v + layer) * k],
-                        c,
-                    );
-                }
-            }
-            None => pick_codes(model, grid, p.seed, single, z0, &slab, codes),
-        }
-        ctx.check_cancel()?;
-        let from = z0.max(est.layers.start);
-        f(from..z1, &codes[(from - z0) * layer..])?;
+        each(z0, z1, &mut slab)?;
         z0 = z1;
     }
     Ok(())

@@ -21,13 +21,13 @@ pub mod profile;
 use std::ops::Range;
 
 use rayon::prelude::*;
-use volcad_core::sampler::{Consumer, Grid, Sampler, Slab};
+use volcad_core::sampler::{Consumer, Grid, Sampler};
 use volcad_core::{Model, Points};
 
 use crate::design::palette;
 use crate::dither::MIN_TOTAL;
 use crate::job::{ExportError, JobContext};
-use crate::png_stack::{Estimate, PngParams};
+use crate::png_stack::{self, Estimate, PngParams};
 pub use diffuse::{CHANNELS, Ink};
 pub use profile::{J750_COLOR_RESINS, Resin, resins};
 
@@ -212,17 +212,11 @@ pub(crate) fn for_each_slab(
     let k = model.materials().len();
     // Fractions only where `color` is not set everywhere they are needed.
     let sampler = Sampler::new(model, grid, Consumer::PngStackFullColor);
-    let mut slab = Slab::default();
     let mut codes = vec![0u8; est.slab_layers * layer];
     let mut wanted = vec![[0.0f32; CHANNELS]; est.slab_layers * layer];
     let mut inside = vec![false; est.slab_layers * layer];
-    let mut z0 = est.layers.start;
-    while z0 < est.layers.end {
-        ctx.check_cancel()?;
-        let z1 = (z0 + est.slab_layers).min(est.layers.end);
-        sampler
-            .sample_layers(z0, z1, &mut slab, ctx.cancel_flag())
-            .map_err(|_| ExportError::Cancelled)?;
+    let layers = est.layers.clone();
+    png_stack::sample_slabs(&sampler, layers, est.slab_layers, ctx, |z0, z1, slab| {
         let n = (z1 - z0) * layer;
         let results: Vec<Result<(), ExportError>> = codes[..n]
             .par_chunks_mut(layer)
@@ -243,10 +237,8 @@ pub(crate) fn for_each_slab(
         // The lowest layer's error, whatever the thread count.
         results.into_iter().collect::<Result<Vec<()>, _>>()?;
         ctx.check_cancel()?;
-        f(z0..z1, &codes[..n])?;
-        z0 = z1;
-    }
-    Ok(())
+        f(z0..z1, &codes[..n])
+    })
 }
 
 /// The manifest's record of the resins: names and the OKLab colours the

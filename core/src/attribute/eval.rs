@@ -31,11 +31,7 @@ impl ANode {
         pw: DVec3,
         out: &mut [f64],
     ) -> Result<bool, AttributeError> {
-        if let Some(pos) = self.own_of[idx] {
-            self.own_value(pos as usize, q, pw, out)?;
-            return Ok(true);
-        }
-        self.eval_below(idx, q, pw, out, false)
+        self.eval_at(idx, q, pw, out, false)
     }
 
     /// [`ANode::eval`] at a point known to be inside this node: a union
@@ -47,11 +43,24 @@ impl ANode {
         q: DVec3,
         out: &mut [f64],
     ) -> Result<bool, AttributeError> {
+        self.eval_at(idx, q, q, out, true)
+    }
+
+    /// This node's own value of `idx`, else what its children give
+    /// (`inside`: q is known to be inside this node).
+    fn eval_at(
+        &self,
+        idx: usize,
+        q: DVec3,
+        pw: DVec3,
+        out: &mut [f64],
+        inside: bool,
+    ) -> Result<bool, AttributeError> {
         if let Some(pos) = self.own_of[idx] {
-            self.own_value(pos as usize, q, q, out)?;
+            self.own_value(pos as usize, q, pw, out)?;
             return Ok(true);
         }
-        self.eval_below(idx, q, q, out, true)
+        self.eval_below(idx, q, pw, out, inside)
     }
 
     /// Attribute `idx` as the children below this node give it (`inside`:

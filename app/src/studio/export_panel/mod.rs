@@ -59,20 +59,8 @@ pub struct Question {
     pub confirm: String,
 }
 
-/// Which export.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Kind {
-    /// Inkjet slice stack.
-    Png,
-    /// Segmented meshes and 3MF.
-    Mesh,
-    /// FEA mesh.
-    Fea,
-    /// GrabCAD Voxel Print package (one file).
-    Gcvf,
-    /// Vat photopolymer stack.
-    Vat,
-}
+/// Which export: the command line's kinds (`volcad export KIND`).
+pub use crate::cli::export::Kind;
 
 impl Kind {
     fn title(self) -> &'static str {
