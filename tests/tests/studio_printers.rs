@@ -139,6 +139,23 @@ fn the_png_printer_choice_j750_brings_its_resin_table() {
     set_field(&mut h, "Resin map", "red=Crimson,blue=VeroCyan");
     let e = wait_label(&mut h, "is not a J750 material");
     assert!(e.contains("Crimson") && e.contains("VeroMgnt"), "{e}");
+    // Full colour is made of the J750's colour resins whatever the
+    // design's materials: no resin map is asked for (as on the CLI).
+    h.get_by_label("Resin map").focus();
+    h.step();
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    h.key_press(egui::Key::Backspace);
+    h.run_steps(2);
+    wait_label(&mut h, "is not a J750 material");
+    h.get_by_label("Full colour").click();
+    h.run_steps(2);
+    let est = wait_label(&mut h, "Estimate:");
+    assert!(est.contains("355 × 119 × 186 voxels"), "{est}");
+    assert!(
+        h.query_by_label_contains("is not a J750 material")
+            .is_none(),
+        "no resin refusal with full colour"
+    );
 }
 
 #[test]

@@ -28,7 +28,7 @@ use volcad_compilers::mesh::MeshParams;
 use volcad_compilers::plan::folder::{self, Folder};
 use volcad_compilers::plan::{ExportParams, Opt, Severity, Verdict};
 use volcad_compilers::png_stack::{self, PngParams};
-use volcad_compilers::printer_table::{is_j750_preset, j750_model, parse_map};
+use volcad_compilers::printer_table::{check_j750_tray, is_j750_preset, j750_model, parse_map};
 use volcad_core::Model;
 
 use super::files::Document;
@@ -289,10 +289,17 @@ impl ExportPanels {
 
     /// The design as the export writes it: for a PNG stack on a J750, its
     /// materials as J750 resins through the resin map (refused, naming
-    /// the nearest resins, when one is not); otherwise `model`.
+    /// the nearest resins, when one is not); otherwise `model`. A
+    /// full-colour stack is made of the colour resins whatever the
+    /// design's materials, so only the tray is checked, as the CLI does.
     fn printed_model(&mut self, model: &Arc<Model>) -> Result<Arc<Model>, String> {
         if !(self.kind == Kind::Png && self.png_j750()) {
             return Ok(model.clone());
+        }
+        if self.png.full_color {
+            return check_j750_tray(model)
+                .map(|()| model.clone())
+                .map_err(|e| in_panel_words(&e.to_string()));
         }
         let key = (
             Arc::as_ptr(model) as usize,
