@@ -176,3 +176,28 @@ fn gmsh_meshes_every_seat_segment() {
     assert!(check_shared(&segs) > 0, "segments share no interface");
     check("seat", &segs);
 }
+
+#[test]
+fn gmsh_meshes_a_one_segment_lattice() {
+    // One segment is contoured as marching cubes (no face diagonals): its
+    // ambiguous faces abound on a lattice's thin struts.
+    let dir = scratch("bcc-design");
+    let design = dir.join("bcc.rhai");
+    std::fs::write(
+        &design,
+        r#"let cell = GraphLattice(LatticeType::BodyCenteredCubic, Vec3(5, 5, 5), 0.35, default_materials().id("gray"));
+        Intersection(false, [Tile(cell), Sphere(Vec3(0, 0, 0), 6)])"#,
+    )
+    .expect("scratch design");
+    let m = model_of_file(&design).expect("lattice prepares");
+    let _ = std::fs::remove_dir_all(&dir);
+    let segs = meshes(&m, 0.2, SegmentBy::Dominant, 1);
+    let full: Vec<_> = segs.iter().filter(|s| !s.mesh.is_empty()).collect();
+    assert_eq!(full.len(), 1, "one segment with triangles");
+    assert!(
+        full[0].mesh.is_watertight(),
+        "{:?}",
+        full[0].mesh.edge_report()
+    );
+    check("bcc", &segs);
+}

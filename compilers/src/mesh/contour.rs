@@ -44,6 +44,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use volcad_core::sampler::Grid;
 
+use super::cube_loops;
 use super::flat::{FlatKey, FlatMemo, KeptCubes, Regions, SampleAt};
 use super::indexed::IndexedMesh;
 use super::interface::{Cube, Interface, cut_field, front_back};
@@ -73,9 +74,12 @@ pub struct Plane {
 /// and needles stopped gmsh's boundary recovery (the surface moves by at
 /// most this much of an edge there).
 const T_MIN: f64 = 0.05;
-/// Key type offsets: edges 1..=7 (direction mask), faces 8..=71, tets 72..=77.
+/// Key type offsets: edges 1..=7 (direction mask), faces 8..=71, tets
+/// 72..=77, loop centres 78..=81.
 const FACE_KEY: u64 = 8;
 const TET_KEY: u64 = 72;
+/// Centre points of one-label loops (up to four a cube): 78..=81.
+const LOOP_KEY: u64 = 78;
 const KEY_TYPES: u64 = 128;
 
 /// A band's flat cubes: row, column, key and the corners of the key's `x`
@@ -115,6 +119,9 @@ pub struct Contourer {
     /// Merge flat regions (see [`super::flat`]); off: plain marching
     /// tetrahedra.
     merge: bool,
+    /// One label: cubes are cut as marching cubes ([`cube_loops`]), with
+    /// no face diagonals.
+    one_label: bool,
     regions: Regions,
     /// Region id per cube of the previous layer, or [`NOT_FLAT`], and the
     /// cubes that have one.
@@ -144,6 +151,7 @@ impl Contourer {
                 .collect(),
             prev: None,
             merge: true,
+            one_label: labels == 1,
             regions: Regions::new(iface.stride()),
             prev_flat: Vec::new(),
             prev_list: Vec::new(),
@@ -258,9 +266,7 @@ impl Contourer {
         let mut meshes = std::mem::take(&mut self.meshes);
         let contour = |cube: &Cube, out: &mut Vec<Tri>| {
             let mut scratch = Scratch::default();
-            for perm in 0..6 {
-                self.tet(cube, perm, &mut scratch, out);
-            }
+            self.contour_cube(cube, &mut scratch, out);
         };
         regions.finish(&mut meshes, &contour, samples);
         meshes
@@ -318,9 +324,7 @@ impl Contourer {
                     flats.kept.push(cube.base, mask);
                     continue;
                 }
-                for perm in 0..6 {
-                    self.tet(&cube, perm, &mut scratch, &mut out);
-                }
+                self.contour_cube(&cube, &mut scratch, &mut out);
             }
         }
         (out, flats)
@@ -408,6 +412,17 @@ impl Contourer {
     /// face when `reverse`).
     fn outline(&mut self, pz: usize, id: u32, cube: &Cube, axis: usize, side: u8, reverse: bool) {
         let key = self.regions.key(id);
+        if self.one_label {
+            let mut segs = Vec::with_capacity(2);
+            cube_loops::face_segments(corner_mask(cube, key.x), axis, side, &mut segs);
+            for (a, b) in segs {
+                let (a, b) = if reverse { (b, a) } else { (a, b) };
+                let r = [a, b].map(|p| self.resolve(cube, 0, &[0; 4], p));
+                let xi = r.map(|r| self.index_of(pz, key.x, r));
+                self.regions.add_edge(id, r.map(|r| r.key), xi, [0; 2]);
+            }
+            return;
+        }
         for perm in 0..6 {
             let v = tet_corners(perm);
             let lab = v.map(|m| cube.label[m as usize]);
@@ -534,6 +549,48 @@ impl Contourer {
         VRef {
             key,
             pos: pos.as_vec3().to_array(),
+        }
+    }
+
+    /// Contour one cube into `out`: as marching cubes with one label, tet
+    /// by tet with more.
+    fn contour_cube(&self, cube: &Cube, scratch: &mut Scratch, out: &mut Vec<Tri>) {
+        if !self.one_label {
+            for perm in 0..6 {
+                self.tet(cube, perm, scratch, out);
+            }
+            return;
+        }
+        for (n, l) in cube_loops::case(corner_mask(cube, 1)).iter().enumerate() {
+            let refs = &mut scratch.refs;
+            refs.clear();
+            refs.extend(l.points.iter().map(|p| self.resolve(cube, 0, &[0; 4], *p)));
+            let k = refs.len();
+            let apex = match l.apex {
+                Some(a) => a,
+                None => {
+                    let mut c = [0.0f32; 3];
+                    for r in refs.iter() {
+                        (0..3).for_each(|i| c[i] += r.pos[i] / k as f32);
+                    }
+                    refs.push(VRef {
+                        key: self.global(cube.base) * KEY_TYPES + LOOP_KEY + n as u64,
+                        pos: c,
+                    });
+                    k
+                }
+            };
+            // The fan over the loop's points from the apex (the loop's own
+            // points skip it; an added centre closes the whole loop).
+            let steps = if apex == k { k } else { k - 2 };
+            let first = if apex == k { 0 } else { apex + 1 };
+            for d in 0..steps {
+                let (i, j) = ((first + d) % k, (first + d + 1) % k);
+                out.push(Tri {
+                    label: 1,
+                    v: [refs[apex], refs[i], refs[j]],
+                });
+            }
         }
     }
 

@@ -97,22 +97,36 @@ impl IndexedMesh {
     /// shortest edge (mm): slivers and needles show here before another
     /// program trips on them. `(180, inf)` without triangles.
     pub fn shape(&self) -> (f64, f64) {
-        let (mut angle, mut edge) = (180.0f64, f64::INFINITY);
-        for t in 0..self.triangles.len() {
-            let p = self.corners(t);
-            for k in 0..3 {
-                let (a, b, c) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
-                let (u, v) = (sub(b, a), sub(c, a));
-                let (lu, lv) = (dot(u, u).sqrt(), dot(v, v).sqrt());
-                edge = edge.min(lu);
-                // atan2(|u × v|, u · v) stays exact for needles, where the
-                // acos of the normalised dot product rounds to 0.
-                let n = cross(u, v);
-                let deg = dot(n, n).sqrt().atan2(dot(u, v)).to_degrees();
-                angle = angle.min(if lu > 0.0 && lv > 0.0 { deg } else { 0.0 });
-            }
+        // A triangle's smallest angle is opposite its shortest edge and is
+        // at most 60°, where the sine rises with the angle: keep the
+        // smallest sine |u × v| / (|u| |v|) over triangles and take one
+        // asin at the end (exact for needles, where the acos of the
+        // normalised dot product rounds to 0).
+        if self.triangles.is_empty() {
+            return (180.0, f64::INFINITY);
         }
-        (angle, edge)
+        let (sine, edge) = self
+            .triangles
+            .par_iter()
+            .enumerate()
+            .map(|(t, _)| {
+                let p = self.corners(t);
+                let e = [0, 1, 2].map(|k| sub(p[(k + 1) % 3], p[k]));
+                let l = e.map(|v| dot(v, v));
+                let k = (0..3).fold(0, |m, k| if l[k] < l[m] { k } else { m });
+                // The two edges from the corner opposite the shortest, e[k].
+                let (u, v) = (e[(k + 1) % 3], e[(k + 2) % 3]);
+                let (lu, lv) = (l[(k + 1) % 3].sqrt(), l[(k + 2) % 3].sqrt());
+                let n = cross(u, v);
+                let sine = if lu > 0.0 && lv > 0.0 {
+                    (dot(n, n).sqrt() / (lu * lv)).min(1.0)
+                } else {
+                    0.0
+                };
+                (sine, l[k].sqrt())
+            })
+            .reduce(|| (1.0, f64::INFINITY), |a, b| (a.0.min(b.0), a.1.min(b.1)));
+        (sine.asin().to_degrees().min(60.0), edge)
     }
 
     /// Unit normal of triangle `t` (zero for a degenerate one).

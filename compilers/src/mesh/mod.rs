@@ -4,7 +4,7 @@
 //! Pipeline, a slab of layers at a time: `Sampler::sample_layers` (grid
 //! padded by one voxel so its outer layer is outside) → [`segment`] labels
 //! per voxel → [`contour`] (marching tetrahedra inside each cube, multi-label,
-//! shared vertices) → per segment an [`IndexedMesh`] → STL ([`stl`]), OBJ
+//! shared vertices; marching cubes with one label, see `cube_loops`) → per segment an [`IndexedMesh`] → STL ([`stl`]), OBJ
 //! ([`obj`]) per segment and one `segments.3mf` ([`threemf`]) with every
 //! segment as a named part carrying its `fill_density`.
 //!
@@ -29,6 +29,7 @@
 
 pub mod bodies;
 pub mod contour;
+mod cube_loops;
 pub mod field;
 mod flat;
 pub mod indexed;
@@ -81,18 +82,22 @@ const SLAB_BUDGET: usize = 256 << 20;
 /// 115 M with 16, 148 M with 4; the seat, gyroid, bunny lattice and
 /// tiled FCC within noise.
 const SLAB_LAYERS: usize = 4;
-/// Triangles per voxel face of surface (measured on spheres and lattices).
-const TRIANGLES_PER_FACE: f64 = 9.0;
+/// Triangles per voxel face of surface (measured on spheres and lattices),
+/// by marching tetrahedra (two or more segments) and by marching cubes (one
+/// segment: no face diagonals, see `cube_loops`).
+const TRIANGLES_PER_FACE: [f64; 2] = [9.0, 3.5];
 /// Cube layers the triangle estimate samples at the export's voxel size
 /// (see `sampled_triangles`), when the coarse grid's cells are more than
 /// [`SAMPLE_BEYOND`] voxels across.
 const SAMPLED_LAYERS: usize = 3;
 /// Coarse cells at most this many voxels across see what the export sees.
 const SAMPLE_BEYOND: f64 = 2.0;
-/// Triangles of merged flat faces per voxel of `sqrt(flat area)`: a 10 mm
-/// cube makes about 12 thousand at 0.1 mm and 24 thousand at 0.05 mm,
-/// where `sqrt(600 mm²)` is 245 and 490 voxels.
-const FLAT_TRIANGLES_PER_EDGE: f64 = 50.0;
+/// Triangles of merged flat faces per voxel of `sqrt(flat area)`, with two
+/// or more segments and with one: a 10 mm cube makes about 12 thousand
+/// with two segments at 0.1 mm and 24 thousand at 0.05 mm, where
+/// `sqrt(600 mm²)` is 245 and 490 voxels; its outlines have no face
+/// diagonals' points with one segment.
+const FLAT_TRIANGLES_PER_EDGE: [f64; 2] = [50.0, 20.0];
 /// Bytes held until the end of the export per flat cube (a voxel of a
 /// planar face): its region's union-find entry, its interned key, its
 /// kept place and labels (8 bytes) and growth slack (its samples are not
@@ -286,8 +291,9 @@ fn plan(model: &Model, p: &MeshParams, look: Look) -> Result<Plan, ExportError> 
     // Faces on the bounding box are planar and merge: their triangles go
     // with their outlines, about their length in voxels (each segment has
     // its own).
-    let flat_triangles = FLAT_TRIANGLES_PER_EDGE * (pr.flat_mm2 / face).sqrt() * more;
-    let coarse = pr.surface_mm2 * more / face * TRIANGLES_PER_FACE;
+    let cut = usize::from(segments == 1);
+    let flat_triangles = FLAT_TRIANGLES_PER_EDGE[cut] * (pr.flat_mm2 / face).sqrt() * more;
+    let coarse = pr.surface_mm2 * more / face * TRIANGLES_PER_FACE[cut];
     // Sampled layers see what the coarse grid's cells are too coarse for. Two
     // layers and their planes must fit the slab budget: a grid whose layer
     // alone outgrows memory is refused below, not sampled first.
