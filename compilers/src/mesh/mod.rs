@@ -4,9 +4,10 @@
 //! Pipeline, a slab of layers at a time: `Sampler::sample_layers` (grid
 //! padded by one voxel so its outer layer is outside) → [`segment`] labels
 //! per voxel → [`contour`] (marching tetrahedra inside each cube, multi-label,
-//! shared vertices; marching cubes with one label, see `cube_loops`) → per segment an [`IndexedMesh`] → STL ([`stl`]), OBJ
-//! ([`obj`]) per segment and one `segments.3mf` ([`threemf`]) with every
-//! segment as a named part carrying its `fill_density`.
+//! shared vertices; marching cubes with one label, see `cube_loops`) → per
+//! segment an [`IndexedMesh`] → STL ([`stl`]), OBJ ([`obj`]) per segment
+//! and one `segments.3mf` ([`threemf`]) with every segment as a named part
+//! carrying its `fill_density`.
 //!
 //! Guarantees: each segment's mesh is watertight (every edge in exactly two
 //! triangles, opposite directions) and outward oriented; neighbouring
