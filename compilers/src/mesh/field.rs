@@ -7,9 +7,8 @@ use super::indexed::IndexedMesh;
 use super::interface::Interface;
 
 /// Mesh the region `{v ≤ 0}` of a field sampled at the centres of `grid`
-/// (`values` x fastest, then y, then z): marching cubes, each cube split
-/// into six tetrahedra (see [`super::contour`]), with flat regions merged
-/// (see `super::flat`). Samples on the grid's outer layer count as
+/// (`values` x fastest, then y, then z): marching cubes (one label, see
+/// `super::cube_loops`), with flat regions merged (see `super::flat`). Samples on the grid's outer layer count as
 /// outside, so the mesh is always closed.
 ///
 /// # Panics
