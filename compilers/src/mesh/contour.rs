@@ -569,13 +569,18 @@ impl Contourer {
             let apex = match l.apex {
                 Some(a) => a,
                 None => {
-                    let mut c = [0.0f32; 3];
+                    // The loop's centroid, a quarter of the way to the
+                    // cube's centre: a loop on one face's four edges (a
+                    // sheet across that face) has its centroid on the face,
+                    // where the cube across may put its own.
+                    let mid = (self.center(cube.base) + self.center(Self::corner(cube, 7))) * 0.5;
+                    let mut c = DVec3::ZERO;
                     for r in refs.iter() {
-                        (0..3).for_each(|i| c[i] += r.pos[i] / k as f32);
+                        c += DVec3::from(r.pos.map(f64::from)) / k as f64;
                     }
                     refs.push(VRef {
                         key: self.global(cube.base) * KEY_TYPES + LOOP_KEY + n as u64,
-                        pos: c,
+                        pos: (c * 0.75 + mid * 0.25).as_vec3().to_array(),
                     });
                     k
                 }
