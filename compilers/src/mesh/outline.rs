@@ -207,6 +207,17 @@ fn inner_points(
         p[v] += dv;
         // Along the plane: n · Δ = 0.
         p[drop] -= (n[u] * du + n[v] * dv) / n[drop];
+        // Neighbouring short edges (a cluster of three or more points)
+        // would add points a rounding error apart, an edge of 10⁻⁶ mm: one
+        // point serves them all.
+        let near = (0.1 * step) * (0.1 * step);
+        let first = pts.len() - added.len();
+        if pts[first..].iter().any(|q| {
+            let (du, dv) = (q.x - p[u], q.y - p[v]);
+            du * du + dv * dv < near
+        }) {
+            continue;
+        }
         pts.push(Point2::new(p[u], p[v]));
         global.push(ADDED + added.len() as u32);
         added.push(p.map(|c| c as f32));
