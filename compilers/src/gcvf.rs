@@ -1,7 +1,10 @@
 //! GrabCAD Voxel Print packages (`.gcvf`) for Stratasys PolyJet printers:
 //! the zip pyvcad 2.3.4's `GCVFExporter` writes, streamed one slab of
-//! layers at a time as the PNG stack is (memory: the stack's slab plus one
-//! 16-bit height per column).
+//! layers at a time as the PNG stack is. Memory: the stack's slab plus one
+//! 16-bit height per column, less than the PNG stack itself holds, since a
+//! layer's PNG is encoded a row at a time ([`crate::row_png`]) where the
+//! stack holds the layer's whole RGBA image (4 bytes a voxel, twice the
+//! z-buffer's 2).
 //!
 //! # Entries
 //!
@@ -52,7 +55,8 @@ use crate::png_io::PixelsPerMetre;
 use crate::png_stack::{self, Dither, Estimate, PngParams};
 use crate::printer_table::{PrinterMaterial, palette_of, resolve};
 use crate::resources::{check_disk, run_with_threads};
-use crate::slice_image::{ImageStyle, Orientation, rgba_png};
+use crate::row_png::rgba_png;
+use crate::slice_image::{ImageStyle, Orientation};
 
 /// The slice images' name prefix (pyvcad's).
 pub const PREFIX: &str = "gcvf_export_";
@@ -208,8 +212,9 @@ fn write_package(
     })?;
     ctx.check_cancel()?;
     let zbuf =
-        zbuffer_png(&top, nx, ny).map_err(|e| ExportError::Other(format!("Zbuffer.png: {e}")))?;
+        zbuffer_png(top, nx, ny).map_err(|e| ExportError::Other(format!("Zbuffer.png: {e}")))?;
     zip.stored("Zbuffer.png", &zbuf).map_err(io)?;
+    drop(zbuf);
     ctx.progress("mesh", 0, 1, "meshes", 0.96);
     let mesh = preview_mesh(model, est, ctx)?;
     zip.entry("Mesh.stl", false, |w| {
@@ -233,17 +238,20 @@ fn write_package(
     Ok(summary(p, est, mats, counts))
 }
 
-/// `Zbuffer.png`: `top` (x fastest) in pyvcad's orientation.
-fn zbuffer_png(top: &[u16], nx: usize, ny: usize) -> Result<Vec<u8>, png::EncodingError> {
+/// `Zbuffer.png`: `top` (x fastest) in pyvcad's orientation; `top` is
+/// dropped once its pixels are laid out, before they are encoded.
+fn zbuffer_png(top: Vec<u16>, nx: usize, ny: usize) -> Result<Vec<u8>, png::EncodingError> {
     let o = Orientation::Pyvcad;
-    let mut img = vec![0u16; nx * ny];
+    let mut img = vec![0u8; nx * ny * 2];
     for (j, row) in top.chunks_exact(nx).enumerate() {
         let r = o.row(j, ny);
         for (i, v) in row.iter().enumerate() {
-            img[r * nx + o.col(i, nx)] = *v;
+            let k = (r * nx + o.col(i, nx)) * 2;
+            img[k..k + 2].copy_from_slice(&v.to_be_bytes());
         }
     }
-    crate::png_io::encode_gray16(nx, ny, &img)
+    drop(top);
+    crate::png_io::encode_gray16_be(nx, ny, &img)
 }
 
 /// The part's surface on a grid of at most [`MESH_CELLS`] cubic cells (the
