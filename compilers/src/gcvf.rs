@@ -48,6 +48,7 @@ use volcad_core::sampler::{Consumer, Sampler, Slab};
 use volcad_core::{MaterialTable, Model};
 
 use crate::design::grid_for;
+use crate::estimate::Look;
 use crate::job::{ExportError, JobContext, Summary};
 use crate::mesh::field::marching_cubes;
 use crate::mesh::stl::write_stl;
@@ -109,15 +110,15 @@ pub fn estimate(
     model: &Model,
     p: &GcvfParams,
 ) -> Result<(Estimate, Vec<PrinterMaterial>), ExportError> {
-    estimate_with(model, p, png_stack::estimate)
+    estimate_with(model, p, Look::Layers)
 }
 
-/// [`estimate`] with the stack's estimate `stack` (the sampled one for
-/// front ends, the coarse one in the job).
+/// [`estimate`] with the stack's estimate looking as `look` says (layers
+/// sampled for front ends, the coarse look in the job).
 fn estimate_with(
     model: &Model,
     p: &GcvfParams,
-    stack: fn(&Model, &PngParams) -> Result<Estimate, ExportError>,
+    look: Look,
 ) -> Result<(Estimate, Vec<PrinterMaterial>), ExportError> {
     crate::printer_table::check_j750_tray(model)?;
     let mats = resolve(model, &MaterialTable::j750(), &p.map, "J750")?;
@@ -132,7 +133,7 @@ fn estimate_with(
             ),
         ));
     }
-    let est = stack(model, &p.stack())?;
+    let est = png_stack::estimate_with(model, &p.stack(), look)?;
     let nz = est.grid.dims[2];
     if nz > usize::from(u16::MAX) + 1 {
         return Err(ExportError::param(
@@ -151,7 +152,7 @@ pub fn export_gcvf(
 ) -> Result<Summary, ExportError> {
     // The front end showed the sampled estimate; the job checks by the
     // coarse one, as the PNG stack's does (no layers sampled twice).
-    let (est, mats) = estimate_with(model, p, png_stack::estimate_coarse)?;
+    let (est, mats) = estimate_with(model, p, Look::Coarse)?;
     check_disk(est.disk_bytes, ctx.folder(), "a larger voxel size")?;
     run_with_threads(p.threads, || write_package(model, p, &est, &mats, ctx))
 }

@@ -171,13 +171,11 @@ pub fn estimate(model: &Model, p: &PngParams) -> Result<Estimate, ExportError> {
     estimate_with(model, p, Look::Layers)
 }
 
-/// [`estimate`] by the coarse look alone: what an export job checks up
-/// front (its front end has shown the sampled estimate already).
-pub(crate) fn estimate_coarse(model: &Model, p: &PngParams) -> Result<Estimate, ExportError> {
-    estimate_with(model, p, Look::Coarse)
-}
-
-fn estimate_with(model: &Model, p: &PngParams, look: Look) -> Result<Estimate, ExportError> {
+pub(crate) fn estimate_with(
+    model: &Model,
+    p: &PngParams,
+    look: Look,
+) -> Result<Estimate, ExportError> {
     let pal = palette(model)?;
     keep_out::plan(model, p.liquid_keep_out)?;
     let grid = grid_for(model, p.voxel, 0.0)?;
@@ -325,7 +323,7 @@ pub fn export_png_stack(
     p: &PngParams,
     ctx: &JobContext,
 ) -> Result<Summary, ExportError> {
-    let est = estimate_coarse(model, p)?;
+    let est = estimate_with(model, p, Look::Coarse)?;
     check_disk(est.disk_bytes, ctx.folder(), "a larger voxel size")?;
     run_with_threads(p.threads, || write_stack(model, p, &est, ctx))
 }
