@@ -1,7 +1,10 @@
 //! GrabCAD Voxel Print packages (`.gcvf`) for Stratasys PolyJet printers:
 //! the zip pyvcad 2.3.4's `GCVFExporter` writes, streamed one slab of
-//! layers at a time as the PNG stack is (memory: the stack's slab plus one
-//! 16-bit height per column).
+//! layers at a time as the PNG stack is. Memory: the stack's slab plus one
+//! 16-bit height per column, less than the PNG stack itself holds, since a
+//! layer's PNG is encoded a row at a time ([`crate::row_png`]) where the
+//! stack holds the layer's whole RGBA image (4 bytes a voxel, twice the
+//! z-buffer's 2).
 //!
 //! # Entries
 //!
@@ -45,6 +48,7 @@ use volcad_core::sampler::{Consumer, Sampler, Slab};
 use volcad_core::{MaterialTable, Model};
 
 use crate::design::grid_for;
+use crate::estimate::Look;
 use crate::job::{ExportError, JobContext, Summary};
 use crate::mesh::field::marching_cubes;
 use crate::mesh::stl::write_stl;
@@ -52,7 +56,8 @@ use crate::png_io::PixelsPerMetre;
 use crate::png_stack::{self, Dither, Estimate, PngParams};
 use crate::printer_table::{PrinterMaterial, palette_of, resolve};
 use crate::resources::{check_disk, run_with_threads};
-use crate::slice_image::{ImageStyle, Orientation, rgba_png};
+use crate::row_png::rgba_png;
+use crate::slice_image::{ImageStyle, Orientation};
 
 /// The slice images' name prefix (pyvcad's).
 pub const PREFIX: &str = "gcvf_export_";
@@ -105,6 +110,16 @@ pub fn estimate(
     model: &Model,
     p: &GcvfParams,
 ) -> Result<(Estimate, Vec<PrinterMaterial>), ExportError> {
+    estimate_with(model, p, Look::Layers)
+}
+
+/// [`estimate`] with the stack's estimate looking as `look` says (layers
+/// sampled for front ends, the coarse look in the job).
+fn estimate_with(
+    model: &Model,
+    p: &GcvfParams,
+    look: Look,
+) -> Result<(Estimate, Vec<PrinterMaterial>), ExportError> {
     crate::printer_table::check_j750_tray(model)?;
     let mats = resolve(model, &MaterialTable::j750(), &p.map, "J750")?;
     if mats.len() > MAX_RESINS {
@@ -118,7 +133,7 @@ pub fn estimate(
             ),
         ));
     }
-    let est = png_stack::estimate(model, &p.stack())?;
+    let est = png_stack::estimate_with(model, &p.stack(), look)?;
     let nz = est.grid.dims[2];
     if nz > usize::from(u16::MAX) + 1 {
         return Err(ExportError::param(
@@ -135,7 +150,9 @@ pub fn export_gcvf(
     p: &GcvfParams,
     ctx: &JobContext,
 ) -> Result<Summary, ExportError> {
-    let (est, mats) = estimate(model, p)?;
+    // The front end showed the sampled estimate; the job checks by the
+    // coarse one, as the PNG stack's does (no layers sampled twice).
+    let (est, mats) = estimate_with(model, p, Look::Coarse)?;
     check_disk(est.disk_bytes, ctx.folder(), "a larger voxel size")?;
     run_with_threads(p.threads, || write_package(model, p, &est, &mats, ctx))
 }
@@ -159,16 +176,20 @@ fn write_package(
         pixel: Some(PixelsPerMetre::from_mm(est.grid.voxel.x, est.grid.voxel.y)),
     };
     let mut counts = vec![0u64; mats.len()];
-    let mut top = vec![0u16; layer];
+    // The z-buffer, kept as `Zbuffer.png`'s pixels (big-endian, pyvcad's
+    // orientation: image row j is voxel row j, column nx - 1 - i is voxel
+    // column i), so it is encoded without a second copy.
+    let mut top = vec![0u8; layer * 2];
     let batch = rayon::current_num_threads().max(1);
     png_stack::for_each_slab(model, &p.stack(), est, ctx, |zs, codes| {
-        // The z-buffer: layers come in rising order, so the last solid one wins.
-        top.par_chunks_mut(nx).enumerate().for_each(|(j, t)| {
+        // Layers come in rising order, so the last solid one wins.
+        top.par_chunks_mut(nx * 2).enumerate().for_each(|(j, t)| {
             for l in 0..zs.len() {
                 let row = &codes[l * layer + j * nx..l * layer + (j + 1) * nx];
-                for (t, c) in t.iter_mut().zip(row) {
+                let z = ((zs.start + l) as u16).to_be_bytes();
+                for (t, c) in t.chunks_exact_mut(2).rev().zip(row) {
                     if *c != 0 {
-                        *t = (zs.start + l) as u16;
+                        t.copy_from_slice(&z);
                     }
                 }
             }
@@ -207,9 +228,11 @@ fn write_package(
         Ok(())
     })?;
     ctx.check_cancel()?;
-    let zbuf =
-        zbuffer_png(&top, nx, ny).map_err(|e| ExportError::Other(format!("Zbuffer.png: {e}")))?;
+    let zbuf = crate::png_io::encode_gray16_be(nx, ny, &top)
+        .map_err(|e| ExportError::Other(format!("Zbuffer.png: {e}")))?;
+    drop(top);
     zip.stored("Zbuffer.png", &zbuf).map_err(io)?;
+    drop(zbuf);
     ctx.progress("mesh", 0, 1, "meshes", 0.96);
     let mesh = preview_mesh(model, est, ctx)?;
     zip.entry("Mesh.stl", false, |w| {
@@ -231,19 +254,6 @@ fn write_package(
         .sync_all()
         .map_err(io)?;
     Ok(summary(p, est, mats, counts))
-}
-
-/// `Zbuffer.png`: `top` (x fastest) in pyvcad's orientation.
-fn zbuffer_png(top: &[u16], nx: usize, ny: usize) -> Result<Vec<u8>, png::EncodingError> {
-    let o = Orientation::Pyvcad;
-    let mut img = vec![0u16; nx * ny];
-    for (j, row) in top.chunks_exact(nx).enumerate() {
-        let r = o.row(j, ny);
-        for (i, v) in row.iter().enumerate() {
-            img[r * nx + o.col(i, nx)] = *v;
-        }
-    }
-    crate::png_io::encode_gray16(nx, ny, &img)
 }
 
 /// The part's surface on a grid of at most [`MESH_CELLS`] cubic cells (the

@@ -32,6 +32,7 @@ mod png_summary;
 mod presets;
 pub mod printer_table;
 pub mod resources;
+pub mod row_png;
 pub mod shard;
 pub mod slice_image;
 pub mod thin;

@@ -50,6 +50,30 @@ pub fn folder_name(name: &str, id: u8) -> String {
     }
 }
 
+/// The encoder every slice image uses: `color` at `depth`, the physical
+/// pixel size when given, the fastest setting.
+pub(crate) fn encoder<W: std::io::Write>(
+    out: W,
+    width: usize,
+    height: usize,
+    color: ColorType,
+    depth: BitDepth,
+    pixel: Option<PixelsPerMetre>,
+) -> Encoder<'static, W> {
+    let mut enc = Encoder::new(out, width as u32, height as u32);
+    enc.set_color(color);
+    enc.set_depth(depth);
+    if let Some(PixelsPerMetre([xppu, yppu])) = pixel {
+        enc.set_pixel_dims(Some(PixelDimensions {
+            xppu,
+            yppu,
+            unit: Unit::Meter,
+        }));
+    }
+    enc.set_compression(Compression::Fastest);
+    enc
+}
+
 fn encode(
     width: usize,
     height: usize,
@@ -60,17 +84,7 @@ fn encode(
 ) -> Result<Vec<u8>, png::EncodingError> {
     let mut out = Cursor::new(Vec::with_capacity(data.len() / 8 + 256));
     {
-        let mut enc = Encoder::new(&mut out, width as u32, height as u32);
-        enc.set_color(color);
-        enc.set_depth(depth);
-        if let Some(PixelsPerMetre([xppu, yppu])) = pixel {
-            enc.set_pixel_dims(Some(PixelDimensions {
-                xppu,
-                yppu,
-                unit: Unit::Meter,
-            }));
-        }
-        enc.set_compression(Compression::Fastest);
+        let enc = encoder(&mut out, width, height, color, depth, pixel);
         let mut w = enc.write_header()?;
         w.write_image_data(data)?;
         w.finish()?;
@@ -114,12 +128,22 @@ pub fn encode_gray16(
     data: &[u16],
 ) -> Result<Vec<u8>, png::EncodingError> {
     let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_be_bytes()).collect();
+    encode_gray16_be(width, height, &bytes)
+}
+
+/// A 16-bit grayscale image from its big-endian bytes (two a pixel), rows
+/// from the top.
+pub fn encode_gray16_be(
+    width: usize,
+    height: usize,
+    bytes: &[u8],
+) -> Result<Vec<u8>, png::EncodingError> {
     encode(
         width,
         height,
         ColorType::Grayscale,
         BitDepth::Sixteen,
-        &bytes,
+        bytes,
         None,
     )
 }

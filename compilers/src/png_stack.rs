@@ -171,7 +171,11 @@ pub fn estimate(model: &Model, p: &PngParams) -> Result<Estimate, ExportError> {
     estimate_with(model, p, Look::Layers)
 }
 
-fn estimate_with(model: &Model, p: &PngParams, look: Look) -> Result<Estimate, ExportError> {
+pub(crate) fn estimate_with(
+    model: &Model,
+    p: &PngParams,
+    look: Look,
+) -> Result<Estimate, ExportError> {
     let pal = palette(model)?;
     keep_out::plan(model, p.liquid_keep_out)?;
     let grid = grid_for(model, p.voxel, 0.0)?;

@@ -270,6 +270,30 @@ fn bmp_images_are_8_bit_screens() {
     // Moved 3 mm right and 2 mm down: columns 75..225, rows 50..150.
     assert!(img.get_pixel(75, 50)[0] == 255 && img.get_pixel(224, 149)[0] == 255);
     assert!(img.get_pixel(74, 50)[0] == 0 && img.get_pixel(75, 49)[0] == 0);
+    // The pixel size: 100 µm = 10 000 px/m (biXPelsPerMeter,
+    // biYPelsPerMeter after the 14-byte file header and 24 bytes of the
+    // 40-byte BITMAPINFOHEADER).
+    let b = &files["slice_00010.bmp"];
+    let u32_at = |o: usize| u32::from_le_bytes([b[o], b[o + 1], b[o + 2], b[o + 3]]);
+    assert_eq!(u32_at(14), 40, "BITMAPINFOHEADER");
+    assert_eq!((u32_at(38), u32_at(42)), (10_000, 10_000));
+}
+
+#[test]
+fn bmp_pixel_size_follows_a_non_square_pitch() {
+    let (_t, dest) = scratch("pitch");
+    let mut printer = small();
+    // The Saturn 4 Ultra's pitch: 19 × 24 µm.
+    printer.pixel = [0.019, 0.024];
+    printer.screen = [1000, 600];
+    let mut p = params(printer, &[], None);
+    p.bmp = true;
+    p.layers = Some(10..11);
+    export(&model(GRADED_BAR), &p, &dest).unwrap();
+    let b = &read_tree(&dest)["slice_00010.bmp"];
+    let u32_at = |o: usize| u32::from_le_bytes([b[o], b[o + 1], b[o + 2], b[o + 3]]);
+    // 1000 / 0.019 = 52 631.6 and 1000 / 0.024 = 41 666.7 px/m, rounded.
+    assert_eq!((u32_at(38), u32_at(42)), (52_632, 41_667));
 }
 
 #[test]

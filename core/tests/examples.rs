@@ -277,6 +277,43 @@ fn color_gradient() {
     assert!(near(c, [0.5, 0.975, 0.5, 1.0]), "{c:?}");
 }
 
+/// The photo tile: at the centre of each pixel of the picture (256 px
+/// over 40 mm, the top row at +y) the colour is that pixel's, through the
+/// whole thickness (pixels inside the rounded corners); between centres a
+/// mix of the neighbours.
+#[test]
+fn photo_tile() {
+    let m = example("photo_tile.rhai");
+    let i = m.attribute_index("color").unwrap();
+    let path =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets/examples/data/astronaut.png");
+    let img = image::open(path).unwrap().to_rgba8();
+    assert_eq!(img.dimensions(), (256, 256));
+    let pitch = 40.0 / 256.0;
+    let mut c = [0.0; 4];
+    for (col, row) in [(3, 3), (128, 40), (70, 200), (252, 252), (200, 17)] {
+        let want = img.get_pixel(col, row).0.map(|v| f64::from(v) / 255.0);
+        let x = -20.0 + (f64::from(col) + 0.5) * pitch;
+        let y = 20.0 - (f64::from(row) + 0.5) * pitch;
+        for z in [-1.4, 0.0, 1.4] {
+            m.attribute_at(i, DVec3::new(x, y, z), &mut c).unwrap();
+            assert!(
+                c.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-12),
+                "pixel {col}, {row} at z {z}: {c:?} vs {want:?}"
+            );
+        }
+    }
+    // Half way between two centres along a row: their mean.
+    let (a, b) = (img.get_pixel(100, 50).0, img.get_pixel(101, 50).0);
+    let x = -20.0 + 101.0 * pitch;
+    let y = 20.0 - 50.5 * pitch;
+    m.attribute_at(i, DVec3::new(x, y, 0.0), &mut c).unwrap();
+    for k in 0..3 {
+        let mean = (f64::from(a[k]) + f64::from(b[k])) / 510.0;
+        assert!((c[k] - mean).abs() < 1e-12, "{c:?}");
+    }
+}
+
 /// The colour wheel: white at the centre, the pure hue at the rim (red
 /// at +x, green at 120°, blue at 240°).
 #[test]

@@ -1,7 +1,8 @@
 //! The studio's printer exports, headless (egui_kittest, wgpu on lavapipe
 //! where there is no GPU): a GrabCAD package written from its panel, the
 //! J750 resin table refusing a `default_materials()` design with the
-//! nearest J750 resins until mapped, and a vat stack from its panel.
+//! nearest J750 resins until mapped, and a vat stack from its panel (a
+//! layer range, an offset, and the shard-or-layers refusal in its words).
 
 use std::path::Path;
 use std::time::Duration;
@@ -178,15 +179,54 @@ fn a_vat_stack_from_its_panel() {
     let out = dir.path().join("vat");
     set_field(&mut h, "Output folder", &out.display().to_string());
     set_field(&mut h, "Vat materials", "red,blue");
+    // The command line's --layers, --shard and --offset, read the same way.
+    set_field(&mut h, "Layers", "2..5");
+    set_field(&mut h, "Shard", "1/2");
+    let refusal = wait_label(&mut h, "both choose layers");
+    assert!(
+        refusal.contains("the shard: 1/2 and the layer range both choose layers"),
+        "{refusal}"
+    );
+    h.get_by_label("Shard").focus();
+    h.step();
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    h.step();
+    h.key_press(egui::Key::Backspace);
+    h.run_steps(2);
+    set_field(&mut h, "Offset (mm)", "1,0");
     let est = wait_label(&mut h, "Estimate:");
     assert!(
-        est.contains("part 60 × 40 px of a 80 × 60 px screen") && est.contains("2 vat(s)"),
+        est.contains("part 60 × 40 px of a 80 × 60 px screen")
+            && est.contains("2 vat(s)")
+            && est.contains("layers 2 to 4 included (3 of 10)"),
         "{est}"
     );
     export_to_the_end(&mut h, "Export Vat stack");
+    let mut cols = (usize::MAX, 0);
     for v in ["vat1", "vat2"] {
-        let n = std::fs::read_dir(out.join(v)).map_or(0, |d| d.count());
-        assert_eq!(n, 10, "{v}: 5 mm at 0.5 mm layers");
+        let mut names: Vec<String> = std::fs::read_dir(out.join(v))
+            .map(|d| {
+                d.filter_map(Result::ok)
+                    .map(|e| e.file_name().to_string_lossy().into_owned())
+                    .collect()
+            })
+            .unwrap_or_default();
+        names.sort();
+        assert_eq!(
+            names,
+            ["slice_00002.png", "slice_00003.png", "slice_00004.png"],
+            "{v}"
+        );
+        let img = image::open(out.join(v).join("slice_00003.png"))
+            .unwrap_or_else(|e| panic!("{v}: {e}"))
+            .to_luma8();
+        for (x, _, p) in img.enumerate_pixels() {
+            if p[0] > 0 {
+                cols = (cols.0.min(x as usize), cols.1.max(x as usize));
+            }
+        }
     }
+    // The 60 px bar centred on 80 px spans columns 10..70; 1 mm = 4 px right.
+    assert_eq!(cols, (14, 73));
     assert!(Path::new(&out.join("manifest.json")).is_file());
 }

@@ -193,32 +193,7 @@ fn parse_voxel(s: &str) -> anyhow::Result<DVec3> {
 }
 
 pub(super) fn parse_layers(s: &str) -> anyhow::Result<std::ops::Range<usize>> {
-    let (a, b, inclusive) = match s.split_once("..=") {
-        Some((a, b)) => (a, b, true),
-        None => {
-            let (a, b) = s.split_once("..").with_context(|| {
-                format!(
-                    "--layers {s}: expected A..B (B excluded) or A..=B (B included), e.g. 100..200"
-                )
-            })?;
-            (a, b, false)
-        }
-    };
-    let a: usize = a
-        .trim()
-        .parse()
-        .with_context(|| format!("--layers {s}: bad start (a layer index, 0 or more)"))?;
-    let b: usize = b
-        .trim()
-        .parse()
-        .with_context(|| format!("--layers {s}: bad end (a layer index, 0 or more)"))?;
-    let end = if inclusive { b.checked_add(1) } else { Some(b) };
-    match end {
-        Some(end) if a < end => Ok(a..end),
-        _ => bail!(
-            "--layers {s}: the range holds no layer; A..B writes A to B-1, A..=B writes A to B"
-        ),
-    }
+    Ok(volcad_compilers::plan::text::parse_layers("--layers", s)?)
 }
 
 /// `--formats stl,obj,3mf` (any subset, any order).

@@ -3,6 +3,8 @@
 //! vat), from a printer preset or a custom screen.
 
 use anyhow::{Context, bail};
+use volcad_compilers::plan::VatText;
+use volcad_compilers::plan::text::parse_pair;
 use volcad_compilers::vat::{Intensity, VatParams, VatPrinter, vat_preset};
 use volcad_core::Model;
 
@@ -62,19 +64,6 @@ impl VatArgs {
     }
 }
 
-/// Two numbers `A,B` of `flag`.
-fn pair(flag: &str, s: &str, example: &str) -> anyhow::Result<[f64; 2]> {
-    let v: Vec<f64> = s
-        .split(',')
-        .map(|p| p.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .with_context(|| format!("{flag} {s}: not numbers; e.g. {flag} {example}"))?;
-    match v.as_slice() {
-        [a, b] if a.is_finite() && b.is_finite() => Ok([*a, *b]),
-        _ => bail!("{flag} {s}: give two finite numbers A,B, e.g. {flag} {example}"),
-    }
-}
-
 /// The printer: a preset (with `--layer` overriding its layer) or a custom
 /// screen from `--pixel`, `--screen` and `--layer`.
 fn printer(a: &ExportArgs) -> anyhow::Result<VatPrinter> {
@@ -103,7 +92,7 @@ fn printer(a: &ExportArgs) -> anyhow::Result<VatPrinter> {
         );
     };
     let pixel = if px.contains(',') {
-        pair("--pixel", px, "19,24")?
+        parse_pair("--pixel", px, "19,24")?
     } else {
         let u: f64 = px
             .trim()
@@ -171,44 +160,33 @@ pub(super) fn vat_params(a: &ExportArgs, model: &Model) -> anyhow::Result<VatPar
         );
     }
     let v = &a.vat;
-    let intensity = match v.intensity.as_deref() {
-        None => {
-            if v.range.is_some() {
-                bail!("--range maps an attribute's values; give --intensity ATTRIBUTE too");
-            }
-            Intensity::Solid
-        }
+    let mut intensity = match v.intensity.as_deref() {
+        None => Intensity::Solid,
         Some(s) => match s.strip_prefix("fraction:") {
             Some(m) => Intensity::Fraction(m.trim().to_owned()),
             None => Intensity::Attribute {
                 name: s.trim().to_owned(),
-                range: v
-                    .range
-                    .as_deref()
-                    .map(|r| pair("--range", r, "0,1").map(|[a, b]| (a, b)))
-                    .transpose()?,
+                range: None,
             },
         },
     };
+    let chosen = VatText {
+        layers: a.layers.as_deref(),
+        shard: a.shard.as_deref(),
+        offset: v.offset.as_deref(),
+        range: v.range.as_deref(),
+    }
+    .apply(&mut intensity)?;
     Ok(VatParams {
         printer: printer(a)?,
         intensity,
         vats: vat_groups(a, model)?,
-        offset: v
-            .offset
-            .as_deref()
-            .map(|o| pair("--offset", o, "10,-5"))
-            .transpose()?
-            .unwrap_or([0.0, 0.0]),
+        offset: chosen.offset,
         bmp: v.bmp,
         seed: a.seed,
         dither: parse_dither(a.dither.as_deref())?,
-        layers: a
-            .layers
-            .as_deref()
-            .map(super::export::parse_layers)
-            .transpose()?,
-        shard: a.shard.as_deref().map(str::parse).transpose()?,
+        layers: chosen.layers,
+        shard: chosen.shard,
         threads: a.threads,
     })
 }

@@ -30,7 +30,10 @@ pub mod folder;
 mod gcvf;
 mod mesh;
 mod png;
+pub mod text;
 mod vat;
+
+pub use vat::{VatChoices, VatText};
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

@@ -93,8 +93,10 @@ pub fn vat_presets() -> Vec<VatPrinter> {
     vec![
         // Elegoo Saturn 4 Ultra (12K): 10" mono LCD of 11520 × 5120 px,
         // XY resolution 19 × 24 µm, build volume 218.88 × 122.88 × 220 mm
-        // (elegoo.com product specification). Layer: 50 µm, the slicer's
-        // default for standard resin.
+        // (elegoo.com product specification; UVtools' PrusaSlicer profile
+        // "Elegoo Saturn 4 Ultra 12K.ini" agrees: display 11520 × 5120 px
+        // over 218.88 × 122.88 mm, max_print_height 220). Layer: 50 µm,
+        // the slicer's default for standard resin.
         VatPrinter {
             name: "saturn-4-ultra".into(),
             pixel: [0.019, 0.024],
@@ -105,7 +107,12 @@ pub fn vat_presets() -> Vec<VatPrinter> {
         },
         // Anycubic Photon Mono M7 Pro (14K): 10.1" mono LCD of
         // 13312 × 5120 px, XY resolution 16.8 × 24.8 µm, build volume
-        // 223 × 126 × 230 mm (anycubic.com product specification).
+        // 223 × 126 × 230 mm (anycubic.com product specification). Checked
+        // against UVtools' PrusaSlicer profile "Anycubic Photon Mono M7
+        // Pro.ini" (github.com/sn4k3/UVtools): display_pixels 13312 × 5120
+        // over 223.642 × 126.976 mm (16.8 × 24.8 µm exactly) and
+        // max_print_height 230; its default print profile is 0.05 mm
+        // layers.
         VatPrinter {
             name: "photon-mono-m7-pro".into(),
             pixel: [0.0168, 0.0248],

@@ -155,8 +155,11 @@ fn write_layer(
     Ok(LayerOut { files, counts })
 }
 
-/// An 8-bit grayscale image as PNG (with its pixel size) or BMP (the
-/// `image` crate's encoder: 8 bits a pixel with a gray palette).
+/// An 8-bit grayscale image as PNG or BMP (the `image` crate's encoder: 8
+/// bits a pixel with a gray palette), either with its pixel size: PNG's
+/// `pHYs`, BMP's `biXPelsPerMeter` and `biYPelsPerMeter` (bytes 38 and 42
+/// of the file: the 14-byte file header, then those fields at 24 and 28 of
+/// the info header, where `image` writes 0).
 fn encode(
     img: &[u8],
     w: usize,
@@ -175,7 +178,13 @@ fn encode(
     image::codecs::bmp::BmpEncoder::new(&mut out)
         .encode(img, w, h, image::ExtendedColorType::L8)
         .map_err(|e| e.to_string())?;
-    Ok(out.into_inner())
+    let mut bytes = out.into_inner();
+    let PixelsPerMetre([x, y]) = pixel;
+    if let Some(field) = bytes.get_mut(38..46) {
+        field[..4].copy_from_slice(&x.to_le_bytes());
+        field[4..].copy_from_slice(&y.to_le_bytes());
+    }
+    Ok(bytes)
 }
 
 fn summary(

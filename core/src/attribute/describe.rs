@@ -83,6 +83,18 @@ fn source_text(s: &AttrSource) -> String {
             "column \"{column_name}\" of a SimulationField ({} nodes)",
             field.node_count()
         ),
+        AttrSource::Image { map, channel } => {
+            let (w, h) = map.picture().size();
+            format!(
+                "{} of picture \"{}\" ({w} x {h} px) projected along {}",
+                match channel {
+                    Some(c) => format!("{c:?}").to_lowercase(),
+                    None => "RGBA".into(),
+                },
+                map.file(),
+                map.axis().name()
+            )
+        }
         AttrSource::Points { cloud, column } => format!(
             "column \"{}\" of {} points, inverse-distance weighted",
             cloud.names()[*column],

@@ -216,6 +216,7 @@ impl ANode {
                 };
             }
             OwnSrc::Points { cloud, column } => out[0] = cloud.sample(q, *column),
+            OwnSrc::Image { map, channel } => map.value(q, *channel, out),
             OwnSrc::Convert {
                 from,
                 from_own,
@@ -359,6 +360,11 @@ impl ANode {
             // Inverse-distance weights are positive: a convex combination.
             OwnSrc::Points { cloud, column } => {
                 let (lo, hi) = cloud.range(*column);
+                Interval::new(lo, hi)
+            }
+            // Bilinear weights are a convex combination of the pixels.
+            OwnSrc::Image { map, channel } => {
+                let (lo, hi) = map.range(channel.unwrap_or(super::ImageChannel::R));
                 Interval::new(lo, hi)
             }
             OwnSrc::Data { field, column } => match field.variable_range(*column) {

@@ -16,6 +16,7 @@
 mod convert;
 mod describe;
 mod eval;
+mod image_field;
 mod mix;
 mod moves;
 mod names;
@@ -30,6 +31,7 @@ use std::sync::Arc;
 
 pub use convert::{ConvMap, FRACTIONS, Table};
 pub use describe::{column_names, describe_tree, value_text};
+pub use image_field::{CHANNELS, ImageAxis, ImageChannel, ImageMap, MAX_PIXELS, Picture};
 pub use mix::MixTable;
 pub use names::{COMMON, Common, check_kind, range, range_text};
 pub use points::{NEIGHBOURS, PointCloud};
@@ -124,6 +126,14 @@ pub enum AttrSource {
         /// The column's index in [`PointCloud::names`].
         column: usize,
     },
+    /// A picture projected onto a rectangle (`ImageField`): its RGBA, or
+    /// one channel as a scalar.
+    Image {
+        /// The placed picture.
+        map: Arc<ImageMap>,
+        /// The channel of a scalar attribute; `None`: RGBA (a Vec4).
+        channel: Option<ImageChannel>,
+    },
     /// Another scalar attribute mapped by a table or a math string
     /// (`Convert`): the node's own value of `from`, else the one below it.
     Convert {
@@ -199,5 +209,7 @@ impl NodeAttributes {
 mod tests;
 #[cfg(test)]
 mod tests_fractions;
+#[cfg(test)]
+mod tests_image;
 #[cfg(test)]
 mod tests_points;

@@ -12,7 +12,7 @@ fn direct_used(o: &Own) -> u64 {
             PComp::Const(_) => m,
             PComp::Expr(e) => m | e.used_vars(),
         }),
-        OwnSrc::Data { .. } | OwnSrc::Points { .. } => 0,
+        OwnSrc::Data { .. } | OwnSrc::Points { .. } | OwnSrc::Image { .. } => 0,
         // The math string's slot 9 is its input, not an own attribute.
         OwnSrc::Convert { from_own, map, .. } => {
             let coords = match map {

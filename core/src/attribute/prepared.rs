@@ -53,6 +53,10 @@ pub(super) enum OwnSrc {
         cloud: Arc<super::PointCloud>,
         column: usize,
     },
+    Image {
+        map: Arc<super::ImageMap>,
+        channel: Option<super::ImageChannel>,
+    },
     Convert {
         /// Design index of the input attribute.
         from: usize,
@@ -465,6 +469,10 @@ impl Builder<'_> {
                 AttrSource::Points { cloud, column } => OwnSrc::Points {
                     cloud: cloud.clone(),
                     column: *column,
+                },
+                AttrSource::Image { map, channel } => OwnSrc::Image {
+                    map: map.clone(),
+                    channel: *channel,
                 },
                 AttrSource::Convert { from, map } => self.convert(n, a, d, from, map)?,
             };

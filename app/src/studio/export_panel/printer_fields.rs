@@ -1,11 +1,13 @@
 //! The printer exports' fields: the GrabCAD package (J750 grid, resin
-//! map, seed, keep-out) and the vat stack (printer, intensity, vats).
+//! map, seed, keep-out) and the vat stack (printer, intensity and its
+//! range, vats, offset, layers or shard).
 //! Text fields are parsed as the command line parses its options, so a
 //! field that does not parse names itself and what to write.
 
 use std::sync::Arc;
 
 use volcad_compilers::gcvf::GcvfParams;
+use volcad_compilers::plan::VatText;
 use volcad_compilers::png_stack::{self, Dither};
 use volcad_compilers::printer_table::parse_map;
 use volcad_compilers::vat::{Intensity, VatParams, VatPrinter, vat_presets};
@@ -35,6 +37,12 @@ pub(super) struct PrinterFields {
     /// `a,b` or `a+c,b`: the materials of each vat (empty: one vat).
     vats: String,
     bmp: bool,
+    /// The vat options the command line takes as text, as it writes them
+    /// (`LO,HI`, `X,Y`, `A..B`, `K/N`; blank: not given).
+    range: String,
+    offset: String,
+    layers: String,
+    shard: String,
 }
 
 impl Default for PrinterFields {
@@ -52,6 +60,10 @@ impl Default for PrinterFields {
             intensity: Intensity::Solid,
             vats: String::new(),
             bmp: false,
+            range: String::new(),
+            offset: String::new(),
+            layers: String::new(),
+            shard: String::new(),
         }
     }
 }
@@ -97,16 +109,25 @@ impl PrinterFields {
         } else {
             vats
         };
+        let mut intensity = self.intensity.clone();
+        let chosen = VatText {
+            layers: Some(&self.layers),
+            shard: Some(&self.shard),
+            offset: Some(&self.offset),
+            range: Some(&self.range),
+        }
+        .apply(&mut intensity)
+        .map_err(|e| in_panel_words(&e.to_string()))?;
         Ok(VatParams {
             printer,
-            intensity: self.intensity.clone(),
+            intensity,
             vats,
-            offset: [0.0, 0.0],
+            offset: chosen.offset,
             bmp: self.bmp,
             seed: self.seed,
             dither: self.dither,
-            layers: None,
-            shard: None,
+            layers: chosen.layers,
+            shard: chosen.shard,
             threads: None,
         })
     }
@@ -211,7 +232,43 @@ impl PrinterFields {
             ui.label("");
             ui.checkbox(&mut self.bmp, "8-bit BMP instead of PNG");
             ui.end_row();
+            self.vat_text_rows(ui);
         });
+    }
+
+    /// Offset, layers and shard: text as the command line takes it.
+    fn vat_text_rows(&mut self, ui: &mut egui::Ui) {
+        let rows = [
+            (
+                "Offset (mm)",
+                "centred; or X,Y",
+                &mut self.offset,
+                "The part's centre moved from the screen's, X,Y mm",
+            ),
+            (
+                "Layers",
+                "all; or A..B, A..=B",
+                &mut self.layers,
+                "Only these layers (file names keep the global layer indices)",
+            ),
+            (
+                "Shard",
+                "all; or K/N",
+                &mut self.shard,
+                "Only the K-th of N equal layer ranges, for volcad merge",
+            ),
+        ];
+        for (name, hint, text, tip) in rows {
+            let label = ui.label(name).id;
+            ui.add(
+                egui::TextEdit::singleline(text)
+                    .hint_text(hint)
+                    .desired_width(220.0),
+            )
+            .labelled_by(label)
+            .on_hover_text(tip);
+            ui.end_row();
+        }
     }
 
     /// A custom screen's pitch, size and layer.
@@ -279,5 +336,18 @@ impl PrinterFields {
             .response
             .labelled_by(label);
         ui.end_row();
+        if matches!(self.intensity, Intensity::Attribute { .. }) {
+            let label = ui.label("Range").id;
+            ui.add(
+                egui::TextEdit::singleline(&mut self.range)
+                    .hint_text("the attribute's bound; or LO,HI")
+                    .desired_width(220.0),
+            )
+            .labelled_by(label)
+            .on_hover_text("The attribute values shown as black and white");
+            ui.end_row();
+        } else {
+            self.range.clear();
+        }
     }
 }

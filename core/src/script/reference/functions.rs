@@ -454,7 +454,8 @@ pub static FUNCTIONS: &[FnDoc] = &[
         [
             "node.set_attribute(name: string, value: float | string | Vec3 | Vec4 | array)",
             "node.set_attribute(name: string, field: SimulationField, column: string)",
-            "node.set_attribute(name: string, points: PointsField)"
+            "node.set_attribute(name: string, points: PointsField)",
+            "node.set_attribute(name: string, image: ImageField)"
         ],
         "Sets a property field (modulus MPa, poissons_ratio, density g/cm^3, shore_hardness, infill_density %, temperature, color Vec4, or any name): a number, a math string of x y z rho phic r theta phis d and the node's other attributes, a vector, or an FEA column; a parent's overrides its children's.",
         "n.set_attribute(\"modulus\", 2850.0)",
@@ -486,6 +487,17 @@ pub static FUNCTIONS: &[FnDoc] = &[
         ["PointsField(csv: string, column: string) -> PointsField"],
         "A value column of scattered points (CSV columns x, y, z and named values) for set_attribute: inverse-distance weighting of the 8 nearest points.",
         "PointsField(\"points.csv\", \"temperature\")",
+        ""
+    ),
+    f!(
+        "ImageField",
+        Data,
+        [
+            "ImageField(file: string, axis: \"x\" | \"y\" | \"z\", rect: [float; 4]) -> ImageField",
+            "ImageField(file: string, axis: string, rect: [float; 4], channel: \"r\" | \"g\" | \"b\" | \"a\" | \"luminance\") -> ImageField"
+        ],
+        "A PNG or JPEG picture (at most 4096 x 4096 px) projected along an axis onto the rectangle [u0, v0, u1, v1] of the plane across it in the node's frame (z: x across, y up; x: y, z; y: x, z), for set_attribute: its sRGB colour 0-1 as a Vec4 (\"color\"), or one channel as a number; bilinear between pixel centres, the edge pixels beyond.",
+        "ImageField(\"photo.png\", \"z\", [-20, -20, 20, 20])",
         ""
     ),
     f!(
