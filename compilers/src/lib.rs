@@ -27,6 +27,7 @@ pub mod mesh;
 pub mod par_deflate;
 pub mod plan;
 pub mod png_io;
+mod png_params;
 pub mod png_stack;
 mod png_summary;
 mod presets;
