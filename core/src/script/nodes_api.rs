@@ -404,16 +404,7 @@ fn register_grade_blend(engine: &mut Engine) {
             p,
         ))
     };
-    engine.register_fn(
-        "FGrade",
-        move |c: Ctx, e: Dynamic, m: Dynamic, b: Dynamic| fgrade(&c, &e, &m, &b, None),
-    );
-    engine.register_fn(
-        "FGrade",
-        move |c: Ctx, e: Dynamic, m: Dynamic, b: Dynamic, ch: Dynamic| {
-            fgrade(&c, &e, &m, &b, Some(&ch))
-        },
-    );
+    register_optional_last!(engine, "FGrade", fgrade(e, m, b; ch));
 
     // Blend(radius[, child])
     let blend = |c: &Ctx, r: &Dynamic, ch: Option<&Dynamic>| -> RResult<Node> {
