@@ -57,6 +57,35 @@ pub(crate) const MIN_TOTAL: f32 = 1e-6;
 /// fractions and of sums of at most 64 of them (`64 · 2⁻²⁴ ≈ 4·10⁻⁶`), far
 /// below the fraction steps that matter.
 pub(crate) const BOUND_MARGIN: f64 = 1e-5;
+
+/// The Floyd–Steinberg neighbours of `x` on a serpentine row: the columns
+/// ahead of and behind it in the row's direction (`forward`: rising x), and
+/// which of the four error receivers (ahead in `row`; behind, below and
+/// ahead in `below`) exist and are inside. A column off either end
+/// (`usize::MAX` or `nx`) is not inside.
+#[inline]
+pub(crate) fn serpentine_neighbours(
+    row: &[bool],
+    below: Option<&[bool]>,
+    x: usize,
+    forward: bool,
+) -> (usize, usize, [bool; 4]) {
+    let (ahead, behind) = if forward {
+        (x + 1, x.wrapping_sub(1))
+    } else {
+        (x.wrapping_sub(1), x + 1)
+    };
+    let at =
+        |cells: Option<&[bool]>, i: usize| cells.and_then(|c| c.get(i)).copied().unwrap_or(false);
+    let has = [
+        at(Some(row), ahead),
+        at(below, behind),
+        at(below, x),
+        at(below, ahead),
+    ];
+    (ahead, behind, has)
+}
+
 /// SplitMix64's increment (2⁶⁴ / φ).
 const GAMMA: u64 = 0x9E37_79B9_7F4A_7C15;
 
@@ -283,20 +312,7 @@ fn diffuse_strip<const K: usize>(
             }
             // Neighbours that exist and are inside share the error in
             // proportion to their weights, so no error is lost inside the part.
-            let (ahead, behind) = if forward {
-                (x + 1, x.wrapping_sub(1))
-            } else {
-                (x.wrapping_sub(1), x + 1)
-            };
-            let ok = |cells: Option<&[bool]>, x: usize| {
-                cells.and_then(|c| c.get(x)).copied().unwrap_or(false)
-            };
-            let has = [
-                ok(Some(row), ahead),
-                ok(next_row, behind),
-                ok(next_row, x),
-                ok(next_row, ahead),
-            ];
+            let (ahead, behind, has) = serpentine_neighbours(row, next_row, x, forward);
             let w = if has == [true; 4] && carry_on {
                 [W_AHEAD, W_NEXT_BEHIND, W_NEXT_BELOW, W_NEXT_AHEAD, W_Z]
             } else {

@@ -110,14 +110,7 @@ pub fn encode_gray(
     data: &[u8],
     pixel: Option<PixelsPerMetre>,
 ) -> Result<Vec<u8>, png::EncodingError> {
-    encode(
-        width,
-        height,
-        ColorType::Grayscale,
-        BitDepth::Eight,
-        data,
-        pixel,
-    )
+    encode_gray_depth(width, height, BitDepth::Eight, data, pixel)
 }
 
 /// A 16-bit grayscale image: one big-endian `u16` a pixel (as PNG stores
@@ -138,14 +131,7 @@ pub fn encode_gray16_be(
     height: usize,
     bytes: &[u8],
 ) -> Result<Vec<u8>, png::EncodingError> {
-    encode(
-        width,
-        height,
-        ColorType::Grayscale,
-        BitDepth::Sixteen,
-        bytes,
-        None,
-    )
+    encode_gray_depth(width, height, BitDepth::Sixteen, bytes, None)
 }
 
 /// Bytes per row of a 1-bit image.
@@ -161,14 +147,19 @@ pub fn encode_bits(
     data: &[u8],
     pixel: Option<PixelsPerMetre>,
 ) -> Result<Vec<u8>, png::EncodingError> {
-    encode(
-        width,
-        height,
-        ColorType::Grayscale,
-        BitDepth::One,
-        data,
-        pixel,
-    )
+    encode_gray_depth(width, height, BitDepth::One, data, pixel)
+}
+
+/// A grayscale image of `depth` bits a pixel, `data` packed as PNG packs
+/// that depth.
+fn encode_gray_depth(
+    width: usize,
+    height: usize,
+    depth: BitDepth,
+    data: &[u8],
+    pixel: Option<PixelsPerMetre>,
+) -> Result<Vec<u8>, png::EncodingError> {
+    encode(width, height, ColorType::Grayscale, depth, data, pixel)
 }
 
 #[cfg(test)]

@@ -254,6 +254,24 @@ pub enum NodeKind {
     },
 }
 
+/// The pattern of every unary node (one optional child slot), binding the
+/// slot to `$child`: one list for [`NodeKind::children`] and
+/// [`NodeKind::child_slot`], so a new unary node is added in one place.
+macro_rules! unary_kinds {
+    ($child:ident) => {
+        NodeKind::Translate { $child, .. }
+            | NodeKind::Rotate { $child, .. }
+            | NodeKind::Scale { $child, .. }
+            | NodeKind::Offset { $child, .. }
+            | NodeKind::Shell { $child, .. }
+            | NodeKind::Tile { $child, .. }
+            | NodeKind::FGrade { $child, .. }
+            | NodeKind::Blend { $child, .. }
+            | NodeKind::Mirror { $child, .. }
+            | NodeKind::Identity { $child }
+    };
+}
+
 impl NodeKind {
     /// pyvcad's class name of this node (for messages and `volcad info`).
     pub fn type_name(&self) -> &'static str {
@@ -318,16 +336,7 @@ impl NodeKind {
     /// The children, in order (missing optional children are skipped).
     pub fn children(&self) -> Vec<&Node> {
         match self {
-            NodeKind::Translate { child, .. }
-            | NodeKind::Rotate { child, .. }
-            | NodeKind::Scale { child, .. }
-            | NodeKind::Offset { child, .. }
-            | NodeKind::Shell { child, .. }
-            | NodeKind::Tile { child, .. }
-            | NodeKind::FGrade { child, .. }
-            | NodeKind::Blend { child, .. }
-            | NodeKind::Mirror { child, .. }
-            | NodeKind::Identity { child } => child.iter().collect(),
+            unary_kinds!(child) => child.iter().collect(),
             NodeKind::Union { children, .. }
             | NodeKind::Intersection { children, .. }
             | NodeKind::Sum { children, .. } => children.iter().collect(),
@@ -339,16 +348,7 @@ impl NodeKind {
     /// Mutable access to the single child slot of a unary node.
     pub(crate) fn child_slot(&mut self) -> Option<&mut Option<Node>> {
         match self {
-            NodeKind::Translate { child, .. }
-            | NodeKind::Rotate { child, .. }
-            | NodeKind::Scale { child, .. }
-            | NodeKind::Offset { child, .. }
-            | NodeKind::Shell { child, .. }
-            | NodeKind::Tile { child, .. }
-            | NodeKind::FGrade { child, .. }
-            | NodeKind::Blend { child, .. }
-            | NodeKind::Mirror { child, .. }
-            | NodeKind::Identity { child } => Some(child),
+            unary_kinds!(child) => Some(child),
             _ => None,
         }
     }

@@ -1,7 +1,8 @@
-//! Agreement with pyvcad 2.3.4's own numbers (`tests/data/*.json`, copied
-//! from the reference harness; see `tests/data/README.md`).
+//! Agreement with pyvcad 2.3.4's own numbers (`tests/data/*.json`: points
+//! from a fixed seed over each design's box and inside it, with pyvcad's
+//! distance and fractions at each; each file names its generator).
 //!
-//! Rules (from the reference README):
+//! Rules:
 //! * inside/outside agrees at every point farther than 1e-6 mm from the surface;
 //! * fractions agree within 1e-5 wherever the point is inside;
 //! * distances agree within 1e-4 mm wherever pyvcad's distance is exact.

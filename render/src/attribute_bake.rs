@@ -70,35 +70,18 @@ pub fn shade(
         eval_row(grid, inside, eval, width, row, b)
     };
     if width == 4 {
-        let failed = color
-            .par_chunks_mut(nx)
-            .enumerate()
-            .map_init(RowBuf::default, |b, (r, c)| {
-                row(r, b)?;
-                for (n, &i) in b.at.iter().enumerate() {
-                    c[i] = rgba(&b.out[n * 4..n * 4 + 4]);
-                }
-                Ok(())
-            })
-            .filter_map(Result::err)
-            .min_by_key(|(r, _)| *r);
+        let failed = by_rows(color, nx, &row, |c, i, x| c[i] = rgba(x), 4);
         return finish(failed, cancel).map(|_| None);
     }
     // Scalars (or magnitudes) first, then the range, then the colours.
     let mut value = vec![f32::NAN; color.len()];
-    let failed = value
-        .par_chunks_mut(nx)
-        .enumerate()
-        .map_init(RowBuf::default, |b, (r, v)| {
-            row(r, b)?;
-            for (n, &i) in b.at.iter().enumerate() {
-                let x = &b.out[n * width..(n + 1) * width];
-                v[i] = scalar_of(x) as f32;
-            }
-            Ok(())
-        })
-        .filter_map(Result::err)
-        .min_by_key(|(r, _)| *r);
+    let failed = by_rows(
+        &mut value,
+        nx,
+        &row,
+        |v, i, x| v[i] = scalar_of(x) as f32,
+        width,
+    );
     finish(failed, cancel)?;
     let range = shading.range.or_else(|| auto_range(&value));
     let Some([lo, hi]) = range else {
@@ -121,6 +104,29 @@ pub fn shade(
             }
         });
     Ok(range)
+}
+
+/// Evaluates the rows of `out` (`nx` voxels each) in parallel with `row`,
+/// then hands each evaluated voxel's `width` numbers to `put(row of out,
+/// its index in the row, numbers)`: the first failing row and its error.
+fn by_rows<T: Send>(
+    out: &mut [T],
+    nx: usize,
+    row: &(impl Fn(usize, &mut RowBuf) -> Result<(), (usize, String)> + Sync),
+    put: impl Fn(&mut [T], usize, &[f64]) + Sync,
+    width: usize,
+) -> Option<(usize, String)> {
+    out.par_chunks_mut(nx)
+        .enumerate()
+        .map_init(RowBuf::default, |b, (r, o)| {
+            row(r, b)?;
+            for (n, &i) in b.at.iter().enumerate() {
+                put(o, i, &b.out[n * width..(n + 1) * width]);
+            }
+            Ok(())
+        })
+        .filter_map(Result::err)
+        .min_by_key(|(r, _)| *r)
 }
 
 /// Cancelled, or the first row's error, or fine.

@@ -61,20 +61,7 @@ pub fn diffuse_layer(nx: usize, wanted: &[Ink], inside: &[bool], resins: &[Ink],
             // `resins` has at most 255 entries (checked where it is built).
             out[v] = (pick + 1) as u8;
             let err: Ink = [0, 1, 2, 3].map(|c| t[c] - resins[pick][c]);
-            let (ahead, behind) = if forward {
-                (x + 1, x.wrapping_sub(1))
-            } else {
-                (x.wrapping_sub(1), x + 1)
-            };
-            let at = |cells: Option<&[bool]>, i: usize| {
-                cells.and_then(|c| c.get(i)).copied().unwrap_or(false)
-            };
-            let has = [
-                at(Some(row), ahead),
-                at(below, behind),
-                at(below, x),
-                at(below, ahead),
-            ];
+            let (ahead, behind, has) = crate::dither::serpentine_neighbours(row, below, x, forward);
             let total: f32 = FS.iter().zip(has).filter(|(_, h)| *h).map(|(w, _)| w).sum();
             if total == 0.0 {
                 continue;

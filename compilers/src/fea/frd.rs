@@ -1,6 +1,6 @@
 //! Reading CalculiX results (`.frd`) back, and the result CSV.
 //!
-//! The ASCII `.frd` layout (CalculiX 2.20; `shared/data/seat/frd_to_csv.py`):
+//! The ASCII `.frd` layout (CalculiX 2.20, its manual's "Result Format" chapter):
 //!
 //! ```text
 //!     2C ... <fmt>            node block; fmt 0/1 = ASCII (I5 / I10 ids), 2 = binary

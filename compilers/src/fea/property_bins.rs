@@ -171,19 +171,30 @@ fn per_element(
             let at = scalar_at(model, index, &corners)?;
             let set: Vec<f64> = at.into_iter().filter(|a| !a.is_nan()).collect();
             if set.is_empty() {
-                let c = centroids[e];
-                return Err(ExportError::Other(format!(
-                    "element {} at ({:.4}, {:.4}, {:.4}) mm: no node sets \"{name}\" there; set it on every part that has elements (or on the root, which its children inherit)",
-                    e + 1,
-                    c.x,
-                    c.y,
-                    c.z
-                )));
+                return Err(element_error(
+                    e,
+                    centroids[e],
+                    &format!(
+                        "no node sets \"{name}\" there; set it on every part that has elements (or on the root, which its children inherit)"
+                    ),
+                ));
             }
             *x = set.iter().sum::<f64>() / set.len() as f64;
         }
     }
     Ok(v)
+}
+
+/// An error about element `e` (0-based; named 1-based, as the deck numbers
+/// it) at its centroid `c`.
+fn element_error(e: usize, c: DVec3, what: &str) -> ExportError {
+    ExportError::Other(format!(
+        "element {} at ({:.4}, {:.4}, {:.4}) mm: {what}",
+        e + 1,
+        c.x,
+        c.y,
+        c.z
+    ))
 }
 
 /// The properties of every element of `mesh` from the design's `modulus`,
@@ -202,14 +213,11 @@ pub fn element_props(model: &Model, mesh: &FeaMesh) -> Result<Option<ElementProp
         .collect();
     let modulus = per_element(model, "modulus", mesh, &centroids)?;
     if let Some((e, m)) = modulus.iter().enumerate().find(|(_, m)| **m <= 0.0) {
-        let c = centroids[e];
-        return Err(ExportError::Other(format!(
-            "element {} at ({:.4}, {:.4}, {:.4}) mm: modulus {m} MPa; the FEA export needs a modulus > 0",
-            e + 1,
-            c.x,
-            c.y,
-            c.z
-        )));
+        return Err(element_error(
+            e,
+            centroids[e],
+            &format!("modulus {m} MPa; the FEA export needs a modulus > 0"),
+        ));
     }
     let poisson = if model.attribute_index("poissons_ratio").is_some() {
         per_element(model, "poissons_ratio", mesh, &centroids)?

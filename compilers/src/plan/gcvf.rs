@@ -28,11 +28,6 @@ pub(super) fn estimate(model: &Model, p: &GcvfParams) -> Result<Assessment, Expo
     })
 }
 
-/// A voxel's largest side decides what it resolves.
-pub(super) fn cell(p: &GcvfParams) -> (f64, Opt) {
-    (p.voxel.max_element(), Opt::Voxel)
-}
-
 /// The verdict on writing the package to `dest`: none when nothing is
 /// there, a question before replacing a regular file, a refusal for a
 /// folder or anything else that is not a regular file.

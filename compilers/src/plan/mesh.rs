@@ -3,7 +3,7 @@
 
 use volcad_core::Model;
 
-use super::{Assessment, Opt};
+use super::Assessment;
 use crate::job::{ExportError, JobContext, Summary};
 use crate::mesh::{self, MeshParams};
 use crate::resources::human_bytes;
@@ -23,11 +23,6 @@ pub(super) fn estimate(model: &Model, p: &MeshParams) -> Result<Assessment, Expo
         disk_bytes: Some(est.disk_bytes),
         verdicts: Vec::new(),
     })
-}
-
-/// A voxel's largest side decides what it resolves.
-pub(super) fn cell(p: &MeshParams) -> (f64, Opt) {
-    (p.voxel.max_element(), Opt::Voxel)
 }
 
 pub(super) fn run(model: &Model, p: &MeshParams, ctx: &JobContext) -> Result<Summary, ExportError> {

@@ -291,11 +291,12 @@ impl ExportParams {
     /// The checks that need no estimate: features thinner than the cells
     /// resolve.
     pub fn design_verdicts(&self, model: &Model) -> Vec<Verdict> {
+        // A voxel's largest side decides what it resolves.
         let (size, option) = match self {
-            ExportParams::Png(p) => png::cell(p),
-            ExportParams::Mesh(p) => mesh::cell(p),
+            ExportParams::Png(p) => (p.voxel.max_element(), Opt::Voxel),
+            ExportParams::Mesh(p) => (p.voxel.max_element(), Opt::Voxel),
             ExportParams::Fea(p) => fea::cell(p),
-            ExportParams::Gcvf(p) => gcvf::cell(p),
+            ExportParams::Gcvf(p) => (p.voxel.max_element(), Opt::Voxel),
             ExportParams::Vat(p) => vat::cell(p),
         };
         thin_feature_notes(model, size, option.flag())

@@ -3,7 +3,7 @@
 
 use volcad_core::Model;
 
-use super::{Assessment, Opt};
+use super::Assessment;
 use crate::job::{ExportError, JobContext, Summary};
 use crate::png_stack::{self, PngParams};
 use crate::resources::human_bytes;
@@ -25,11 +25,6 @@ pub(super) fn estimate(model: &Model, p: &PngParams) -> Result<Assessment, Expor
         disk_bytes: Some(est.disk_bytes),
         verdicts: Vec::new(),
     })
-}
-
-/// A voxel's largest side decides what it resolves.
-pub(super) fn cell(p: &PngParams) -> (f64, Opt) {
-    (p.voxel.max_element(), Opt::Voxel)
 }
 
 pub(super) fn run(model: &Model, p: &PngParams, ctx: &JobContext) -> Result<Summary, ExportError> {

@@ -9,6 +9,9 @@ use crate::aabb::Aabb;
 use crate::interval::Interval;
 use crate::model::{Model, Points, sdf};
 
+/// What an attribute query that writes into a caller's buffer returns.
+type AttributeResult = Result<(), AttributeError>;
+
 /// Most numbers of one value (a Vec4).
 const MAX_WIDTH: usize = 4;
 
@@ -142,13 +145,7 @@ impl ANode {
     }
 
     /// One of this node's own attributes at `q`.
-    fn own_value(
-        &self,
-        pos: usize,
-        q: DVec3,
-        pw: DVec3,
-        out: &mut [f64],
-    ) -> Result<(), AttributeError> {
+    fn own_value(&self, pos: usize, q: DVec3, pw: DVec3, out: &mut [f64]) -> AttributeResult {
         let own = &self.own[pos];
         let mut slots = [0.0f64; 64];
         if own.used != 0 {
@@ -196,7 +193,7 @@ impl ANode {
         pw: DVec3,
         slots: &[f64],
         out: &mut [f64],
-    ) -> Result<(), AttributeError> {
+    ) -> AttributeResult {
         match &self.own[pos].src {
             OwnSrc::Comps(cs) => {
                 for (o, c) in out.iter_mut().zip(cs) {
@@ -443,12 +440,7 @@ impl Model {
         })
     }
 
-    fn attribute_checked(
-        &self,
-        index: usize,
-        out_len: usize,
-        points: usize,
-    ) -> Result<(), AttributeError> {
+    fn attribute_checked(&self, index: usize, out_len: usize, points: usize) -> AttributeResult {
         let Some(info) = self.attributes().get(index) else {
             return Err(AttributeError {
                 node: "design".into(),
@@ -473,12 +465,7 @@ impl Model {
 
     /// Attribute `index` at `p` into `out` (its width): NaN outside the
     /// part or where no node defines it.
-    pub fn attribute_at(
-        &self,
-        index: usize,
-        p: DVec3,
-        out: &mut [f64],
-    ) -> Result<(), AttributeError> {
+    pub fn attribute_at(&self, index: usize, p: DVec3, out: &mut [f64]) -> AttributeResult {
         self.attribute_checked(index, out.len(), 1)?;
         self.attribute_unchecked(index, p, out, false)
     }
@@ -486,12 +473,7 @@ impl Model {
     /// [`Model::attribute_at`] at a point the caller knows is inside the
     /// part (its distance from [`Model::eval_into`] is ≤ 0): skips the
     /// inside test, a second distance evaluation.
-    pub fn attribute_inside(
-        &self,
-        index: usize,
-        p: DVec3,
-        out: &mut [f64],
-    ) -> Result<(), AttributeError> {
+    pub fn attribute_inside(&self, index: usize, p: DVec3, out: &mut [f64]) -> AttributeResult {
         self.attribute_checked(index, out.len(), 1)?;
         self.attribute_unchecked(index, p, out, true)
     }
@@ -503,7 +485,7 @@ impl Model {
         p: DVec3,
         out: &mut [f64],
         inside: bool,
-    ) -> Result<(), AttributeError> {
+    ) -> AttributeResult {
         let Some(a) = &self.attrs else {
             return Ok(());
         };
@@ -526,7 +508,7 @@ impl Model {
         index: usize,
         pts: Points<'_>,
         out: &mut [f64],
-    ) -> Result<(), AttributeError> {
+    ) -> AttributeResult {
         self.attribute_checked(index, out.len(), pts.len())?;
         let w = self.attributes()[index].kind.width();
         for (i, o) in out.chunks_exact_mut(w).enumerate() {

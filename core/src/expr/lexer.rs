@@ -6,6 +6,7 @@
 //! `and`, `|`/`||` for `or`, `=` for `==`, `<>` for `!=`.
 
 use super::ExprError;
+use super::ops::Op;
 
 /// What a token is.
 #[derive(Clone, Debug, PartialEq)]
@@ -36,30 +37,10 @@ pub(crate) enum Tok {
     Question,
     /// `:`
     Colon,
-    /// `==` or `=`
-    Eq,
-    /// `!=` or `<>`
-    Ne,
-    /// `<`
-    Lt,
-    /// `<=`
-    Le,
-    /// `>`
-    Gt,
-    /// `>=`
-    Ge,
-    /// `and`, `&`, `&&`
-    And,
-    /// `or`, `|`, `||`
-    Or,
-    /// `nand`
-    Nand,
-    /// `nor`
-    Nor,
-    /// `xor`
-    Xor,
-    /// `xnor`
-    Xnor,
+    /// A comparison or logical binary operator, as the operation it
+    /// applies: `==` or `=`, `!=` or `<>`, `<`, `<=`, `>`, `>=`; `and`,
+    /// `&`, `&&`; `or`, `|`, `||`; `nand`, `nor`, `xor`, `xnor`.
+    Binary(Op),
     /// `not`
     Not,
 }
@@ -116,30 +97,30 @@ pub(crate) fn lex(src: &str) -> Result<(Vec<Token>, usize), ExprError> {
             }
             let word: String = chars[start..i].iter().collect::<String>().to_lowercase();
             match word.as_str() {
-                "and" => Tok::And,
-                "or" => Tok::Or,
-                "nand" => Tok::Nand,
-                "nor" => Tok::Nor,
-                "xor" => Tok::Xor,
-                "xnor" => Tok::Xnor,
+                "and" => Tok::Binary(Op::And),
+                "or" => Tok::Binary(Op::Or),
+                "nand" => Tok::Binary(Op::Nand),
+                "nor" => Tok::Binary(Op::Nor),
+                "xor" => Tok::Binary(Op::Xor),
+                "xnor" => Tok::Binary(Op::Xnor),
                 "not" => Tok::Not,
                 _ => Tok::Ident(word),
             }
         } else {
             let next = chars.get(i + 1).copied();
             let (tok, len) = match (c, next) {
-                ('=', Some('=')) => (Tok::Eq, 2),
-                ('!', Some('=')) => (Tok::Ne, 2),
-                ('<', Some('>')) => (Tok::Ne, 2),
-                ('<', Some('=')) => (Tok::Le, 2),
-                ('>', Some('=')) => (Tok::Ge, 2),
-                ('&', Some('&')) => (Tok::And, 2),
-                ('|', Some('|')) => (Tok::Or, 2),
-                ('=', _) => (Tok::Eq, 1),
-                ('<', _) => (Tok::Lt, 1),
-                ('>', _) => (Tok::Gt, 1),
-                ('&', _) => (Tok::And, 1),
-                ('|', _) => (Tok::Or, 1),
+                ('=', Some('=')) => (Tok::Binary(Op::Eq), 2),
+                ('!', Some('=')) => (Tok::Binary(Op::Ne), 2),
+                ('<', Some('>')) => (Tok::Binary(Op::Ne), 2),
+                ('<', Some('=')) => (Tok::Binary(Op::Le), 2),
+                ('>', Some('=')) => (Tok::Binary(Op::Ge), 2),
+                ('&', Some('&')) => (Tok::Binary(Op::And), 2),
+                ('|', Some('|')) => (Tok::Binary(Op::Or), 2),
+                ('=', _) => (Tok::Binary(Op::Eq), 1),
+                ('<', _) => (Tok::Binary(Op::Lt), 1),
+                ('>', _) => (Tok::Binary(Op::Gt), 1),
+                ('&', _) => (Tok::Binary(Op::And), 1),
+                ('|', _) => (Tok::Binary(Op::Or), 1),
                 ('+', _) => (Tok::Plus, 1),
                 ('-', _) => (Tok::Minus, 1),
                 ('*', _) => (Tok::Star, 1),
@@ -235,17 +216,17 @@ mod tests {
             toks("a<=b<>c AND d && e | f = g"),
             [
                 Tok::Ident("a".into()),
-                Tok::Le,
+                Tok::Binary(Op::Le),
                 Tok::Ident("b".into()),
-                Tok::Ne,
+                Tok::Binary(Op::Ne),
                 Tok::Ident("c".into()),
-                Tok::And,
+                Tok::Binary(Op::And),
                 Tok::Ident("d".into()),
-                Tok::And,
+                Tok::Binary(Op::And),
                 Tok::Ident("e".into()),
-                Tok::Or,
+                Tok::Binary(Op::Or),
                 Tok::Ident("f".into()),
-                Tok::Eq,
+                Tok::Binary(Op::Eq),
                 Tok::Ident("g".into()),
             ]
         );

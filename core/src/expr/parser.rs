@@ -64,18 +64,7 @@ const MUL_LEVEL: u8 = 6;
 /// The operation and binding level (higher binds tighter) of a binary operator.
 fn binary_op(tok: &Tok) -> Option<(Op, u8)> {
     Some(match tok {
-        Tok::Or => (Op::Or, 1),
-        Tok::Nor => (Op::Nor, 1),
-        Tok::Xor => (Op::Xor, 1),
-        Tok::Xnor => (Op::Xnor, 1),
-        Tok::And => (Op::And, 2),
-        Tok::Nand => (Op::Nand, 2),
-        Tok::Eq => (Op::Eq, 4),
-        Tok::Ne => (Op::Ne, 4),
-        Tok::Lt => (Op::Lt, 4),
-        Tok::Le => (Op::Le, 4),
-        Tok::Gt => (Op::Gt, 4),
-        Tok::Ge => (Op::Ge, 4),
+        Tok::Binary(op) => (*op, binary_level(*op)),
         Tok::Plus => (Op::Add, 5),
         Tok::Minus => (Op::Sub, 5),
         Tok::Star => (Op::Mul, MUL_LEVEL),
@@ -83,6 +72,16 @@ fn binary_op(tok: &Tok) -> Option<(Op, u8)> {
         Tok::Percent => (Op::Mod, MUL_LEVEL),
         _ => return None,
     })
+}
+
+/// The binding level of a comparison or logical operator: `or`-like 1,
+/// `and`-like 2, comparisons 4 (tighter than `not`, looser than `+`).
+fn binary_level(op: Op) -> u8 {
+    match op {
+        Op::Or | Op::Nor | Op::Xor | Op::Xnor => 1,
+        Op::And | Op::Nand => 2,
+        _ => 4,
+    }
 }
 
 struct Parser<'a> {

@@ -346,16 +346,25 @@ impl Tape {
     }
 }
 
-/// The scalar hot loop: runs `code` over a register file of `N` entries
-/// and hands it back. `N` is a power of two, so `% N` is a mask that keeps
-/// every index in range without a bounds check.
+/// The tape loop: runs `code` over a register file of `N` entries of `T`
+/// (set to `empty` first), each op through `apply`, and hands it back.
+/// `N` is a power of two, so `% N` is a mask that keeps every index in
+/// range without a bounds check. The scalar and interval evaluations are
+/// this loop with `Op::apply` and `Op::apply_interval`; both are
+/// monomorphised and inlined, so the scalar hot loop stays a direct match.
 #[inline(always)]
-fn registers<const N: usize>(code: &[Instr], slots: &[f64]) -> [f64; N] {
-    let mut r = [0.0f64; N];
+fn registers<T: Copy, const N: usize>(
+    code: &[Instr],
+    slots: &[T],
+    empty: T,
+    apply: impl Fn(Op, T, T, T, f64) -> T,
+) -> [T; N] {
+    let mut r = [empty; N];
     for ins in code {
         let v = match ins.op {
             Op::Var => slots[ins.a as usize],
-            op => op.apply(
+            op => apply(
+                op,
                 r[ins.a as usize % N],
                 r[ins.b as usize % N],
                 r[ins.c as usize % N],
@@ -370,13 +379,13 @@ fn registers<const N: usize>(code: &[Instr], slots: &[f64]) -> [f64; N] {
 /// A tape's value.
 #[inline]
 fn run<const N: usize>(code: &[Instr], result: u8, slots: &[f64]) -> f64 {
-    registers::<N>(code, slots)[result as usize % N]
+    registers::<f64, N>(code, slots, 0.0, Op::apply)[result as usize % N]
 }
 
 /// A fused tape's values.
 #[inline]
 fn run_many<const N: usize>(code: &[Instr], results: &[u8], slots: &[f64], out: &mut [f64]) {
-    let r = registers::<N>(code, slots);
+    let r = registers::<f64, N>(code, slots, 0.0, Op::apply);
     for (o, &res) in out.iter_mut().zip(results) {
         *o = r[res as usize % N];
     }
@@ -384,20 +393,8 @@ fn run_many<const N: usize>(code: &[Instr], results: &[u8], slots: &[f64], out: 
 
 /// The interval loop: same tape, [`Interval`] registers.
 fn run_interval<const N: usize>(code: &[Instr], result: u8, slots: &[Interval]) -> Interval {
-    let mut r = [Interval::EVERYTHING; N];
-    for ins in code {
-        let v = match ins.op {
-            Op::Var => slots[ins.a as usize],
-            op => op.apply_interval(
-                r[ins.a as usize % N],
-                r[ins.b as usize % N],
-                r[ins.c as usize % N],
-                ins.imm,
-            ),
-        };
-        r[ins.out as usize % N] = v;
-    }
-    r[result as usize % N]
+    registers::<Interval, N>(code, slots, Interval::EVERYTHING, Op::apply_interval)
+        [result as usize % N]
 }
 
 impl fmt::Display for Instr {

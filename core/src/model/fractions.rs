@@ -195,10 +195,9 @@ impl NAry {
             }
         };
         match &self.index {
-            // The walk of `NAry::indexed_min`, also visiting every child that
-            // can contain p (written out again: through a shared closure-taking
-            // walk, `best` and `first` leave registers; see docs/PERFORMANCE.md,
-            // "Large unions").
+            // Speed copy of core/src/model/pnode.rs::NAry::indexed_min: through a shared closure-taking walk `best` and `first` leave registers.
+            // The same walk, also visiting every child that can contain p
+            // (docs/PERFORMANCE.md, "Large unions").
             Some(index) => {
                 for &i in index.always() {
                     visit(i as usize, &mut best, &mut first);

@@ -350,18 +350,7 @@ impl PNode {
             PNode::Scale { inv, k, child } => child.dist(p * *inv) * *k,
             PNode::Affine(a) => a.child.dist(a.m * p + a.t) * a.k,
             PNode::Union(u) => u.union_dist(p),
-            PNode::Intersection(n) => {
-                let mut d = n.children[0].dist(p);
-                for c in &n.children[1..] {
-                    let e = c.dist(p);
-                    d = if n.smooth > 0.0 {
-                        sdf::smooth_max(d, e, n.smooth)
-                    } else {
-                        d.max(e)
-                    };
-                }
-                d
-            }
+            PNode::Intersection(n) => n.fold_dist(p, f64::max, sdf::smooth_max),
             PNode::Difference { a, b, smooth } => {
                 let (da, db) = (a.dist(p), -b.dist(p));
                 if *smooth > 0.0 {
@@ -448,13 +437,26 @@ impl NAry {
         if let Some(index) = &self.index {
             return self.indexed_min(index, p);
         }
+        self.fold_dist(p, f64::min, sdf::smooth_min)
+    }
+
+    /// The children's distances folded in child order by `sharp`, or by
+    /// `smooth` with radius `self.smooth` when it is positive (pyvcad folds
+    /// its smooth union and intersection pairwise in this order).
+    #[inline]
+    fn fold_dist(
+        &self,
+        p: DVec3,
+        sharp: impl Fn(f64, f64) -> f64,
+        smooth: impl Fn(f64, f64, f64) -> f64,
+    ) -> f64 {
         let mut d = self.children[0].dist(p);
         for c in &self.children[1..] {
             let e = c.dist(p);
             d = if self.smooth > 0.0 {
-                sdf::smooth_min(d, e, self.smooth)
+                smooth(d, e, self.smooth)
             } else {
-                d.min(e)
+                sharp(d, e)
             };
         }
         d
@@ -466,6 +468,7 @@ impl NAry {
     /// the cell cannot prove the minimum (best ≥ margin, or `p` outside the
     /// grid). `union_eval` walks the same way.
     fn indexed_min(&self, index: &UnionIndex, p: DVec3) -> f64 {
+        // Speed copy of core/src/model/fractions.rs::NAry::union_eval: through a shared closure-taking walk `best` leaves registers.
         let mut best = f64::INFINITY;
         for &i in index.always() {
             best = best.min(self.child_dist(i as usize, p));

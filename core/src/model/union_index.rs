@@ -332,45 +332,48 @@ impl Bvh {
     /// Visit children in near-to-far-ish order, pruning subtrees whose box is
     /// farther than the bound `visit` returns (it is called with a child
     /// index and returns the new pruning distance).
-    pub fn nearest(&self, p: DVec3, mut bound: f64, mut visit: impl FnMut(u32) -> f64) {
-        if self.nodes.is_empty() {
-            return;
-        }
-        let mut stack: [u32; 64] = [0; 64];
-        let mut sp = 1usize;
-        while sp > 0 {
-            sp -= 1;
-            let node = &self.nodes[stack[sp] as usize];
-            if node.bbox.distance(p) > bound {
-                continue;
-            }
-            if node.count > 0 {
-                let a = node.first_or_right as usize;
-                for &c in &self.order[a..a + node.count as usize] {
-                    bound = bound.min(visit(c));
-                }
-            } else {
-                let left = stack[sp] + 1;
-                let right = node.first_or_right;
-                let dl = self.nodes[left as usize].bbox.distance_squared(p);
-                let dr = self.nodes[right as usize].bbox.distance_squared(p);
+    pub fn nearest(&self, p: DVec3, bound: f64, mut visit: impl FnMut(u32) -> f64) {
+        let mut bound = bound;
+        self.walk(
+            &mut bound,
+            |bound, bbox| bbox.distance(p) > *bound,
+            |bound, c| *bound = bound.min(visit(c)),
+            |nodes, left, right| {
+                let dl = nodes[left as usize].bbox.distance_squared(p);
+                let dr = nodes[right as usize].bbox.distance_squared(p);
                 // Push the farther first so the nearer is visited first.
-                let (far, near) = if dl < dr {
+                if dl < dr {
                     (right, left)
                 } else {
                     (left, right)
-                };
-                if sp + 2 <= stack.len() {
-                    stack[sp] = far;
-                    stack[sp + 1] = near;
-                    sp += 2;
                 }
-            }
-        }
+            },
+        );
     }
 
     /// Visit every child whose box overlaps `b`.
     pub fn overlapping(&self, b: &Aabb, mut visit: impl FnMut(u32)) {
+        self.walk(
+            &mut (),
+            |(), bbox| !bbox.overlaps(b),
+            |(), c| visit(c),
+            |_, left, right| (left, right),
+        );
+    }
+
+    /// The depth-first walk of both queries: a node is skipped when
+    /// `prune(state, its box)`, a leaf's children go to `leaf` in order, and
+    /// an inner node's two halves are pushed in the order `push` gives (the
+    /// second is visited first). The stack's 64 entries outnumber the
+    /// depth of any tree `build` makes: its median splits halve `u32` ids.
+    #[inline(always)]
+    fn walk<S>(
+        &self,
+        state: &mut S,
+        prune: impl Fn(&S, &Aabb) -> bool,
+        mut leaf: impl FnMut(&mut S, u32),
+        push: impl Fn(&[BvhNode], u32, u32) -> (u32, u32),
+    ) {
         if self.nodes.is_empty() {
             return;
         }
@@ -380,17 +383,16 @@ impl Bvh {
             sp -= 1;
             let idx = stack[sp];
             let node = &self.nodes[idx as usize];
-            if !node.bbox.overlaps(b) {
+            if prune(state, &node.bbox) {
                 continue;
             }
             if node.count > 0 {
                 let a = node.first_or_right as usize;
                 for &c in &self.order[a..a + node.count as usize] {
-                    visit(c);
+                    leaf(state, c);
                 }
             } else if sp + 2 <= stack.len() {
-                stack[sp] = idx + 1;
-                stack[sp + 1] = node.first_or_right;
+                (stack[sp], stack[sp + 1]) = push(&self.nodes, idx + 1, node.first_or_right);
                 sp += 2;
             }
         }

@@ -43,13 +43,7 @@ fn register_sphere_and_box(engine: &mut Engine) {
             p,
         ))
     };
-    engine.register_fn("Sphere", move |c: Ctx, a: Dynamic, r: Dynamic| {
-        sphere(&c, &a, &r, None)
-    });
-    engine.register_fn(
-        "Sphere",
-        move |c: Ctx, a: Dynamic, r: Dynamic, m: Dynamic| sphere(&c, &a, &r, Some(&m)),
-    );
+    register_optional_last!(engine, "Sphere", sphere(a, r; m));
     engine.register_fn(
         "Sphere",
         move |c: Ctx,
@@ -101,13 +95,7 @@ fn register_sphere_and_box(engine: &mut Engine) {
             p,
         ))
     };
-    engine.register_fn("RectPrism", move |c: Ctx, a: Dynamic, s: Dynamic| {
-        prism(&c, &a, &s, None)
-    });
-    engine.register_fn(
-        "RectPrism",
-        move |c: Ctx, a: Dynamic, s: Dynamic, m: Dynamic| prism(&c, &a, &s, Some(&m)),
-    );
+    register_optional_last!(engine, "RectPrism", prism(a, s; m));
 }
 
 /// `Cylinder` and `Strut` (pyvcad 3's tapered strut is in `shapes_api`).
@@ -141,14 +129,7 @@ fn register_cylinder_and_strut(engine: &mut Engine) {
             p,
         ))
     };
-    engine.register_fn(
-        "Cylinder",
-        move |c: Ctx, a: Dynamic, r: Dynamic, h: Dynamic| cyl(&c, &a, &r, &h, None),
-    );
-    engine.register_fn(
-        "Cylinder",
-        move |c: Ctx, a: Dynamic, r: Dynamic, h: Dynamic, m: Dynamic| cyl(&c, &a, &r, &h, Some(&m)),
-    );
+    register_optional_last!(engine, "Cylinder", cyl(a, r, h; m));
 
     // Strut
     let strut =

@@ -9,6 +9,18 @@
 //! binary counts the heap, `crate::heap`), or when its cancel flag is set.
 //! The design is the script's final value, or else a variable named `root`.
 
+/// Registers the constructor `$name` twice, as pyvcad overloads it: with
+/// the arguments `$arg…` (the last one left to its default) and with one
+/// more, `$last`. `$f(&ctx, &arg…, Option<&last>)` builds the node.
+macro_rules! register_optional_last {
+    ($engine:expr, $name:literal, $f:ident($($arg:ident),+; $last:ident)) => {
+        $engine.register_fn($name, move |c: Ctx, $($arg: Dynamic),+| $f(&c, $(&$arg),+, None));
+        $engine.register_fn($name, move |c: Ctx, $($arg: Dynamic),+, $last: Dynamic| {
+            $f(&c, $(&$arg),+, Some(&$last))
+        });
+    };
+}
+
 mod arith;
 mod attribute_api;
 mod bulk;

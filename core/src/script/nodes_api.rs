@@ -404,16 +404,7 @@ fn register_grade_blend(engine: &mut Engine) {
             p,
         ))
     };
-    engine.register_fn(
-        "FGrade",
-        move |c: Ctx, e: Dynamic, m: Dynamic, b: Dynamic| fgrade(&c, &e, &m, &b, None),
-    );
-    engine.register_fn(
-        "FGrade",
-        move |c: Ctx, e: Dynamic, m: Dynamic, b: Dynamic, ch: Dynamic| {
-            fgrade(&c, &e, &m, &b, Some(&ch))
-        },
-    );
+    register_optional_last!(engine, "FGrade", fgrade(e, m, b; ch));
 
     // Blend(radius[, child])
     let blend = |c: &Ctx, r: &Dynamic, ch: Option<&Dynamic>| -> RResult<Node> {
@@ -470,36 +461,26 @@ pub fn register_methods(engine: &mut Engine) {
             }
         },
     );
-    engine.register_fn(
-        "set_left",
-        |c: Ctx, n: &mut Node, child: Node| -> RResult<()> {
-            match n.kind_mut() {
-                NodeKind::Difference { left, .. } => {
-                    *left = Some(child);
-                    Ok(())
+    // pyvcad's Difference takes its two operands one at a time.
+    for (name, right) in [("set_left", false), ("set_right", true)] {
+        engine.register_fn(
+            name,
+            move |c: Ctx, n: &mut Node, child: Node| -> RResult<()> {
+                match n.kind_mut() {
+                    NodeKind::Difference {
+                        left: l, right: r, ..
+                    } => {
+                        *(if right { r } else { l }) = Some(child);
+                        Ok(())
+                    }
+                    k => fail(
+                        c.call_position(),
+                        format!("{}: {name} is for Difference", k.type_name()),
+                    ),
                 }
-                k => fail(
-                    c.call_position(),
-                    format!("{}: set_left is for Difference", k.type_name()),
-                ),
-            }
-        },
-    );
-    engine.register_fn(
-        "set_right",
-        |c: Ctx, n: &mut Node, child: Node| -> RResult<()> {
-            match n.kind_mut() {
-                NodeKind::Difference { right, .. } => {
-                    *right = Some(child);
-                    Ok(())
-                }
-                k => fail(
-                    c.call_position(),
-                    format!("{}: set_right is for Difference", k.type_name()),
-                ),
-            }
-        },
-    );
+            },
+        );
+    }
     engine.register_fn("type", |n: &mut Node| n.kind().type_name().to_string());
     engine.register_fn("num_children", |n: &mut Node| {
         n.kind().children().len() as i64

@@ -68,13 +68,7 @@ fn register_cone_torus(engine: &mut Engine) {
                 m.map_or(Ok(1), |m| material(m, p))?,
             ))
         };
-    engine.register_fn("Torus", move |c: Ctx, r1: Dynamic, r2: Dynamic| {
-        checked(&c, &r1, &r2, None)
-    });
-    engine.register_fn(
-        "Torus",
-        move |c: Ctx, r1: Dynamic, r2: Dynamic, m: Dynamic| checked(&c, &r1, &r2, Some(&m)),
-    );
+    register_optional_last!(engine, "Torus", checked(r1, r2; m));
 }
 
 fn register_revolve(engine: &mut Engine) {

@@ -163,6 +163,19 @@ pub fn material(v: &Dynamic, pos: Position) -> RResult<u8> {
     }
 }
 
+/// `v` as an array, or the error that `what` must be an array of `items`.
+fn array(v: &Dynamic, what: &str, items: &str, pos: Position) -> RResult<rhai::Array> {
+    v.clone().try_cast::<rhai::Array>().map_or_else(
+        || {
+            fail(
+                pos,
+                format!("{what} must be an array of {items}, got {}", described(v)),
+            )
+        },
+        Ok,
+    )
+}
+
 /// A node argument.
 pub fn node(v: &Dynamic, what: &str, pos: Position) -> RResult<Node> {
     v.clone().try_cast::<Node>().map_or_else(
@@ -173,13 +186,8 @@ pub fn node(v: &Dynamic, what: &str, pos: Position) -> RResult<Node> {
 
 /// An array of nodes.
 pub fn nodes(v: &Dynamic, what: &str, pos: Position) -> RResult<Vec<Node>> {
-    let Some(a) = v.clone().try_cast::<rhai::Array>() else {
-        return fail(
-            pos,
-            format!("{what} must be an array of nodes, got {}", described(v)),
-        );
-    };
-    a.iter()
+    array(v, what, "nodes", pos)?
+        .iter()
         .enumerate()
         .map(|(i, n)| node(n, &format!("{what}[{i}]"), pos))
         .collect()
@@ -197,13 +205,8 @@ pub fn boolean(v: &Dynamic, what: &str, pos: Position) -> RResult<bool> {
 
 /// An array of strings.
 pub fn strings(v: &Dynamic, what: &str, pos: Position) -> RResult<Vec<String>> {
-    let Some(a) = v.clone().try_cast::<rhai::Array>() else {
-        return fail(
-            pos,
-            format!("{what} must be an array of strings, got {}", described(v)),
-        );
-    };
-    a.iter()
+    array(v, what, "strings", pos)?
+        .iter()
         .enumerate()
         .map(|(i, s)| {
             s.clone()
@@ -215,14 +218,8 @@ pub fn strings(v: &Dynamic, what: &str, pos: Position) -> RResult<Vec<String>> {
 
 /// An array of material ids.
 pub fn materials(v: &Dynamic, what: &str, pos: Position) -> RResult<Vec<u8>> {
-    let Some(a) = v.clone().try_cast::<rhai::Array>() else {
-        return fail(
-            pos,
-            format!(
-                "{what} must be an array of material ids, got {}",
-                described(v)
-            ),
-        );
-    };
-    a.iter().map(|m| material(m, pos)).collect()
+    array(v, what, "material ids", pos)?
+        .iter()
+        .map(|m| material(m, pos))
+        .collect()
 }

@@ -1,6 +1,6 @@
 //! Reading nodal results from a CSV file.
 //!
-//! Two layouts (see `shared/data/seat/README.md`):
+//! Two layouts:
 //!
 //! * **Header** (generic): the first line names the columns. A `node_id`
 //!   (or `id`, `node`, `nodeid`) column maps each row to a mesh node by id,

@@ -46,37 +46,39 @@ impl Topology {
 
     /// Human-readable warnings for everything that is not a closed manifold.
     pub fn warnings(&self) -> Vec<String> {
-        let mut w = Vec::new();
-        if self.boundary_edges > 0 {
-            w.push(format!(
-                "mesh is not closed: {} boundary edges",
-                self.boundary_edges
-            ));
-        }
-        if self.nonmanifold_edges > 0 {
-            w.push(format!(
-                "mesh has {} non-manifold edges (shared by more than two triangles)",
-                self.nonmanifold_edges
-            ));
-        }
-        if self.inconsistent_edges > 0 {
-            w.push(format!(
-                "mesh is not consistently oriented: {} edges are traversed in the same direction by both triangles",
-                self.inconsistent_edges
-            ));
-        }
-        if self.degenerate_triangles > 0 {
-            w.push(format!(
-                "mesh has {} degenerate (zero-area) triangles",
-                self.degenerate_triangles
-            ));
-        }
-        if self.nonmanifold_vertices > 0 {
-            w.push(format!(
-                "mesh has {} non-manifold vertices (several triangle fans meet)",
-                self.nonmanifold_vertices
-            ));
-        }
+        // Each count with the words before and after it.
+        let counts = [
+            (
+                self.boundary_edges,
+                "mesh is not closed: ",
+                " boundary edges",
+            ),
+            (
+                self.nonmanifold_edges,
+                "mesh has ",
+                " non-manifold edges (shared by more than two triangles)",
+            ),
+            (
+                self.inconsistent_edges,
+                "mesh is not consistently oriented: ",
+                " edges are traversed in the same direction by both triangles",
+            ),
+            (
+                self.degenerate_triangles,
+                "mesh has ",
+                " degenerate (zero-area) triangles",
+            ),
+            (
+                self.nonmanifold_vertices,
+                "mesh has ",
+                " non-manifold vertices (several triangle fans meet)",
+            ),
+        ];
+        let mut w: Vec<String> = counts
+            .iter()
+            .filter(|(n, _, _)| *n > 0)
+            .map(|(n, before, after)| format!("{before}{n}{after}"))
+            .collect();
         if !w.is_empty() {
             w.push(
                 "inside/outside is decided by the generalised winding number (slower than pseudo-normals)"

@@ -194,6 +194,12 @@ pub(crate) fn excerpt(s: &str) -> String {
     }
 }
 
+/// The message for a line that is not the statement `what` names:
+/// "expected WHAT, found `LINE`" (the line trimmed and cut to an excerpt).
+pub(crate) fn expected(what: &str, line: &str) -> String {
+    format!("expected {what}, found `{}`", excerpt(line.trim()))
+}
+
 /// Refuses magnitudes beyond [`MAX_COORD`].
 pub(crate) fn range_check(v: f64) -> Result<(), String> {
     if v.abs() > MAX_COORD {

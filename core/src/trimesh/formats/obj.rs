@@ -13,7 +13,7 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use super::{MeshError, Soup, excerpt, fan, parse_error, point, words};
+use super::{MeshError, Soup, excerpt, expected, fan, parse_error, point, words};
 
 /// Column, resolved 0-based index, index as written.
 type FaceRef = (usize, i64, i64);
@@ -45,14 +45,7 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<Soup, MeshError> {
                 let nums: Vec<(usize, &str)> = it.collect();
                 // x y z, then an optional w or an r g b colour.
                 if nums.len() < 3 {
-                    return Err(err(
-                        ln,
-                        col,
-                        format!(
-                            "expected `v x y z` with 3 numbers, found `{}`",
-                            excerpt(raw.trim())
-                        ),
-                    ));
+                    return Err(err(ln, col, expected("`v x y z` with 3 numbers", raw)));
                 }
                 vertices.push(point(&nums, ln, &err)?);
             }

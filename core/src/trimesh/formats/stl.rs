@@ -10,7 +10,7 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use super::{MeshError, Soup, excerpt, parse_error, point, range_check, words};
+use super::{MeshError, Soup, expected, parse_error, point, range_check, words};
 
 /// Parses STL bytes (ASCII or binary, see the module docs).
 pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Soup, MeshError> {
@@ -146,14 +146,7 @@ fn parse_ascii(path: &Path, text: &str) -> Result<Soup, MeshError> {
                     .is_some_and(|(_, w)| w.eq_ignore_ascii_case("normal"));
                 let nums: Vec<(usize, &str)> = it.collect();
                 if !ok || nums.len() != 3 || nums.iter().any(|(_, s)| s.parse::<f64>().is_err()) {
-                    return Err(err(
-                        ln,
-                        col,
-                        format!(
-                            "expected `facet normal nx ny nz`, found `{}`",
-                            excerpt(raw.trim())
-                        ),
-                    ));
+                    return Err(err(ln, col, expected("`facet normal nx ny nz`", raw)));
                 }
             }
             ("outer", State::InSolid) => {
@@ -161,11 +154,7 @@ fn parse_ascii(path: &Path, text: &str) -> Result<Soup, MeshError> {
                     .next()
                     .is_some_and(|(_, w)| w.eq_ignore_ascii_case("loop"))
                 {
-                    return Err(err(
-                        ln,
-                        col,
-                        format!("expected `outer loop`, found `{}`", excerpt(raw.trim())),
-                    ));
+                    return Err(err(ln, col, expected("`outer loop`", raw)));
                 }
                 state = State::InLoop;
                 loop_start = vertices.len();
@@ -173,14 +162,7 @@ fn parse_ascii(path: &Path, text: &str) -> Result<Soup, MeshError> {
             ("vertex", State::InLoop) => {
                 let nums: Vec<(usize, &str)> = it.collect();
                 if nums.len() != 3 {
-                    return Err(err(
-                        ln,
-                        col,
-                        format!(
-                            "expected `vertex x y z` with 3 numbers, found `{}`",
-                            excerpt(raw.trim())
-                        ),
-                    ));
+                    return Err(err(ln, col, expected("`vertex x y z` with 3 numbers", raw)));
                 }
                 vertices.push(point(&nums, ln, &err)?);
             }
@@ -201,16 +183,12 @@ fn parse_ascii(path: &Path, text: &str) -> Result<Soup, MeshError> {
             }
             ("endfacet", State::InSolid) => {}
             _ => {
-                let expected = match state {
+                let what = match state {
                     State::InLoop => "`vertex x y z` or `endloop`",
                     State::InSolid => "`facet normal`, `outer loop`, `endfacet` or `endsolid`",
                     State::Outside => "`solid`",
                 };
-                return Err(err(
-                    ln,
-                    col,
-                    format!("expected {expected}, found `{}`", excerpt(raw.trim())),
-                ));
+                return Err(err(ln, col, expected(what, raw)));
             }
         }
     }
