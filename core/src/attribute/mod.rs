@@ -16,6 +16,7 @@
 mod convert;
 mod describe;
 mod eval;
+mod hint;
 mod mix;
 mod moves;
 mod names;
@@ -199,5 +200,7 @@ impl NodeAttributes {
 mod tests;
 #[cfg(test)]
 mod tests_fractions;
+#[cfg(test)]
+mod tests_hint;
 #[cfg(test)]
 mod tests_points;

@@ -26,6 +26,9 @@ const MAX_DEPTH: u32 = 500;
 pub struct Evaluator {
     pub(super) infos: Vec<AttributeInfo>,
     pub(super) root: Arc<ANode>,
+    /// How the design's top union numbers the root's children, when the
+    /// distance walk can hand over the child it found (`hint`).
+    pub(super) hint: Option<super::hint::RootHint>,
 }
 
 impl std::fmt::Debug for Evaluator {
@@ -192,7 +195,11 @@ impl Evaluator {
         };
         let root = b.tree(root)?;
         let root = root.ok_or_else(|| err(root_node(&nodes), "has no attributes".into()))?;
-        Ok(Some(Evaluator { infos, root }))
+        Ok(Some(Evaluator {
+            infos,
+            root,
+            hint: None,
+        }))
     }
 }
 

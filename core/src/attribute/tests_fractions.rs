@@ -145,3 +145,98 @@ fn bad_conversions_are_refused() {
     let e = try_model(&bar("\"mix.txt\"")).unwrap_err();
     assert!(e.contains(".csv"), "{e}");
 }
+
+/// Random boxes over `m`: where the fraction bounds are given, every
+/// inside sample lies within them, and where the fractions are called
+/// constant, every inside sample has the same; returns how many boxes were
+/// bounded and how many called constant.
+fn bounds_hold(m: &Model, seed: u64) -> (usize, usize) {
+    use crate::interval::Interval;
+    let k = m.materials().len();
+    let bb = m.bbox();
+    let mut g = crate::xorshift::XorShift::new(seed);
+    let mut r = || g.next_f64();
+    let (mut bounded, mut constant) = (0, 0);
+    let mut iv = vec![Interval::point(0.0); k];
+    for n in 0..600 {
+        let c = bb.min + bb.size() * DVec3::new(r(), r(), r());
+        let h = DVec3::new(r(), r(), r()) * [0.05, 0.5, 3.0][n % 3];
+        let b = crate::aabb::Aabb::new(c - h, c + h);
+        let has = m.fraction_bounds(&b, &mut iv);
+        let same = m.constant_fractions(&b);
+        bounded += usize::from(has);
+        constant += usize::from(same);
+        let mut first: Option<Vec<f64>> = None;
+        for _ in 0..40 {
+            let p = b.min + b.size() * DVec3::new(r(), r(), r());
+            let mut f = vec![0.0; k];
+            if m.eval_into(p, &mut f) > 0.0 {
+                continue;
+            }
+            if has {
+                for (i, (b, v)) in iv.iter().zip(&f).enumerate() {
+                    assert!(
+                        b.lo - 1e-9 <= *v && *v <= b.hi + 1e-9,
+                        "fraction {i} = {v} outside {b:?} at {p}"
+                    );
+                }
+            }
+            if same {
+                let f0 = first.get_or_insert_with(|| f.clone());
+                for (a, b) in f0.iter().zip(&f) {
+                    assert!((a - b).abs() < 1e-12, "not constant at {p}: {f0:?} {f:?}");
+                }
+            }
+        }
+    }
+    (bounded, constant)
+}
+
+#[test]
+fn fraction_bounds_of_a_conversion_contain_every_sample() {
+    let falling = "let b = Translate(3.0, 0.0, 1.0, Rotate(0.0, 30.0, 0.0, Vec3(0, 0, 0), RectPrism(Vec3(0, 0, 0), Vec3(20, 4, 4), m.id(\"gray\"))));
+         b.set_attribute(\"shore_hardness\", \"60 + 20 * sin(x / 3)\");
+         Convert(b, \"shore_hardness\", fractions([m.id(\"red\"), m.id(\"blue\")]), [[0.0, 85.0], [0.3, 70.0], [1.0, 45.0]])";
+    let designs = [
+        bar("[[0.0, 30.0], [1.0, 90.0]]"),
+        bar("[[0.0, 30.0], [0.5, 50.0], [1.0, 90.0]]"),
+        falling.to_owned(),
+        // Only one child sets it: the other keeps its own material.
+        "let a = Sphere(Vec3(-3, 0, 0), 4.0, m.id(\"gray\"));
+         a.set_attribute(\"hardness\", \"50 + 5 * x\");
+         let b = Sphere(Vec3(4, 0, 0), 4.0, m.id(\"green\"));
+         Convert(Union(false, [a, b]), \"hardness\", fractions([m.id(\"red\"), m.id(\"blue\")]), [[0.0, 30.0], [1.0, 90.0]])".to_owned(),
+        // NaN where x < 0 (sqrt): those points keep the child's fractions.
+        "let b = RectPrism(Vec3(0, 0, 0), Vec3(20, 4, 4), m.id(\"gray\"));
+         b.set_attribute(\"hardness\", \"30 + 10 * sqrt(x)\");
+         Convert(b, \"hardness\", fractions([m.id(\"red\"), m.id(\"blue\")]), [[0.0, 30.0], [1.0, 90.0]])".to_owned(),
+    ];
+    for src in &designs {
+        let m = model(src);
+        let (bounded, _) = bounds_hold(&m, 11);
+        assert!(bounded > 300, "{src}: {bounded} of 600 boxes bounded");
+    }
+    // A constant hardness: one mix everywhere, so boxes are constant.
+    let m = model(&bar("[[0.0, 30.0], [1.0, 90.0]]").replace("\"30 + 4 * (x + 10)\"", "75.0"));
+    let (bounded, constant) = bounds_hold(&m, 12);
+    assert_eq!((bounded, constant), (600, 600));
+}
+
+#[test]
+fn bounds_of_a_graded_conversion_decide_small_boxes() {
+    // The bar's hardness 30 + 4(x + 10) over x in [−2.5, −2.4]: 60 to
+    // 60.4, shares 0.5 to 0.50667 of blue.
+    let m = model(&bar("[[0.0, 30.0], [1.0, 90.0]]"));
+    let b = crate::aabb::Aabb::new(DVec3::new(-2.5, -1.0, -1.0), DVec3::new(-2.4, 1.0, 1.0));
+    let k = m.materials().len();
+    let mut iv = vec![crate::interval::Interval::point(0.0); k];
+    assert!(m.fraction_bounds(&b, &mut iv));
+    let blue = m
+        .materials()
+        .iter()
+        .position(|&i| i == m.table().id("blue").unwrap())
+        .unwrap();
+    assert!((iv[blue].lo - 0.5).abs() < 1e-9, "{:?}", iv[blue]);
+    assert!((iv[blue].hi - 30.4 / 60.0).abs() < 1e-9, "{:?}", iv[blue]);
+    assert!(!m.constant_fractions(&b));
+}

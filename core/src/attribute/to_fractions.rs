@@ -15,8 +15,10 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::DVec3;
 
-use super::prepared::{ANode, Evaluator};
+use super::prepared::{ANode, Evaluator, Op, OwnSrc, PConv};
 use super::{AttributeKind, FracConv, MixTable};
+use crate::aabb::Aabb;
+use crate::interval::Interval;
 use crate::material::MaterialId;
 use crate::model::{PrepareError, SubPreparer};
 use crate::node::Node;
@@ -116,6 +118,38 @@ impl FractionSource {
         true
     }
 
+    /// Bounds of the second material's share at the inside points of `b`
+    /// (the node's frame) that have a value of `from`, and whether every
+    /// inside point has one (else some keep the child's fractions); `None`
+    /// when none has one.
+    ///
+    /// The inverted mix table is monotonic (rising or falling values give a
+    /// rising or falling share), so the shares of a value interval lie
+    /// between those of its ends; widened by 10⁻¹² for the rounding of the
+    /// table's interpolation.
+    pub(crate) fn share_bounds(&self, b: &Aabb) -> Option<(Interval, bool)> {
+        let v = self.tree.interval(self.index, b)?;
+        let (a, z) = (self.table.share(v.lo).0, self.table.share(v.hi).0);
+        let share = if v.lo == v.hi {
+            Interval::point(a)
+        } else if a.is_nan() || z.is_nan() {
+            Interval::new(0.0, 1.0)
+        } else {
+            Interval::new((a.min(z) - 1e-12).max(0.0), (a.max(z) + 1e-12).min(1.0))
+        };
+        Some((share, self.tree.covers(self.index, b)))
+    }
+
+    /// The mix of `share` added to the dense fraction bounds `out`, as
+    /// [`FractionSource::frac`] adds it.
+    pub(crate) fn add_share_bounds(&self, share: Interval, out: &mut [Interval]) {
+        let first = Interval::new(1.0 - share.hi, 1.0 - share.lo);
+        for (slot, f) in self.slots.iter().zip([first, share]) {
+            let o = &mut out[usize::from(*slot)];
+            *o = Interval::new(o.lo + f.lo, o.hi + f.hi);
+        }
+    }
+
     /// The clamping warning, when samples so far were clamped.
     pub(crate) fn warning(&self) -> Option<String> {
         let k = self.clamped.load(Ordering::Relaxed);
@@ -127,5 +161,62 @@ impl FractionSource {
             "{}: Convert to fractions: {k} samples of \"{}\" outside the mix table's {lo}..{hi} were clamped to its ends",
             self.describe, self.from
         ))
+    }
+}
+
+impl ANode {
+    /// True when every inside point of `b` (this node's frame) gets a
+    /// value of scalar attribute `idx`: no point where nothing defines it,
+    /// where it is NaN, or where a common name's range refuses it. Only a
+    /// node's own values are judged (a union's children may leave points
+    /// without one: false).
+    ///
+    /// An interval is `EVERYTHING` wherever a math string may give NaN
+    /// (`expr::interval_eval`), so a finite one rules NaN out; a table
+    /// gives NaN only for a NaN input, and an FEA column outside its mesh.
+    pub(super) fn covers(&self, idx: usize, b: &Aabb) -> bool {
+        match (self.own_of[idx], &self.op) {
+            (Some(pos), _) => self.own_covers(usize::from(pos), b),
+            (None, Op::Map(m, c)) => c.covers(idx, &m.apply_box(b)),
+            (None, _) => false,
+        }
+    }
+
+    fn own_covers(&self, pos: usize, b: &Aabb) -> bool {
+        let own = &self.own[pos];
+        let Some(v) = self.own_interval(pos, b) else {
+            return false;
+        };
+        let in_range = own.range.is_none_or(|(lo, hi, _)| lo <= v.lo && v.hi <= hi);
+        let finite = v.lo.is_finite() && v.hi.is_finite();
+        in_range
+            && finite
+            && own
+                .order
+                .iter()
+                .chain([&pos])
+                .all(|&k| match &self.own[k].src {
+                    OwnSrc::Comps(_) | OwnSrc::Points { .. } => true,
+                    OwnSrc::Data { .. } => false,
+                    OwnSrc::Convert {
+                        from,
+                        from_own,
+                        map,
+                        ..
+                    } => match (map, from_own) {
+                        (PConv::Mix { .. }, _) => false,
+                        // An own input is among `order`, judged there.
+                        (_, Some(_)) => true,
+                        (_, None) => self.covers_below(*from, b),
+                    },
+                })
+    }
+
+    /// [`ANode::covers`] for what the children give.
+    fn covers_below(&self, idx: usize, b: &Aabb) -> bool {
+        match &self.op {
+            Op::Map(m, c) => c.covers(idx, &m.apply_box(b)),
+            _ => false,
+        }
     }
 }

@@ -19,6 +19,13 @@
 //! (`SimulationField`) is bounded through the nodal ranges of the
 //! tetrahedra that meet the box (`SimField::bounds`).
 //!
+//! A scalar -> fractions conversion (`Convert(child, from, fractions([a,
+//! b]), table)`) mixes by the inverted mix table, which is monotonic: the
+//! share of b over the box lies between the shares of the ends of `from`'s
+//! interval bound ([`crate::attribute::FractionSource::share_bounds`]).
+//! Points where `from` has no value keep the child's fractions, so unless
+//! every inside point has one, the bound is the hull with the child's.
+//!
 //! FGrade (clamped, normalised expressions `vᵢ = max(eᵢ, 0)`,
 //! `fᵢ = vᵢ / Σⱼ vⱼ`): with `vᵢ ∈ [aᵢ, bᵢ]`, `fᵢ` is increasing in `vᵢ` and
 //! decreasing in every other `vⱼ`, so
@@ -33,6 +40,7 @@ use super::MAX_MATERIALS;
 use super::distance_interval::coord_intervals;
 use super::pnode::{COORD_SLOTS, Grade, NAry, PNode, SimGrade, Slot};
 use crate::aabb::Aabb;
+use crate::attribute::FractionSource;
 use crate::expr::Expr;
 use crate::interval::Interval;
 
@@ -80,8 +88,42 @@ impl PNode {
             PNode::Difference { a, .. } => a.frac_bounds(b, out),
             PNode::FGrade(g) => g.bounds(b, out),
             PNode::SimField(g) => g.bounds(b, out),
+            PNode::AttrGrade { child, src } => attr_grade_bounds(child, src, b, out),
             _ => false,
         }
+    }
+}
+
+/// `Convert(child, from, fractions([a, b]), table)`: the mix where `from`
+/// has a value, the child's own fractions where it has none, so the hull
+/// of the two unless every inside point has a value (or none has).
+fn attr_grade_bounds(child: &PNode, src: &FractionSource, b: &Aabb, out: &mut [Interval]) -> bool {
+    let Some((share, every)) = src.share_bounds(b) else {
+        return child.frac_bounds(b, out);
+    };
+    if every {
+        src.add_share_bounds(share, out);
+        return true;
+    }
+    let k = out.len();
+    let mut own = [ZERO; MAX_MATERIALS];
+    if !child.frac_bounds(b, &mut own[..k]) {
+        return false;
+    }
+    src.add_share_bounds(share, out);
+    for (o, c) in out.iter_mut().zip(&own[..k]) {
+        *o = o.union(*c);
+    }
+    true
+}
+
+/// True when a conversion's fractions are the same at every inside point
+/// of `b`: one share everywhere, or no value anywhere and a constant
+/// child ([`PNode::constant_fractions`]).
+pub(super) fn attr_grade_constant(child: &PNode, src: &FractionSource, b: &Aabb) -> bool {
+    match src.share_bounds(b) {
+        None => child.constant_fractions(b),
+        Some((share, every)) => every && share.lo == share.hi,
     }
 }
 
