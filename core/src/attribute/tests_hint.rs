@@ -113,3 +113,29 @@ fn resolvers_parents_and_other_tops_search_as_before() {
         assert!(agree(&m) > 500, "{src}");
     }
 }
+
+#[test]
+fn one_math_string_on_many_nodes_is_compiled_once() {
+    use super::prepared::{Op, OwnSrc, PComp};
+    let m = model(
+        "let u = Union(); for i in 0..20 { let s = Sphere(Vec3(3.0 * i, 0, 0), 1.0, m.id(\"red\")); s.set_attribute(\"t\", \"x + d\"); u.add_child(s); }
+         let other = Sphere(Vec3(0, 5, 0), 1.0, m.id(\"red\")); other.set_attribute(\"t\", \"x + d\"); other.set_attribute(\"w\", 2.0); u.add_child(other); u",
+    );
+    let root = &m.attrs.as_ref().unwrap().root;
+    let Op::Pick { children, .. } = &root.op else {
+        panic!("a union");
+    };
+    let tape = |k: usize| match &children[k].own[0].src {
+        OwnSrc::Comps(cs) => match &cs[0] {
+            PComp::Expr(e) => e.clone(),
+            PComp::Const(_) => panic!("a math string"),
+        },
+        _ => panic!("components"),
+    };
+    for k in 1..20 {
+        assert!(std::sync::Arc::ptr_eq(&tape(0), &tape(k)), "{k}");
+    }
+    // Another variable list (the node also sets "w") compiles its own.
+    assert!(!std::sync::Arc::ptr_eq(&tape(0), &tape(20)));
+    assert!(agree(&m) > 100);
+}
