@@ -140,8 +140,10 @@ fn bad_conversions_are_refused() {
     assert!(e.contains("a Vec4"), "{e}");
     let e = try_model(&bar("[[0.0, 30.0]]")).unwrap_err();
     assert!(e.contains("at least 2"), "{e}");
-    let e = try_model("fractions([m.id(\"red\"), m.id(\"blue\"), m.id(\"green\")])").unwrap_err();
-    assert!(e.contains("mixes 2 materials, got 3"), "{e}");
+    let e = try_model("fractions([m.id(\"red\")])").unwrap_err();
+    assert!(e.contains("mixes 2 to 16 materials, got 1"), "{e}");
+    let e = try_model("fractions([m.id(\"red\"), m.id(\"blue\"), m.id(\"red\")])").unwrap_err();
+    assert!(e.contains("named twice"), "{e}");
     let e = try_model(&bar("\"mix.txt\"")).unwrap_err();
     assert!(e.contains(".csv"), "{e}");
 }
@@ -239,4 +241,94 @@ fn bounds_of_a_graded_conversion_decide_small_boxes() {
     assert!((iv[blue].lo - 0.5).abs() < 1e-9, "{:?}", iv[blue]);
     assert!((iv[blue].hi - 30.4 / 60.0).abs() < 1e-9, "{:?}", iv[blue]);
     assert!(!m.constant_fractions(&b));
+}
+
+/// The bar of [`bar`] mixing red, green and blue along the path `table`.
+fn bar3(table: &str) -> String {
+    bar(table).replace(
+        "fractions([m.id(\"red\"), m.id(\"blue\")])",
+        "fractions([m.id(\"red\"), m.id(\"green\"), m.id(\"blue\")])",
+    )
+}
+
+/// Red to green (30 to 60), then green to an even green-blue (60 to 90).
+const PATH3: &str = "[[1, 0, 0, 30], [0, 1, 0, 60], [0, 0.5, 0.5, 90]]";
+
+#[test]
+fn three_materials_follow_the_path_of_the_rows() {
+    let m = model(&bar3(PATH3));
+    // Hardness 30 + 4(x + 10): x = −6.25 gives 45, half way to green.
+    let at = |x: f64| ["red", "green", "blue"].map(|n| frac(&m, n, [x, 0.0, 0.0]));
+    let close = |a: [f64; 3], b: [f64; 3]| a.iter().zip(&b).all(|(p, q)| (p - q).abs() < 1e-12);
+    assert!(close(at(-6.25), [0.5, 0.5, 0.0]), "{:?}", at(-6.25));
+    // x = 0: 70, a third of the way from green to the green-blue row.
+    assert!(
+        close(at(0.0), [0.0, 1.0 - 0.5 / 3.0, 0.5 / 3.0]),
+        "{:?}",
+        at(0.0)
+    );
+    // x = 9: 106, past the last row: its mix, counted (`at` evaluates
+    // the point once per material).
+    assert!(m.attribute_warnings().is_empty());
+    assert!(close(at(9.0), [0.0, 0.5, 0.5]), "{:?}", at(9.0));
+    let w = m.attribute_warnings();
+    assert!(
+        w[0].contains("3 samples") && w[0].contains("30..90"),
+        "{w:?}"
+    );
+    let sum: f64 = at(-3.3).iter().sum();
+    assert!((sum - 1.0).abs() < 1e-12);
+    // A falling path is read the other way; a CSV gives the same rows.
+    let f = model(&bar3("[[0, 0.5, 0.5, 90], [0, 1, 0, 60], [1, 0, 0, 30]]"));
+    for x in [-9.0, -6.25, 0.0, 4.0] {
+        let g = ["red", "green", "blue"].map(|n| frac(&f, n, [x, 0.0, 0.0]));
+        assert!(close(g, at(x)), "{x}: {g:?} {:?}", at(x));
+    }
+    let t = super::MixTable::parse_csv_path(
+        "# illustrative\nred,green,blue,shore\n1,0,0,30\n0,1,0,60\n0,0.5,0.5,90\n",
+        3,
+        "p.csv",
+    )
+    .unwrap();
+    let mut mix = [0.0; 3];
+    assert!(!t.mix(45.0, |i, v| mix[i] += v));
+    assert_eq!(mix, [0.5, 0.5, 0.0]);
+    assert_eq!(t.materials(), 3);
+}
+
+#[test]
+fn three_material_bounds_contain_every_sample() {
+    for src in [
+        bar3(PATH3),
+        bar3("[[0.2, 0.3, 0.5, 20], [1, 0, 0, 50], [0, 0, 1, 55], [0, 1, 0, 120]]"),
+    ] {
+        let m = model(&src);
+        let (bounded, _) = bounds_hold(&m, 13);
+        assert!(bounded > 300, "{src}: {bounded} of 600 boxes bounded");
+    }
+    let m = model(&bar3(PATH3).replace("\"30 + 4 * (x + 10)\"", "70.0"));
+    assert_eq!(bounds_hold(&m, 14), (600, 600));
+}
+
+#[test]
+fn bad_three_material_tables_are_refused() {
+    for (table, says) in [
+        ("[[1, 0, 0, 30], [0, 1, 0.2, 60]]", "add up to 1.2"),
+        ("[[1, 0, 0, 30], [1.5, -0.5, 0, 60]]", "the fraction -0.5"),
+        (
+            "[[1, 0, 0, 30], [0, 1, 60]]",
+            "table row 2 must be [the 3 materials' fractions, then the value]",
+        ),
+        (
+            "[[1, 0, 0, 30], [0, 1, 0, 60], [0, 0, 1, 50]]",
+            "rows 2 and 3 (values 60 then 50)",
+        ),
+        ("[[1, 0, 0, 30]]", "at least 2 rows"),
+    ] {
+        let e = try_model(&bar3(table)).unwrap_err();
+        assert!(e.contains(says), "{table}: {e}");
+        assert!(e.contains("t.rhai:4:"), "{e}");
+    }
+    let e = super::MixTable::parse_csv_path("a,b,c,v\n1,0,0,30\n0,1,0\n", 3, "p.csv").unwrap_err();
+    assert!(e.contains("p.csv:3: expected 4 numbers"), "{e}");
 }

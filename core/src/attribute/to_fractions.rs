@@ -28,8 +28,8 @@ pub(crate) struct FractionSource {
     tree: Arc<ANode>,
     index: usize,
     table: Arc<MixTable>,
-    /// Dense fraction slots of the first and second material.
-    slots: [u16; 2],
+    /// Dense fraction slots of the materials mixed, in the table's order.
+    slots: Vec<u16>,
     /// Samples whose value was outside the table (clamped).
     clamped: AtomicU64,
     describe: String,
@@ -61,7 +61,7 @@ impl FractionSource {
         conv: &FracConv,
         child: &Node,
         materials: &[MaterialId],
-        slots: [u16; 2],
+        slots: Vec<u16>,
         sub: SubPreparer,
     ) -> Result<FractionSource, PrepareError> {
         let from = conv.from.as_str();
@@ -109,45 +109,27 @@ impl FractionSource {
             Ok(true) if !v[0].is_nan() => {}
             _ => return false,
         }
-        let (s, outside) = self.table.share(v[0]);
+        let outside = self
+            .table
+            .mix(v[0], |m, f| out[usize::from(self.slots[m])] += f);
         if outside {
             self.clamped.fetch_add(1, Ordering::Relaxed);
         }
-        out[usize::from(self.slots[0])] += 1.0 - s;
-        out[usize::from(self.slots[1])] += s;
         true
     }
 
-    /// Bounds of the second material's share at the inside points of `b`
-    /// (the node's frame) that have a value of `from`, and whether every
-    /// inside point has one (else some keep the child's fractions); `None`
-    /// when none has one.
-    ///
-    /// The inverted mix table is monotonic (rising or falling values give a
-    /// rising or falling share), so the shares of a value interval lie
-    /// between those of its ends; widened by 10⁻¹² for the rounding of the
-    /// table's interpolation.
-    pub(crate) fn share_bounds(&self, b: &Aabb) -> Option<(Interval, bool)> {
+    /// Bounds of the mix at the inside points of `b` (the node's frame)
+    /// that have a value of `from`, added to the dense fraction bounds
+    /// `out` ([`MixTable::mix_bounds`]); `None` (and `out` untouched) when
+    /// none has one, else whether every inside point has one (else some
+    /// keep the child's fractions) and whether the mix is one value.
+    pub(crate) fn mix_bounds(&self, b: &Aabb, out: &mut [Interval]) -> Option<(bool, bool)> {
         let v = self.tree.interval(self.index, b)?;
-        let (a, z) = (self.table.share(v.lo).0, self.table.share(v.hi).0);
-        let share = if v.lo == v.hi {
-            Interval::point(a)
-        } else if a.is_nan() || z.is_nan() {
-            Interval::new(0.0, 1.0)
-        } else {
-            Interval::new((a.min(z) - 1e-12).max(0.0), (a.max(z) + 1e-12).min(1.0))
-        };
-        Some((share, self.tree.covers(self.index, b)))
-    }
-
-    /// The mix of `share` added to the dense fraction bounds `out`, as
-    /// [`FractionSource::frac`] adds it.
-    pub(crate) fn add_share_bounds(&self, share: Interval, out: &mut [Interval]) {
-        let first = Interval::new(1.0 - share.hi, 1.0 - share.lo);
-        for (slot, f) in self.slots.iter().zip([first, share]) {
-            let o = &mut out[usize::from(*slot)];
+        self.table.mix_bounds(v, |m, f| {
+            let o = &mut out[usize::from(self.slots[m])];
             *o = Interval::new(o.lo + f.lo, o.hi + f.hi);
-        }
+        });
+        Some((self.tree.covers(self.index, b), v.lo == v.hi))
     }
 
     /// The clamping warning, when samples so far were clamped.

@@ -22,7 +22,8 @@
 //! A scalar -> fractions conversion (`Convert(child, from, fractions([a,
 //! b]), table)`) mixes by the inverted mix table, which is monotonic: the
 //! share of b over the box lies between the shares of the ends of `from`'s
-//! interval bound ([`crate::attribute::FractionSource::share_bounds`]).
+//! interval bound ([`crate::attribute::MixTable::mix_bounds`]; with more
+//! materials, the path's rows between them too).
 //! Points where `from` has no value keep the child's fractions, so unless
 //! every inside point has one, the bound is the hull with the child's.
 //!
@@ -98,32 +99,32 @@ impl PNode {
 /// has a value, the child's own fractions where it has none, so the hull
 /// of the two unless every inside point has a value (or none has).
 fn attr_grade_bounds(child: &PNode, src: &FractionSource, b: &Aabb, out: &mut [Interval]) -> bool {
-    let Some((share, every)) = src.share_bounds(b) else {
+    let k = out.len();
+    let mut mix = [ZERO; MAX_MATERIALS];
+    let Some((every, _)) = src.mix_bounds(b, &mut mix[..k]) else {
         return child.frac_bounds(b, out);
     };
     if every {
-        src.add_share_bounds(share, out);
+        out.copy_from_slice(&mix[..k]);
         return true;
     }
-    let k = out.len();
-    let mut own = [ZERO; MAX_MATERIALS];
-    if !child.frac_bounds(b, &mut own[..k]) {
+    if !child.frac_bounds(b, out) {
         return false;
     }
-    src.add_share_bounds(share, out);
-    for (o, c) in out.iter_mut().zip(&own[..k]) {
-        *o = o.union(*c);
+    for (o, m) in out.iter_mut().zip(&mix[..k]) {
+        *o = o.union(*m);
     }
     true
 }
 
 /// True when a conversion's fractions are the same at every inside point
-/// of `b`: one share everywhere, or no value anywhere and a constant
-/// child ([`PNode::constant_fractions`]).
+/// of `b`: one mix everywhere, or no value anywhere and a constant child
+/// ([`PNode::constant_fractions`]).
 pub(super) fn attr_grade_constant(child: &PNode, src: &FractionSource, b: &Aabb) -> bool {
-    match src.share_bounds(b) {
+    let mut mix = [ZERO; MAX_MATERIALS];
+    match src.mix_bounds(b, &mut mix) {
         None => child.constant_fractions(b),
-        Some((share, every)) => every && share.lo == share.hi,
+        Some((every, one)) => every && one,
     }
 }
 
