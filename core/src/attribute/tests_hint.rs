@@ -139,3 +139,42 @@ fn one_math_string_on_many_nodes_is_compiled_once() {
     assert!(!std::sync::Arc::ptr_eq(&tape(0), &tape(20)));
     assert!(agree(&m) > 100);
 }
+
+#[test]
+fn the_pick_grid_lists_every_child_that_may_hold_a_point() {
+    use super::prepared::Op;
+    // 60 long diagonal struts crossing each other (their boxes meet many
+    // cells they do not pass through), in a union under a move, so the
+    // search uses the grid: its answer is the first child holding the
+    // point, found by testing every child.
+    let m = model(
+        "let u = Union(); for i in 0..60 { let a = Vec3(0.7 * i, 0.0, 0.3 * i); let b = Vec3(40.0 - 0.5 * i, 25.0, 0.2 * i + 5.0); let s = Strut(a, b, 0.8, m.id(\"red\")); s.set_attribute(\"temperature\", 1.0 * i); u.add_child(s); } Translate(0.5, 0.0, 0.0, u)",
+    );
+    let a = m.attrs.as_ref().unwrap();
+    let Op::Map(_, u) = &a.root.op else {
+        panic!("a move");
+    };
+    let Op::Pick { children, grid, .. } = &u.op else {
+        panic!("a union");
+    };
+    assert!(grid.is_some());
+    let b = m.bbox();
+    let n = 40;
+    let mut held = 0;
+    for i in 0..n * n * n {
+        let t = DVec3::new((i % n) as f64, (i / n % n) as f64, (i / (n * n)) as f64) / n as f64;
+        let p = b.min + (b.max - b.min) * (t + 0.013);
+        let q = p - DVec3::new(0.5, 0.0, 0.0);
+        let want = children.iter().position(|c| c.dist.contains(q));
+        let mut got = [0.0];
+        m.attribute_at(0, p, &mut got).unwrap();
+        match want {
+            Some(k) => {
+                assert_eq!(got[0], k as f64, "{p}");
+                held += 1;
+            }
+            None => assert!(got[0].is_nan(), "{p}"),
+        }
+    }
+    assert!(held > 500, "{held}");
+}
