@@ -73,29 +73,21 @@ pub fn sample(
         .collect::<Result<Vec<usize>, _>>()
         .map_err(|e| anyhow::anyhow!("--attributes: {e}"))?;
     let k = model.materials().len();
+    let width: usize = wanted
+        .iter()
+        .map(|&i| model.attributes()[i].kind.width())
+        .sum();
     let rows: Vec<String> = pts
         .par_iter()
         .map_init(
-            || vec![0.0; k],
-            |f, p| -> anyhow::Result<String> {
-                let d = model.eval_into(*p, f);
+            || (vec![0.0; k], vec![0.0; width]),
+            |(f, a), p| -> anyhow::Result<String> {
+                // Distance, fractions and attributes in one walk.
+                let d = model.eval_with_attributes(*p, f, &wanted, a)?;
                 let mut s = format!("{},{},{},{}", p.x, p.y, p.z, d);
-                for v in f.iter() {
+                for v in f.iter().chain(a.iter()) {
                     s.push(',');
                     s.push_str(&v.to_string());
-                }
-                for &i in &wanted {
-                    let mut v = [0.0; 4];
-                    let v = &mut v[..model.attributes()[i].kind.width()];
-                    if d <= 0.0 {
-                        model.attribute_inside(i, *p, v)?;
-                    } else {
-                        v.fill(f64::NAN);
-                    }
-                    for x in v.iter() {
-                        s.push(',');
-                        s.push_str(&x.to_string());
-                    }
                 }
                 Ok(s)
             },

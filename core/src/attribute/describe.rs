@@ -28,10 +28,11 @@ pub fn describe_tree(root: &Node, table: &MaterialTable) -> Vec<String> {
             }
             if let Some(c) = &a.to_fractions {
                 let (lo, hi) = c.table.value_range();
+                let names: Vec<&str> = c.materials.iter().map(|m| table.name(*m)).collect();
+                let (last, rest) = names.split_last().map_or(("", &[][..]), |(l, r)| (*l, r));
                 out.push(format!(
-                    "fractions = {} and {} mixed for \"{}\" through a mix table over {lo}..{hi} on {}",
-                    table.name(c.materials[0]),
-                    table.name(c.materials[1]),
+                    "fractions = {} and {last} mixed for \"{}\" through a mix table over {lo}..{hi} on {}",
+                    rest.join(", "),
                     c.from,
                     n.describe()
                 ));

@@ -16,6 +16,7 @@
 mod convert;
 mod describe;
 mod eval;
+mod hint;
 mod image_field;
 mod mix;
 mod moves;
@@ -165,7 +166,7 @@ pub struct NodeAttributes {
     /// Overlap resolvers by attribute name.
     pub resolvers: Vec<(String, Resolver, Option<Origin>)>,
     /// Fractions from a scalar by a mix table (`Convert(child, from,
-    /// fractions([a, b]), table)`): they replace the child's fractions.
+    /// fractions([a, b, ...]), table)`): they replace the child's fractions.
     pub to_fractions: Option<FracConv>,
 }
 
@@ -174,8 +175,9 @@ pub struct NodeAttributes {
 pub struct FracConv {
     /// The scalar attribute read from the child.
     pub from: String,
-    /// The two materials mixed: the table's share is the second's.
-    pub materials: [MaterialId; 2],
+    /// The materials mixed (two: the table's share is the second's; more:
+    /// the table's rows name each one's fraction).
+    pub materials: Vec<MaterialId>,
     /// The mix table.
     pub table: Arc<MixTable>,
     /// The script position of the `Convert` call.
@@ -209,6 +211,8 @@ impl NodeAttributes {
 mod tests;
 #[cfg(test)]
 mod tests_fractions;
+#[cfg(test)]
+mod tests_hint;
 #[cfg(test)]
 mod tests_image;
 #[cfg(test)]

@@ -1,7 +1,9 @@
 //! Which children of a union with attributes may contain a point: a
 //! uniform grid over the children's boxes, each cell listing (in child
 //! order, so the first child containing a point still wins) the children
-//! whose box meets it.
+//! whose box meets it and whose distance interval over the cell does not
+//! rule out an inside point (a long diagonal strut's box meets many cells
+//! it does not pass through).
 //!
 //! Why: a union's attribute goes to the first child containing the point,
 //! and testing every child is a distance evaluation per child: a lattice
@@ -53,19 +55,20 @@ impl PickGrid {
         let dims = [dim(size.x), dim(size.y), dim(size.z)];
         let cell = size / DVec3::new(dims[0] as f64, dims[1] as f64, dims[2] as f64);
         let cells = CellLattice::new(all.min, cell, dims);
-        // Each box's cell range, grown by one cell: `locate` rounds its own
-        // way, and a child listed in an extra cell is only tested in vain.
+        // Each box's cell range, by `locate`'s arithmetic (`(p − min)·(1 /
+        // cell)`, truncated): it is monotonic in p, so a point of the box
+        // lies in a cell of the range.
+        let inv = DVec3::ONE / cell;
         let range = |b: &Aabb| {
-            let lo = ((b.min - all.min) / cell).floor();
-            let hi = ((b.max - all.min) / cell).floor();
+            let lo = ((b.min - all.min) * inv).floor();
+            let hi = ((b.max - all.min) * inv).floor();
             let clampi = |v: f64, d: usize| (v.max(0.0) as usize).min(d - 1);
             let r = |a: usize| {
                 let (l, h) = ([lo.x, lo.y, lo.z][a], [hi.x, hi.y, hi.z][a]);
-                (clampi(l - 1.0, dims[a]), clampi(h + 1.0, dims[a]))
+                (clampi(l, dims[a]), clampi(h, dims[a]))
             };
             [r(0), r(1), r(2)]
         };
-        let mut counts = vec![0u32; cells.slots() + 1];
         let mut entries = 0usize;
         for b in &boxes {
             let [rx, ry, rz] = range(b);
@@ -73,21 +76,42 @@ impl PickGrid {
             if entries > MAX_ENTRIES {
                 return None;
             }
-            for_cells([rx, ry, rz], |c| counts[cells.index(c) + 1] += 1);
+        }
+        // A cell a child's box meets, kept where the child's distance over
+        // the cell (grown by a rounding margin: `locate` may put a point a
+        // few ulps outside its cell's box) may be ≤ 0.
+        let slack = 1e-9 * cell.length();
+        let listed: Vec<Vec<usize>> = children
+            .iter()
+            .zip(&boxes)
+            .map(|(c, b)| {
+                let mut keep = Vec::new();
+                for_cells(range(b), |k| {
+                    let lo = all.min + DVec3::new(k[0] as f64, k[1] as f64, k[2] as f64) * cell;
+                    let cb = Aabb::new(lo, lo + cell).expand(slack);
+                    if c.dist.interval(&cb).lo <= slack {
+                        keep.push(cells.index(k));
+                    }
+                });
+                keep
+            })
+            .collect();
+        let mut counts = vec![0u32; cells.slots() + 1];
+        for s in listed.iter().flatten() {
+            counts[s + 1] += 1;
         }
         for s in 1..counts.len() {
             counts[s] += counts[s - 1];
         }
         let starts = counts;
         let mut fill = starts.clone();
-        let mut items = vec![0u32; entries];
+        let mut items = vec![0u32; listed.iter().map(Vec::len).sum()];
         // Children in order: each cell's list ascends.
-        for (i, b) in boxes.iter().enumerate() {
-            for_cells(range(b), |c| {
-                let s = cells.index(c);
+        for (i, slots) in listed.iter().enumerate() {
+            for &s in slots {
                 items[fill[s] as usize] = i as u32;
                 fill[s] += 1;
-            });
+            }
         }
         Some(PickGrid {
             cells,

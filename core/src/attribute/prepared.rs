@@ -26,6 +26,9 @@ const MAX_DEPTH: u32 = 500;
 pub struct Evaluator {
     pub(super) infos: Vec<AttributeInfo>,
     pub(super) root: Arc<ANode>,
+    /// How the design's top union numbers the root's children, when the
+    /// distance walk can hand over the child it found (`hint`).
+    pub(super) hint: Option<super::hint::RootHint>,
 }
 
 impl std::fmt::Debug for Evaluator {
@@ -37,6 +40,7 @@ impl std::fmt::Debug for Evaluator {
 }
 
 /// One component of a prepared value.
+#[derive(Clone)]
 pub(super) enum PComp {
     Const(f64),
     Expr(Arc<Expr>),
@@ -193,10 +197,15 @@ impl Evaluator {
             index,
             sub,
             done: HashMap::new(),
+            exprs: HashMap::new(),
         };
         let root = b.tree(root)?;
         let root = root.ok_or_else(|| err(root_node(&nodes), "has no attributes".into()))?;
-        Ok(Some(Evaluator { infos, root }))
+        Ok(Some(Evaluator {
+            infos,
+            root,
+            hint: None,
+        }))
     }
 }
 
@@ -265,6 +274,9 @@ struct Builder<'a> {
     index: HashMap<&'a str, usize>,
     sub: SubPreparer,
     done: HashMap<Key, Option<Arc<ANode>>>,
+    /// Math strings compiled so far, by source and variable list: nodes
+    /// that set the same string (a lattice's 3,286 struts) share one tape.
+    exprs: HashMap<(String, String), PComp>,
 }
 
 impl Builder<'_> {
@@ -429,7 +441,7 @@ impl Builder<'_> {
     /// The node's own attributes compiled, and their positions by design
     /// attribute index.
     #[allow(clippy::type_complexity)]
-    fn own(&self, n: &Node) -> Result<(Vec<Own>, Vec<Option<u16>>), PrepareError> {
+    fn own(&mut self, n: &Node) -> Result<(Vec<Own>, Vec<Option<u16>>), PrepareError> {
         let mut own_of = vec![None; self.infos.len()];
         let Some(a) = n.attributes() else {
             return Ok((Vec::new(), own_of));
@@ -453,13 +465,14 @@ impl Builder<'_> {
             });
         }
         let var_refs: Vec<&str> = vars.iter().map(String::as_str).collect();
+        let vars_key = vars.join("\u{1f}");
         let mut own = Vec::with_capacity(a.defs.len());
         for (pos, d) in a.defs.iter().enumerate() {
             own_of[self.index[d.name.as_str()]] = Some(pos as u16);
             let src = match &d.source {
                 AttrSource::Components(cs) => OwnSrc::Comps(
                     cs.iter()
-                        .map(|c| compile(n, d, c, &var_refs))
+                        .map(|c| self.compile(n, d, c, (&var_refs, &vars_key)))
                         .collect::<Result<_, _>>()?,
                 ),
                 AttrSource::Data { field, column, .. } => OwnSrc::Data {
@@ -586,27 +599,41 @@ impl Builder<'_> {
     }
 }
 
-fn compile(
-    n: &Node,
-    d: &super::AttrDef,
-    c: &Component,
-    vars: &[&str],
-) -> Result<PComp, PrepareError> {
-    match c {
-        Component::Const(v) => Ok(PComp::Const(*v)),
-        Component::Text(s) => match Expr::compile(s, vars) {
-            Ok(e) => Ok(match e.constant() {
+impl Builder<'_> {
+    /// Component `c` of `d`, with the variables `vars` (and their cache
+    /// key): a math string compiled once per source and variable list.
+    fn compile(
+        &mut self,
+        n: &Node,
+        d: &super::AttrDef,
+        c: &Component,
+        (vars, vars_key): (&[&str], &str),
+    ) -> Result<PComp, PrepareError> {
+        let s = match c {
+            Component::Const(v) => return Ok(PComp::Const(*v)),
+            Component::Text(s) => s,
+        };
+        let key = (s.clone(), vars_key.to_owned());
+        if let Some(p) = self.exprs.get(&key) {
+            return Ok(p.clone());
+        }
+        let p = match Expr::compile(s, vars) {
+            Ok(e) => match e.constant() {
                 Some(v) => PComp::Const(v),
                 None => PComp::Expr(Arc::new(e)),
-            }),
-            Err(e) => Err(err(
-                n,
-                format!(
-                    "{} (\"{}\"): {e}; a math string reads x y z rho phic r theta phis d and the node's other number attributes by name",
-                    call(d.origin),
-                    d.name
-                ),
-            )),
-        },
+            },
+            Err(e) => {
+                return Err(err(
+                    n,
+                    format!(
+                        "{} (\"{}\"): {e}; a math string reads x y z rho phic r theta phis d and the node's other number attributes by name",
+                        call(d.origin),
+                        d.name
+                    ),
+                ));
+            }
+        };
+        self.exprs.insert(key, p.clone());
+        Ok(p)
     }
 }

@@ -15,8 +15,10 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::DVec3;
 
-use super::prepared::{ANode, Evaluator};
+use super::prepared::{ANode, Evaluator, Op, OwnSrc, PConv};
 use super::{AttributeKind, FracConv, MixTable};
+use crate::aabb::Aabb;
+use crate::interval::Interval;
 use crate::material::MaterialId;
 use crate::model::{PrepareError, SubPreparer};
 use crate::node::Node;
@@ -26,8 +28,8 @@ pub(crate) struct FractionSource {
     tree: Arc<ANode>,
     index: usize,
     table: Arc<MixTable>,
-    /// Dense fraction slots of the first and second material.
-    slots: [u16; 2],
+    /// Dense fraction slots of the materials mixed, in the table's order.
+    slots: Vec<u16>,
     /// Samples whose value was outside the table (clamped).
     clamped: AtomicU64,
     describe: String,
@@ -59,7 +61,7 @@ impl FractionSource {
         conv: &FracConv,
         child: &Node,
         materials: &[MaterialId],
-        slots: [u16; 2],
+        slots: Vec<u16>,
         sub: SubPreparer,
     ) -> Result<FractionSource, PrepareError> {
         let from = conv.from.as_str();
@@ -107,13 +109,27 @@ impl FractionSource {
             Ok(true) if !v[0].is_nan() => {}
             _ => return false,
         }
-        let (s, outside) = self.table.share(v[0]);
+        let outside = self
+            .table
+            .mix(v[0], |m, f| out[usize::from(self.slots[m])] += f);
         if outside {
             self.clamped.fetch_add(1, Ordering::Relaxed);
         }
-        out[usize::from(self.slots[0])] += 1.0 - s;
-        out[usize::from(self.slots[1])] += s;
         true
+    }
+
+    /// Bounds of the mix at the inside points of `b` (the node's frame)
+    /// that have a value of `from`, added to the dense fraction bounds
+    /// `out` ([`MixTable::mix_bounds`]); `None` (and `out` untouched) when
+    /// none has one, else whether every inside point has one (else some
+    /// keep the child's fractions) and whether the mix is one value.
+    pub(crate) fn mix_bounds(&self, b: &Aabb, out: &mut [Interval]) -> Option<(bool, bool)> {
+        let v = self.tree.interval(self.index, b)?;
+        self.table.mix_bounds(v, |m, f| {
+            let o = &mut out[usize::from(self.slots[m])];
+            *o = Interval::new(o.lo + f.lo, o.hi + f.hi);
+        });
+        Some((self.tree.covers(self.index, b), v.lo == v.hi))
     }
 
     /// The clamping warning, when samples so far were clamped.
@@ -127,5 +143,62 @@ impl FractionSource {
             "{}: Convert to fractions: {k} samples of \"{}\" outside the mix table's {lo}..{hi} were clamped to its ends",
             self.describe, self.from
         ))
+    }
+}
+
+impl ANode {
+    /// True when every inside point of `b` (this node's frame) gets a
+    /// value of scalar attribute `idx`: no point where nothing defines it,
+    /// where it is NaN, or where a common name's range refuses it. Only a
+    /// node's own values are judged (a union's children may leave points
+    /// without one: false).
+    ///
+    /// An interval is `EVERYTHING` wherever a math string may give NaN
+    /// (`expr::interval_eval`), so a finite one rules NaN out; a table
+    /// gives NaN only for a NaN input, and an FEA column outside its mesh.
+    pub(super) fn covers(&self, idx: usize, b: &Aabb) -> bool {
+        match (self.own_of[idx], &self.op) {
+            (Some(pos), _) => self.own_covers(usize::from(pos), b),
+            (None, Op::Map(m, c)) => c.covers(idx, &m.apply_box(b)),
+            (None, _) => false,
+        }
+    }
+
+    fn own_covers(&self, pos: usize, b: &Aabb) -> bool {
+        let own = &self.own[pos];
+        let Some(v) = self.own_interval(pos, b) else {
+            return false;
+        };
+        let in_range = own.range.is_none_or(|(lo, hi, _)| lo <= v.lo && v.hi <= hi);
+        let finite = v.lo.is_finite() && v.hi.is_finite();
+        in_range
+            && finite
+            && own
+                .order
+                .iter()
+                .chain([&pos])
+                .all(|&k| match &self.own[k].src {
+                    OwnSrc::Comps(_) | OwnSrc::Points { .. } | OwnSrc::Image { .. } => true,
+                    OwnSrc::Data { .. } => false,
+                    OwnSrc::Convert {
+                        from,
+                        from_own,
+                        map,
+                        ..
+                    } => match (map, from_own) {
+                        (PConv::Mix { .. }, _) => false,
+                        // An own input is among `order`, judged there.
+                        (_, Some(_)) => true,
+                        (_, None) => self.covers_below(*from, b),
+                    },
+                })
+    }
+
+    /// [`ANode::covers`] for what the children give.
+    fn covers_below(&self, idx: usize, b: &Aabb) -> bool {
+        match &self.op {
+            Op::Map(m, c) => c.covers(idx, &m.apply_box(b)),
+            _ => false,
+        }
     }
 }

@@ -283,7 +283,10 @@ impl PNode {
                     }
                 }),
             },
-            PNode::Blend { .. } | PNode::Sum { .. } | PNode::AttrGrade { .. } => false,
+            PNode::AttrGrade { child, src } => {
+                super::fraction_bound::attr_grade_constant(child, src, b)
+            }
+            PNode::Blend { .. } | PNode::Sum { .. } => false,
             _ => true, // leaves: above
         }
     }

@@ -19,6 +19,14 @@
 //! (`SimulationField`) is bounded through the nodal ranges of the
 //! tetrahedra that meet the box (`SimField::bounds`).
 //!
+//! A scalar -> fractions conversion (`Convert(child, from, fractions([a,
+//! b]), table)`) mixes by the inverted mix table, which is monotonic: the
+//! share of b over the box lies between the shares of the ends of `from`'s
+//! interval bound ([`crate::attribute::MixTable::mix_bounds`]; with more
+//! materials, the path's rows between them too).
+//! Points where `from` has no value keep the child's fractions, so unless
+//! every inside point has one, the bound is the hull with the child's.
+//!
 //! FGrade (clamped, normalised expressions `vᵢ = max(eᵢ, 0)`,
 //! `fᵢ = vᵢ / Σⱼ vⱼ`): with `vᵢ ∈ [aᵢ, bᵢ]`, `fᵢ` is increasing in `vᵢ` and
 //! decreasing in every other `vⱼ`, so
@@ -33,6 +41,7 @@ use super::MAX_MATERIALS;
 use super::distance_interval::coord_intervals;
 use super::pnode::{COORD_SLOTS, Grade, NAry, PNode, SimGrade, Slot};
 use crate::aabb::Aabb;
+use crate::attribute::FractionSource;
 use crate::expr::Expr;
 use crate::interval::Interval;
 
@@ -80,8 +89,42 @@ impl PNode {
             PNode::Difference { a, .. } => a.frac_bounds(b, out),
             PNode::FGrade(g) => g.bounds(b, out),
             PNode::SimField(g) => g.bounds(b, out),
+            PNode::AttrGrade { child, src } => attr_grade_bounds(child, src, b, out),
             _ => false,
         }
+    }
+}
+
+/// `Convert(child, from, fractions([a, b]), table)`: the mix where `from`
+/// has a value, the child's own fractions where it has none, so the hull
+/// of the two unless every inside point has a value (or none has).
+fn attr_grade_bounds(child: &PNode, src: &FractionSource, b: &Aabb, out: &mut [Interval]) -> bool {
+    let k = out.len();
+    let mut mix = [ZERO; MAX_MATERIALS];
+    let Some((every, _)) = src.mix_bounds(b, &mut mix[..k]) else {
+        return child.frac_bounds(b, out);
+    };
+    if every {
+        out.copy_from_slice(&mix[..k]);
+        return true;
+    }
+    if !child.frac_bounds(b, out) {
+        return false;
+    }
+    for (o, m) in out.iter_mut().zip(&mix[..k]) {
+        *o = o.union(*m);
+    }
+    true
+}
+
+/// True when a conversion's fractions are the same at every inside point
+/// of `b`: one mix everywhere, or no value anywhere and a constant child
+/// ([`PNode::constant_fractions`]).
+pub(super) fn attr_grade_constant(child: &PNode, src: &FractionSource, b: &Aabb) -> bool {
+    let mut mix = [ZERO; MAX_MATERIALS];
+    match src.mix_bounds(b, &mut mix) {
+        None => child.constant_fractions(b),
+        Some((every, one)) => every && one,
     }
 }
 

@@ -22,7 +22,7 @@ impl PNode {
     /// same loop over its candidates).
     pub fn eval(&self, p: DVec3, out: &mut [f64]) -> f64 {
         match self {
-            PNode::Union(u) if !u.blend && u.smooth <= 0.0 => u.union_eval(p, out),
+            PNode::Union(u) if !u.blend && u.smooth <= 0.0 => u.union_eval::<true>(p, out).0,
             PNode::Translate { t, child } => child.eval(p - *t, out),
             PNode::FGrade(g) => {
                 let d = g.child.dist(p);
@@ -38,6 +38,28 @@ impl PNode {
                 }
                 d
             }
+        }
+    }
+
+    /// [`PNode::eval`], and for a sharp union the index of the first child
+    /// containing `p` (whose fractions it wrote; `usize::MAX` where none
+    /// does or the node is not a sharp union): the attribute evaluator
+    /// reads the same child's attribute without searching again.
+    #[inline]
+    pub(crate) fn eval_first(&self, p: DVec3, out: &mut [f64]) -> (f64, usize) {
+        match self {
+            PNode::Union(u) if !u.blend && u.smooth <= 0.0 => u.union_eval::<true>(p, out),
+            _ => (self.eval(p, out), usize::MAX),
+        }
+    }
+
+    /// Distance at `p` and, for a sharp union, the index of the first child
+    /// containing it (as [`PNode::eval_first`], without the fractions).
+    #[inline]
+    pub(crate) fn dist_first(&self, p: DVec3) -> (f64, usize) {
+        match self {
+            PNode::Union(u) if !u.blend && u.smooth <= 0.0 => u.union_eval::<false>(p, &mut []),
+            _ => (self.dist(p), usize::MAX),
         }
     }
 
@@ -181,8 +203,10 @@ impl NAry {
         }
     }
 
-    /// Sharp, non-blending union: minimum and first containing child at once.
-    fn union_eval(&self, p: DVec3, out: &mut [f64]) -> f64 {
+    /// Sharp, non-blending union: minimum and first containing child at
+    /// once (the child's index is returned beside the minimum), and that
+    /// child's fractions when `FRACTIONS`.
+    fn union_eval<const FRACTIONS: bool>(&self, p: DVec3, out: &mut [f64]) -> (f64, usize) {
         let mut best = f64::INFINITY;
         let mut first = usize::MAX;
         let visit = |i: usize, best: &mut f64, first: &mut usize| {
@@ -239,9 +263,12 @@ impl NAry {
             }
         }
         if best <= 0.0 && first != usize::MAX {
-            self.child_frac(first, p, out);
+            if FRACTIONS {
+                self.child_frac(first, p, out);
+            }
+            return (best, first);
         }
-        best
+        (best, usize::MAX)
     }
 
     /// `blend = false`: the first child (in order) containing `p` wins.

@@ -125,6 +125,49 @@ impl SubDistance {
         out.fill(0.0);
         self.node.eval(p, out);
     }
+
+    /// True when `other` is this very prepared node (not only an equal one).
+    pub(crate) fn is(&self, other: &SubDistance) -> bool {
+        Arc::ptr_eq(&self.node, &other.node)
+    }
+
+    /// When this is a sharp union whose children are distinct prepared
+    /// nodes: for each child, the position in `parts` of the part that is
+    /// it (`u32::MAX` for none); `None` when it is not such a union, some
+    /// part is not one of its children, or the parts are in another order.
+    pub(crate) fn union_positions(&self, parts: &[&SubDistance]) -> Option<Vec<u32>> {
+        let PNode::Union(u) = &*self.node else {
+            return None;
+        };
+        if u.blend || u.smooth > 0.0 {
+            return None;
+        }
+        let mut at: std::collections::HashMap<*const PNode, usize> =
+            std::collections::HashMap::with_capacity(u.children.len());
+        for (j, c) in u.children.iter().enumerate() {
+            if at.insert(Arc::as_ptr(c), j).is_some() {
+                return None;
+            }
+        }
+        let mut of_child = vec![u32::MAX; u.children.len()];
+        for (k, part) in parts.iter().enumerate() {
+            let j = *at.get(&Arc::as_ptr(&part.node))?;
+            if of_child[j] != u32::MAX {
+                return None;
+            }
+            of_child[j] = u32::try_from(k).ok()?;
+        }
+        // The parts in the children's order: "first" means the same in both.
+        let mut order = of_child.iter().filter(|&&k| k != u32::MAX);
+        let mut last = order.next();
+        for k in order {
+            if last.is_some_and(|l| l >= k) {
+                return None;
+            }
+            last = Some(k);
+        }
+        Some(of_child)
+    }
 }
 
 /// Prepares the distances of script subtrees, sharing one cache.
@@ -184,8 +227,12 @@ impl Model {
         }
         // The attribute evaluator reuses the preparer's cache: each node's
         // distance is prepared once for both.
-        let attrs =
-            crate::attribute::Evaluator::build(root, &materials, SubPreparer(p))?.map(Arc::new);
+        let top = SubDistance {
+            node: root_p.clone(),
+            bbox,
+        };
+        let attrs = crate::attribute::Evaluator::build(root, &materials, SubPreparer(p))?
+            .map(|a| Arc::new(a.with_root_hint(&top)));
         Ok(Model {
             attrs,
             varying: root_p.varying_fractions(),

@@ -187,7 +187,7 @@ impl Preparer {
             slots: self.slots.clone(),
             cache: self.cache.clone(),
         });
-        let slots = conv.materials.map(|m| self.slot(m));
+        let slots = conv.materials.iter().map(|m| self.slot(*m)).collect();
         let src = FractionSource::build(n, conv, c, &materials, slots, sub)?;
         let node = PNode::AttrGrade {
             child: child.node,

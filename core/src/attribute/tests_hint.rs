@@ -1,0 +1,180 @@
+//! The top union's one-walk path (`hint`) gives what the attribute tree's
+//! own search gives, and `eval_with_attributes` what `eval_into` and
+//! `attribute_at` give.
+
+use glam::DVec3;
+
+use super::tests::model;
+use crate::Model;
+
+/// Attribute `idx` at `p` by the attribute tree's own search (no hint).
+fn searched(m: &Model, idx: usize, p: DVec3, out: &mut [f64]) {
+    let a = m.attrs.as_ref().expect("attributes");
+    let found = m.root.contains(p) && a.root.eval(idx, p, p, out).expect("value");
+    if !found {
+        out.fill(f64::NAN);
+    }
+}
+
+fn same(a: f64, b: f64) -> bool {
+    a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
+}
+
+/// Every attribute on a grid of points over the design's box: the hinted,
+/// searched and one-walk results agree bit for bit; returns how many
+/// values were found (not NaN).
+fn agree(m: &Model) -> usize {
+    let k = m.materials().len();
+    let b = m.bbox();
+    let n = 24;
+    let mut found = 0;
+    let all: Vec<usize> = (0..m.attributes().len()).collect();
+    let width: usize = m.attributes().iter().map(|a| a.kind.width()).sum();
+    for i in 0..n * n * n {
+        let t = DVec3::new(
+            (i % n) as f64 + 0.37,
+            (i / n % n) as f64 + 0.61,
+            (i / (n * n)) as f64 + 0.23,
+        ) / n as f64;
+        let p = b.min + (b.max - b.min) * t;
+        let mut f = vec![0.0; k];
+        let d = m.eval_into(p, &mut f);
+        let mut f2 = vec![0.0; k];
+        let mut v = vec![0.0; width];
+        let d2 = m.eval_with_attributes(p, &mut f2, &all, &mut v).unwrap();
+        assert!(same(d, d2), "{p}");
+        assert_eq!(f, f2, "{p}");
+        let mut at = 0;
+        for (idx, info) in m.attributes().iter().enumerate() {
+            let w = info.kind.width();
+            let (mut hinted, mut reference) = ([0.0; 4], [0.0; 4]);
+            m.attribute_at(idx, p, &mut hinted[..w]).unwrap();
+            searched(m, idx, p, &mut reference[..w]);
+            for c in 0..w {
+                assert!(
+                    same(hinted[c], reference[c]) && same(v[at + c], reference[c]),
+                    "{} at {p}: hinted {}, one walk {}, searched {}",
+                    info.name,
+                    hinted[c],
+                    v[at + c],
+                    reference[c]
+                );
+                found += usize::from(!reference[c].is_nan());
+            }
+            at += w;
+        }
+    }
+    found
+}
+
+/// 30 overlapping spheres, each with its index as `temperature`, some
+/// without one, in a union at the top.
+const SPHERES: &str = "let u = Union(); for i in 0..30 { let s = Sphere(Vec3(1.5 * i, 0, 0), 1.0, m.id(\"red\")); if i % 4 != 3 { s.set_attribute(\"temperature\", 1.0 * i); } u.add_child(s); }";
+
+#[test]
+fn the_top_union_hands_over_the_child_it_found() {
+    // Children with the attribute, without it, and a plain box after them
+    // (the bunny lattice's clear body).
+    let m = model(&format!(
+        "{SPHERES} u.add_child(RectPrism(Vec3(20, 0, 0), Vec3(50, 3, 3), m.id(\"blue\"))); u"
+    ));
+    assert!(m.attrs.as_ref().unwrap().hint.is_some());
+    assert!(agree(&m) > 1000);
+}
+
+#[test]
+fn a_later_child_still_gives_its_value() {
+    // A plain box comes first: where it holds a point, a child after it
+    // that holds the point too gives the value (moved children, a colour).
+    let m = model(
+        "let u = Union(); u.add_child(RectPrism(Vec3(20, 0, 0), Vec3(50, 3, 3), m.id(\"blue\")));
+         for i in 0..30 { let s = Sphere(Vec3(1.5 * i, 0, 0), 1.0, m.id(\"red\")); if i % 4 != 3 { s.set_attribute(\"temperature\", 1.0 * i); } u.add_child(s); }
+         for c in 0..3 { let s = Sphere(Vec3(10.0 * c, 0, 0), 2.0, m.id(\"green\")); s.set_attribute(\"temperature\", 100.0 + c); s.set_attribute(\"color\", Vec4(0.1 * c, 0.5, 0.5, 1.0)); u.add_child(Translate(1.0, 0.0, 0.0, s)); }
+         u",
+    );
+    assert!(m.attrs.as_ref().unwrap().hint.is_some());
+    assert!(agree(&m) > 500);
+    // A nested union is spliced into the top one: no hint, the search.
+    let m = model(&format!(
+        "let b = RectPrism(Vec3(20, 0, 0), Vec3(50, 3, 3), m.id(\"blue\")); {SPHERES} let w = Union(); w.add_child(b); w.add_child(u); w"
+    ));
+    assert!(agree(&m) > 500);
+}
+
+#[test]
+fn resolvers_parents_and_other_tops_search_as_before() {
+    for src in [
+        format!("{SPHERES} u.set_attribute_conflict_resolver(\"temperature\", \"max\"); u"),
+        format!("{SPHERES} u.set_attribute(\"temperature\", \"100 + x\"); u"),
+        format!("{SPHERES} Translate(1.0, 2.0, 0.0, u)"),
+        format!("{SPHERES} Union(1.0, false, [u, Sphere(Vec3(0, 3, 0), 2.0, m.id(\"blue\"))])"),
+    ] {
+        let m = model(&src);
+        assert!(agree(&m) > 500, "{src}");
+    }
+}
+
+#[test]
+fn one_math_string_on_many_nodes_is_compiled_once() {
+    use super::prepared::{Op, OwnSrc, PComp};
+    let m = model(
+        "let u = Union(); for i in 0..20 { let s = Sphere(Vec3(3.0 * i, 0, 0), 1.0, m.id(\"red\")); s.set_attribute(\"t\", \"x + d\"); u.add_child(s); }
+         let other = Sphere(Vec3(0, 5, 0), 1.0, m.id(\"red\")); other.set_attribute(\"t\", \"x + d\"); other.set_attribute(\"w\", 2.0); u.add_child(other); u",
+    );
+    let root = &m.attrs.as_ref().unwrap().root;
+    let Op::Pick { children, .. } = &root.op else {
+        panic!("a union");
+    };
+    let tape = |k: usize| match &children[k].own[0].src {
+        OwnSrc::Comps(cs) => match &cs[0] {
+            PComp::Expr(e) => e.clone(),
+            PComp::Const(_) => panic!("a math string"),
+        },
+        _ => panic!("components"),
+    };
+    for k in 1..20 {
+        assert!(std::sync::Arc::ptr_eq(&tape(0), &tape(k)), "{k}");
+    }
+    // Another variable list (the node also sets "w") compiles its own.
+    assert!(!std::sync::Arc::ptr_eq(&tape(0), &tape(20)));
+    assert!(agree(&m) > 100);
+}
+
+#[test]
+fn the_pick_grid_lists_every_child_that_may_hold_a_point() {
+    use super::prepared::Op;
+    // 60 long diagonal struts crossing each other (their boxes meet many
+    // cells they do not pass through), in a union under a move, so the
+    // search uses the grid: its answer is the first child holding the
+    // point, found by testing every child.
+    let m = model(
+        "let u = Union(); for i in 0..60 { let a = Vec3(0.7 * i, 0.0, 0.3 * i); let b = Vec3(40.0 - 0.5 * i, 25.0, 0.2 * i + 5.0); let s = Strut(a, b, 0.8, m.id(\"red\")); s.set_attribute(\"temperature\", 1.0 * i); u.add_child(s); } Translate(0.5, 0.0, 0.0, u)",
+    );
+    let a = m.attrs.as_ref().unwrap();
+    let Op::Map(_, u) = &a.root.op else {
+        panic!("a move");
+    };
+    let Op::Pick { children, grid, .. } = &u.op else {
+        panic!("a union");
+    };
+    assert!(grid.is_some());
+    let b = m.bbox();
+    let n = 40;
+    let mut held = 0;
+    for i in 0..n * n * n {
+        let t = DVec3::new((i % n) as f64, (i / n % n) as f64, (i / (n * n)) as f64) / n as f64;
+        let p = b.min + (b.max - b.min) * (t + 0.013);
+        let q = p - DVec3::new(0.5, 0.0, 0.0);
+        let want = children.iter().position(|c| c.dist.contains(q));
+        let mut got = [0.0];
+        m.attribute_at(0, p, &mut got).unwrap();
+        match want {
+            Some(k) => {
+                assert_eq!(got[0], k as f64, "{p}");
+                held += 1;
+            }
+            None => assert!(got[0].is_nan(), "{p}"),
+        }
+    }
+    assert!(held > 500, "{held}");
+}
