@@ -12,12 +12,28 @@
 //! void and the mean over a region follows the wanted mean up to the error
 //! left at the region's edge. Layers are independent: a layer's result
 //! depends on its own voxels only, never on threads or on other layers.
+//!
+//! Where the wanted colours do not change from layer to layer, plain error
+//! diffusion settles into the same pattern on every layer, and a thick part
+//! shows it as columns of one resin through its thickness (stripes on its
+//! sides). So the choice is made on the wanted colour plus the error plus
+//! a seeded offset of its lightness of up to [`JITTER`], keyed by the
+//! voxel's global index (threshold modulation); the error passed on is
+//! still measured from the unshifted sum, so means are kept. Lightness
+//! alone: an offset of hue would put stray coloured voxels in a region
+//! whose colour is one resin's.
 
 /// Channels of a wanted colour: OKLab L, a, b and opacity.
 pub const CHANNELS: usize = 4;
 
 /// A wanted colour or a resin: `[L, a, b, opacity]`.
 pub type Ink = [f32; CHANNELS];
+
+/// Largest seeded offset of a voxel's lightness before its resin is chosen
+/// (OKLab, lightness 0 to 1): a fraction of the distance between
+/// neighbouring resins, enough to break layer-to-layer repeats, small
+/// against the error diffusion's own swings.
+pub const JITTER: f32 = 0.06;
 
 /// Floyd–Steinberg's weights: ahead, next row behind, below, ahead.
 const FS: [f32; 4] = [7.0 / 16.0, 3.0 / 16.0, 5.0 / 16.0, 1.0 / 16.0];
@@ -37,7 +53,16 @@ pub fn nearest(resins: &[Ink], t: &Ink) -> usize {
 
 /// Diffuse one `nx`-wide layer: `wanted` has one colour per voxel (read
 /// only where `inside`); `out` gets `resin + 1` inside and 0 outside.
-pub fn diffuse_layer(nx: usize, wanted: &[Ink], inside: &[bool], resins: &[Ink], out: &mut [u8]) {
+/// `jitter`: the seed and the layer's first global voxel index of the
+/// seeded offsets (`None`: none).
+pub fn diffuse_layer(
+    nx: usize,
+    wanted: &[Ink],
+    inside: &[bool],
+    resins: &[Ink],
+    jitter: Option<(u64, u64)>,
+    out: &mut [u8],
+) {
     let rows = inside.len() / nx.max(1);
     // Error rows with one padding cell at each end (index x + 1).
     let mut cur = vec![[0.0f32; CHANNELS]; nx + 2];
@@ -57,7 +82,15 @@ pub fn diffuse_layer(nx: usize, wanted: &[Ink], inside: &[bool], resins: &[Ink],
             for (c, e) in t.iter_mut().zip(cur[x + 1]) {
                 *c += e;
             }
-            let pick = nearest(resins, &t);
+            let pick = match jitter {
+                Some((seed, first)) => {
+                    let h = crate::dither::splitmix64(seed, first + v as u64);
+                    let mut s = t;
+                    s[0] += JITTER * (2.0 * crate::dither::unit_f32(h) - 1.0);
+                    nearest(resins, &s)
+                }
+                None => nearest(resins, &t),
+            };
             // `resins` has at most 255 entries (checked where it is built).
             out[v] = (pick + 1) as u8;
             let err: Ink = [0, 1, 2, 3].map(|c| t[c] - resins[pick][c]);
@@ -102,7 +135,7 @@ mod tests {
             .collect();
         let wanted = vec![[0.3, 0.0, 0.0, 1.0]; nx * ny];
         let mut out = vec![9u8; nx * ny];
-        diffuse_layer(nx, &wanted, &inside, &[BLACK, WHITE, CLEAR], &mut out);
+        diffuse_layer(nx, &wanted, &inside, &[BLACK, WHITE, CLEAR], None, &mut out);
         let n_in = inside.iter().filter(|i| **i).count();
         let white = out.iter().filter(|c| **c == 2).count();
         assert!(out.iter().zip(&inside).all(|(c, i)| (*c == 0) != *i));
@@ -117,9 +150,38 @@ mod tests {
         let inside = vec![true; nx * ny];
         let wanted = vec![[1.0, 0.0, 0.0, 0.5]; nx * ny];
         let mut out = vec![0u8; nx * ny];
-        diffuse_layer(nx, &wanted, &inside, &[BLACK, WHITE, CLEAR], &mut out);
+        diffuse_layer(nx, &wanted, &inside, &[BLACK, WHITE, CLEAR], None, &mut out);
         let clear = out.iter().filter(|c| **c == 3).count();
         assert!(out.iter().all(|c| *c == 2 || *c == 3));
         assert!((clear as f64 / (nx * ny) as f64 - 0.5).abs() < 0.01);
+    }
+
+    #[test]
+    fn seeded_offsets_vary_the_pattern_by_layer_and_keep_the_mean() {
+        // The same grey on two layers: plain diffusion repeats its pattern
+        // exactly (columns of one resin through a thick part); with the
+        // seeded offsets the layers differ and the share stays.
+        let (nx, ny) = (64, 64);
+        let inside = vec![true; nx * ny];
+        let wanted = vec![[0.3, 0.0, 0.0, 1.0]; nx * ny];
+        let inks = [BLACK, WHITE, CLEAR];
+        let layer = |jitter| {
+            let mut out = vec![0u8; nx * ny];
+            diffuse_layer(nx, &wanted, &inside, &inks, jitter, &mut out);
+            out
+        };
+        assert_eq!(layer(None), layer(None));
+        let (a, b) = (layer(Some((7, 0))), layer(Some((7, (nx * ny) as u64))));
+        let same = a.iter().zip(&b).filter(|(x, y)| x == y).count();
+        assert!(
+            same < nx * ny * 3 / 4,
+            "{same} of {} voxels repeat",
+            nx * ny
+        );
+        for out in [&a, &b] {
+            let share = out.iter().filter(|c| **c == 2).count() as f64 / (nx * ny) as f64;
+            assert!((share - 0.3).abs() < 0.01, "{share}");
+        }
+        assert_eq!(a, layer(Some((7, 0))), "the same seed and layer repeat");
     }
 }

@@ -44,6 +44,8 @@ pub struct ColorPlan {
     attr: Option<usize>,
     /// Wanted colour of each material slot (its table colour).
     materials: Vec<Ink>,
+    /// Seed of the diffusion's offsets (see [`diffuse`]).
+    seed: u64,
 }
 
 impl ColorPlan {
@@ -71,6 +73,7 @@ impl ColorPlan {
             clear,
             attr,
             materials: Vec::new(),
+            seed: p.seed,
         };
         plan.materials = palette(model)?
             .iter()
@@ -230,7 +233,9 @@ pub(crate) fn for_each_slab(
                     &slab.fracs[v * k..(v + layer) * k],
                 );
                 plan.wanted_layer(model, &grid, z0 + l, df, w, ins)?;
-                diffuse::diffuse_layer(grid.dims[0], w, ins, &plan.inks, c);
+                let first = ((z0 + l) * layer) as u64;
+                let jitter = Some((plan.seed, first));
+                diffuse::diffuse_layer(grid.dims[0], w, ins, &plan.inks, jitter, c);
                 Ok(())
             })
             .collect();
