@@ -24,7 +24,7 @@ mod tpms;
 mod union_index;
 
 pub use thin_gaps::{Gap, StatedGaps};
-pub use thin_sampled::{Sampled, SampledFeature};
+pub use thin_sampled::{GAP_BAND, Sampled, SampledFeature};
 pub use thinnest::{Feature, Thinnest};
 
 #[cfg(test)]
