@@ -370,30 +370,90 @@ impl SubGap for DVec3 {
     }
 }
 
+/// A gap the tree states, to be checked against the whole design: in the
+/// frame `frame`, the points `inside` must be inside the design and `mid`
+/// outside.
+struct Candidate {
+    width: f64,
+    frame: Frame,
+    inside: [DVec3; 2],
+    mid: DVec3,
+    /// The two solids' names (a gap between them), or the cutter's alone.
+    what: (&'static str, Option<&'static str>),
+}
+
+impl Candidate {
+    /// A gap between two solids of a union, nearest points `pa` and `pb`
+    /// (`g` apart) in the union's frame `f`.
+    fn between(a: &Solid, b: &Solid, (g, pa, pb): (f64, DVec3, DVec3), f: Frame) -> Candidate {
+        let u = (pb - pa) / g;
+        let e = 0.25 * g.min(thickness(a)).min(thickness(b));
+        Candidate {
+            width: g * f.s,
+            frame: f,
+            inside: [pa - u * e, pb + u * e],
+            mid: 0.5 * (pa + pb),
+            what: (a.name(), Some(b.name())),
+        }
+    }
+
+    /// The slot or hole a `Difference` cuts with `b`, when `b` is one solid.
+    fn slot(b: &Arc<PNode>, f: Frame) -> Option<Candidate> {
+        let (solids, others) = flatten(std::slice::from_ref(b))?;
+        let ([s], true) = (solids.as_slice(), others.is_empty()) else {
+            return None;
+        };
+        let (w, across, c) = s.slot();
+        let reach = across * (0.75 * w);
+        Some(Candidate {
+            width: w * f.s,
+            frame: f,
+            inside: [c + reach, c - reach],
+            mid: c,
+            what: (s.name(), None),
+        })
+    }
+}
+
 impl Model {
     /// The design's narrowest stated gap below `below` mm and its number of
     /// separate parts where the tree states them (see the module doc).
     /// Walks the tree with an explicit stack, each shared subtree once per
-    /// frame.
+    /// frame; checks at most [`VERIFIED`] gaps against the whole design,
+    /// narrowest first.
     pub fn stated_gaps(&self, below: f64) -> StatedGaps {
-        let mut out = StatedGaps::default();
+        let (candidates, parts) = self.gap_candidates(below);
+        let narrowest = candidates.into_iter().take(VERIFIED).find_map(|c| {
+            let f = &c.frame;
+            let open = c.inside.iter().all(|&p| self.distance(f.apply(p)) <= 0.0)
+                && self.distance(f.apply(c.mid)) > 0.0;
+            open.then(|| Gap {
+                width: c.width,
+                what: match c.what {
+                    (a, Some(b)) => format!("between {a} and {b}"),
+                    (cutter, None) => format!("a slot or hole cut by {cutter}"),
+                },
+                at: f.apply(c.mid),
+            })
+        });
+        StatedGaps { narrowest, parts }
+    }
+
+    /// Every stated gap below `below` mm, narrowest first (ties in the
+    /// walk's order), and the number of parts when the design is one union
+    /// of solids.
+    fn gap_candidates(&self, below: f64) -> (Vec<Candidate>, Option<usize>) {
+        let mut out = Vec::new();
+        let mut parts = None;
         let mut seen: HashSet<(*const PNode, [u64; 12])> = HashSet::new();
-        let mut stack: Vec<(&Arc<PNode>, Frame)> = vec![(&self.root, Frame::IDENTITY)];
-        let mut top = true;
-        let consider = |g: Gap, out: &mut StatedGaps| {
-            if out.narrowest.as_ref().is_none_or(|n| g.width < n.width) {
-                out.narrowest = Some(g);
-            }
-        };
-        while let Some((node, f)) = stack.pop() {
-            let is_top = std::mem::take(&mut top);
+        // (node, its frame, whether it is the design's top after moves)
+        let mut stack: Vec<(&Arc<PNode>, Frame, bool)> = vec![(&self.root, Frame::IDENTITY, true)];
+        while let Some((node, f, top)) = stack.pop() {
             if !seen.insert((Arc::as_ptr(node), f.key())) {
                 continue;
             }
             if Solid::of(node, &Frame::IDENTITY).is_some() {
-                if is_top {
-                    out.parts = Some(1);
-                }
+                parts = parts.or(top.then_some(1));
                 continue;
             }
             match node.as_ref() {
@@ -402,84 +462,33 @@ impl Model {
                         continue;
                     };
                     let (gaps, groups) = union_gaps(&solids, below / f.s);
-                    if is_top && others.is_empty() && n.smooth == 0.0 && !n.blend {
-                        out.parts = Some(groups);
+                    if top && others.is_empty() && n.smooth == 0.0 && !n.blend {
+                        parts = Some(groups);
                     }
-                    if let Some(g) = self.verify_union(&solids, &gaps, &f) {
-                        consider(g, &mut out);
-                    }
+                    out.extend(gaps.into_iter().map(|(g, i, j, pa, pb)| {
+                        Candidate::between(&solids[i], &solids[j], (g, pa, pb), f)
+                    }));
                     for (child, cf) in others {
-                        stack.push((child, compose(&f, &cf)));
+                        stack.push((child, compose(&f, &cf), false));
                     }
                 }
-                PNode::Intersection(n) => stack.extend(n.children.iter().map(|c| (c, f))),
+                PNode::Intersection(n) => stack.extend(n.children.iter().map(|c| (c, f, false))),
                 PNode::Difference { a, b, .. } => {
-                    if let Some(g) = self.verify_slot(b, &f).filter(|g| g.width < below) {
-                        consider(g, &mut out);
-                    }
-                    stack.push((a, f));
+                    out.extend(Candidate::slot(b, f).filter(|c| c.width < below));
+                    stack.push((a, f, false));
                 }
-                PNode::FGrade(g) => {
-                    top = is_top;
-                    stack.push((&g.child, f));
-                }
-                PNode::AttrGrade { child, .. } => {
-                    top = is_top;
-                    stack.push((child, f));
-                }
+                PNode::FGrade(g) => stack.push((&g.child, f, top)),
+                PNode::AttrGrade { child, .. } => stack.push((child, f, top)),
                 other => {
                     if let Some((cf, child)) = child_frame(other, &f) {
-                        top = is_top;
-                        stack.push((child, cf));
+                        stack.push((child, cf, top));
                     }
                 }
             }
         }
-        out
-    }
-
-    /// The narrowest of a union's gaps that the whole design keeps open.
-    fn verify_union(
-        &self,
-        solids: &[Solid],
-        gaps: &[(f64, usize, usize, DVec3, DVec3)],
-        f: &Frame,
-    ) -> Option<Gap> {
-        gaps.iter().take(VERIFIED).find_map(|&(g, i, j, pa, pb)| {
-            let u = (pb - pa) / g;
-            let e = 0.25 * g.min(thickness(&solids[i])).min(thickness(&solids[j]));
-            let mid = 0.5 * (pa + pb);
-            let open = self.distance(f.apply(pa - u * e)) <= 0.0
-                && self.distance(f.apply(pb + u * e)) <= 0.0
-                && self.distance(f.apply(mid)) > 0.0;
-            open.then(|| Gap {
-                width: g * f.s,
-                what: format!("between {} and {}", solids[i].name(), solids[j].name()),
-                at: f.apply(mid),
-            })
-        })
-    }
-
-    /// The slot or hole a `Difference` cuts with `b`, when `b` is one solid
-    /// and the design holds material on both sides of it.
-    fn verify_slot(&self, b: &Arc<PNode>, f: &Frame) -> Option<Gap> {
-        let (solids, others) = flatten(std::slice::from_ref(b))?;
-        let [s] = solids.as_slice() else {
-            return None;
-        };
-        if !others.is_empty() {
-            return None;
-        }
-        let (w, across, c) = s.slot();
-        let reach = across * (0.75 * w);
-        let open = self.distance(f.apply(c)) > 0.0
-            && self.distance(f.apply(c + reach)) <= 0.0
-            && self.distance(f.apply(c - reach)) <= 0.0;
-        open.then(|| Gap {
-            width: w * f.s,
-            what: format!("a slot or hole cut by {}", s.name()),
-            at: f.apply(c),
-        })
+        // Stable: equal widths keep the walk's order.
+        out.sort_by(|a, b| a.width.total_cmp(&b.width));
+        (out, parts)
     }
 }
 
