@@ -325,9 +325,13 @@ fn root(parent: &mut [usize], mut i: usize) -> usize {
     i
 }
 
+/// A gap between solids `i` and `j` of a union: its width and the nearest
+/// points on each.
+type PairGap = (f64, usize, usize, DVec3, DVec3);
+
 /// Gaps of one union's solids below `below` (mm in the union's frame),
 /// narrowest first, and the number of groups of touching solids.
-fn union_gaps(solids: &[Solid], below: f64) -> (Vec<(f64, usize, usize, DVec3, DVec3)>, usize) {
+fn union_gaps(solids: &[Solid], below: f64) -> (Vec<PairGap>, usize) {
     let boxes: Vec<Aabb> = solids.iter().map(Solid::bbox).collect();
     let mut parent: Vec<usize> = (0..solids.len()).collect();
     let mut gaps = Vec::new();
