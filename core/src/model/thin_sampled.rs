@@ -222,9 +222,10 @@ fn shortest(
 /// Samples per side of the blocks that [`sample`] bounds before sampling.
 const BLOCK: usize = 8;
 
-/// The distance at every grid point, x fastest. A block of samples whose
-/// distance interval lies wholly beyond [`GAP_BAND`] spacings outside is
-/// filled with the interval's lower end instead: ridge points are inside
+/// The distance at every grid point, x fastest. A block of samples (or an
+/// octant of a block that is not) whose distance interval lies wholly
+/// beyond [`GAP_BAND`] spacings outside is filled with the interval's
+/// lower end instead: ridge points are inside
 /// samples compared with their neighbours, and any positive value outside
 /// compares the same; gap points lie within the band.
 fn sample(model: &Model, g: &Grid) -> Vec<f64> {
@@ -242,9 +243,31 @@ fn sample(model: &Model, g: &Grid) -> Vec<f64> {
             );
             let bounds = Aabb::new(g.at(i0, j0, k0), g.at(i1 - 1, j1 - 1, k1 - 1));
             let lo = model.interval(&bounds).lo;
-            let at = |(i, j, k)| {
-                if lo > band {
-                    lo
+            // A block near the surface is bounded again by its eight
+            // octants, whose tighter intervals fill more of the band.
+            let mut octants = [lo; 8];
+            if lo <= band {
+                let half = BLOCK / 2;
+                for (o, v) in octants.iter_mut().enumerate() {
+                    let (a0, b0, c0) =
+                        (i0 + o % 2 * half, j0 + o / 2 % 2 * half, k0 + o / 4 * half);
+                    if a0 < i1 && b0 < j1 && c0 < k1 {
+                        let (a1, b1, c1) = (
+                            (a0 + half).min(i1),
+                            (b0 + half).min(j1),
+                            (c0 + half).min(k1),
+                        );
+                        *v = model
+                            .interval(&Aabb::new(g.at(a0, b0, c0), g.at(a1 - 1, b1 - 1, c1 - 1)))
+                            .lo;
+                    }
+                }
+            }
+            let at = |(i, j, k): (usize, usize, usize)| {
+                let half = BLOCK / 2;
+                let o = (i - i0) / half + 2 * ((j - j0) / half) + 4 * ((k - k0) / half);
+                if octants[o] > band {
+                    octants[o]
                 } else {
                     model.distance(g.at(i, j, k))
                 }
@@ -335,7 +358,11 @@ fn gap_points(g: &Grid, d: &[f64], bound: bool) -> Vec<(f64, usize)> {
     let band = GAP_BAND * g.h;
     shallowest(scan(g, |idx| {
         let v = d[idx];
-        if !(v > 0.0 && v <= band) {
+        // A gap of at least `2 h` has a sample within `h / 2` of its
+        // middle plane, at least `h / 2` from both sides: nearer samples
+        // of a distance are the surface's, not a gap's.
+        let least = if bound { 0.5 * g.h } else { 0.0 };
+        if !(v > least && v <= band) {
             return None;
         }
         let (mut central, mut sides) = (0.0, 0.0);
@@ -423,8 +450,18 @@ fn thinnest_chord(model: &Model, p: DVec3, h: f64, bound: bool, side: Side) -> (
 /// gap).
 fn exit(model: &Model, p: DVec3, u: DVec3, h: f64, bound: bool, side: Side) -> f64 {
     let min_step = h / 8.0;
+    // Outside, a gap's half-chord through a point within the band is at
+    // most about the band's width; longer ones are no gap, and stepping
+    // through open space past them would cost most of the estimate.
+    let reach = match side {
+        Side::Inside => f64::INFINITY,
+        Side::Outside => 2.0 * GAP_BAND * h,
+    };
     let (mut before, mut t) = (0.0, 0.0);
     for _ in 0..MAX_STEPS {
+        if t > reach {
+            break;
+        }
         let v = model.distance(p + u * t);
         if side.crossed(v) {
             let mut after = t;
