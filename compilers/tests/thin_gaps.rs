@@ -5,47 +5,12 @@
 
 mod common;
 
-use std::path::Path;
-use std::sync::Arc;
-
-use common::{model, run, scratch};
-use glam::DVec3;
-use volcad_compilers::Summary;
-use volcad_compilers::mesh::{MeshFormats, MeshParams, export_meshes};
+use common::{mesh_design, mesh_stl, model, scratch};
 use volcad_compilers::thin::thin_feature_notes;
-use volcad_core::Model;
-use volcad_core::script::{ScriptOptions, model_of};
 
 /// Two spheres of radius 1 mm, 0.2 mm apart.
 const SPHERES: &str = r#"let m = default_materials();
 Union(false, [Sphere(Vec3(0, 0, 0), 1, m.id("gray")), Sphere(Vec3(2.2, 0, 0), 1, m.id("gray"))])"#;
-
-/// A design of one mesh from the test data.
-// A test helper: a design that fails to prepare fails the test.
-#[allow(clippy::expect_used)]
-fn mesh_design(name: &str) -> Arc<Model> {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/t.rhai");
-    let src = format!(r#"Mesh("{name}", default_materials().id("gray"))"#);
-    Arc::new(model_of(&src, "t.rhai", &ScriptOptions::for_file(&script)).expect("design prepares"))
-}
-
-// A failed export fails the test.
-#[allow(clippy::expect_used)]
-fn mesh(m: &Arc<Model>, voxel: f64, dir: &Path) -> Summary {
-    let (m, p) = (
-        m.clone(),
-        MeshParams {
-            voxel: DVec3::splat(voxel),
-            formats: MeshFormats {
-                stl: true,
-                obj: false,
-                threemf: false,
-            },
-            ..MeshParams::default()
-        },
-    );
-    run(dir, move |ctx| export_meshes(&m, &p, ctx)).expect("mesh export")
-}
 
 /// The voxel a note suggests: `--voxel V keeps it open`.
 fn suggested(note: &str) -> Option<f64> {
@@ -61,7 +26,7 @@ fn warnings(notes: &[String]) -> Vec<&String> {
 fn two_spheres_a_fifth_of_a_millimetre_apart_warn_at_half_a_millimetre() {
     let m = model(SPHERES);
     let (_t, dir) = scratch("mesh");
-    let s = mesh(&m, 0.5, &dir);
+    let s = mesh_stl(&m, 0.5, &dir);
     let w = warnings(&s.notes);
     let gap = "a gap between parts about 0.2 mm across (between a sphere and a sphere near (1.1, 0, 0) mm) is narrower than two cells of --voxel 0.5: it can close and join the parts on either side; --voxel 0.1 keeps it open";
     assert!(w.iter().any(|n| n.ends_with(gap)), "{w:?}");
@@ -78,7 +43,7 @@ Union(false, [RectPrism(Vec3(0, 0, 0), Vec3(2, 2, 2), m.id("gray")), RectPrism(V
     // The box is 4 mm long, 8 voxels: their centres fall at 0.75 and
     // 1.25 mm, on either side of the gap from 1 to 1.2 mm.
     let (_t, dir) = scratch("mesh");
-    let s = mesh(&m, 0.5, &dir);
+    let s = mesh_stl(&m, 0.5, &dir);
     assert!(
         s.notes
             .iter()
@@ -96,7 +61,7 @@ Union(false, [RectPrism(Vec3(0, 0, 0), Vec3(2, 2, 2), m.id("gray")), RectPrism(V
 fn two_spheres_a_fifth_of_a_millimetre_apart_stay_two_bodies_at_five_hundredths() {
     let m = model(SPHERES);
     let (_t, dir) = scratch("mesh");
-    let s = mesh(&m, 0.05, &dir);
+    let s = mesh_stl(&m, 0.05, &dir);
     assert!(warnings(&s.notes).is_empty(), "{:?}", s.notes);
     assert!(
         s.notes
@@ -131,7 +96,7 @@ fn a_mesh_of_two_plates_with_a_slot_warns_by_sampling() {
     assert!((g.thickness - 0.3).abs() < 0.01, "{g:?}");
     assert!((g.at.x - 10.15).abs() < s.spacing, "{g:?}");
     let (_t, dir) = scratch("mesh");
-    let summary = mesh(&m, 0.5, &dir);
+    let summary = mesh_stl(&m, 0.5, &dir);
     let w = warnings(&summary.notes);
     assert!(
         w.iter().any(|n| n

@@ -40,5 +40,8 @@ fn two_spheres_a_fifth_of_a_millimetre_apart_warn_at_half_a_millimetre_only() {
     let (said, manifest) = export("0.05", "fine");
     assert!(!said.contains("a gap between parts"), "{said}");
     assert!(!manifest.contains("a gap between parts"), "{manifest}");
-    assert!(said.contains("bodies: 2 (the design has 2 separate parts)"), "{said}");
+    assert!(
+        said.contains("bodies: 2 (the design has 2 separate parts)"),
+        "{said}"
+    );
 }
