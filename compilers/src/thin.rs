@@ -10,6 +10,7 @@
 //! the volume gone; at 0.25 mm, one body).
 
 use volcad_core::Model;
+use volcad_core::model::{GAP_BAND, Sampled, Thinnest};
 
 /// Cells across the thinnest feature that resolve it.
 pub const CELLS_ACROSS: f64 = 2.0;
@@ -43,11 +44,11 @@ fn two_digits(x: f64, round: fn(f64) -> f64) -> f64 {
 }
 
 /// A `warning: …` line when cells of `size` mm (set by `option`) cannot
-/// resolve the design's thinnest feature, naming the size that would; a
-/// plain note when the design holds geometry whose thickness is not stated
-/// (measured by sampling, [`Model::sampled_thinnest`], or not at all when
-/// the design is unbounded). Designs whose thickness is all stated are
-/// not sampled.
+/// resolve the design's thinnest feature or keep its narrowest gap open,
+/// naming the size that would; a plain note when the design holds geometry
+/// whose thickness is not stated (measured by sampling,
+/// [`Model::sampled_thinnest`], or not at all when the design is
+/// unbounded). Designs whose thickness is all stated are not sampled.
 pub fn thin_feature_notes(model: &Model, size: f64, option: &str) -> Vec<String> {
     let t = model.thinnest_feature();
     // A sampled feature is at least `2 h` thick and warns only when it is
@@ -60,54 +61,123 @@ pub fn thin_feature_notes(model: &Model, size: f64, option: &str) -> Vec<String>
     } else {
         model.sampled_thinnest()
     };
+    let mut out = Vec::new();
+    out.extend(wall_note(&t, sampled, size, option));
+    out.extend(gap_note(model, sampled, size, option));
+    if !t.unknown.is_empty() {
+        out.push(unknown_note(&t, sampled, spacing, size, option));
+    }
+    out
+}
+
+/// The cell size limit for a feature or gap `width` mm across: two cells
+/// across it. A gap closes by the same rule a wall vanishes: with fewer
+/// than two cells across, the cell centres can all fall on its sides
+/// along part of its length, and the contour joins them there.
+fn limit(width: f64) -> f64 {
+    width / CELLS_ACROSS
+}
+
+/// A point for messages, to a tenth of a millimetre (and no `-0`).
+fn near(at: glam::DVec3) -> String {
+    let [x, y, z] = at.to_array().map(|v| (v * 10.0).round() / 10.0 + 0.0);
+    format!("({x}, {y}, {z}) mm")
+}
+
+/// The warning for the thinnest wall or strut, stated or sampled.
+fn wall_note(t: &Thinnest, sampled: Option<&Sampled>, size: f64, option: &str) -> Option<String> {
     let found = sampled.and_then(|s| s.feature.as_ref().map(|f| (s.spacing, f)));
     let stated = t.feature.as_ref();
-    let limit = |thickness: f64| thickness / CELLS_ACROSS;
-    let mut out = Vec::new();
     match (stated, found) {
         (_, Some((h, f)))
             if stated.is_none_or(|s| f.thickness < s.thickness) && size > limit(f.thickness) =>
         {
-            let [x, y, z] = f.at.to_array().map(|v| (v * 10.0).round() / 10.0 + 0.0);
-            out.push(format!(
-                "warning: the design's thinnest feature (a wall or strut of {} about {} mm across near ({x}, {y}, {z}) mm, measured by sampling every {} mm) is narrower than two cells of {option} {size}: it can vanish or break into loose pieces; {option} {} resolves it",
+            Some(format!(
+                "warning: the design's thinnest feature (a wall or strut of {} about {} mm across near {}, measured by sampling every {} mm) is narrower than two cells of {option} {size}: it can vanish or break into loose pieces; {option} {} resolves it",
                 t.unknown.join(" or "),
                 two_digits(f.thickness, f64::round),
+                near(f.at),
                 size_above(h),
                 size_below(limit(f.thickness))
-            ));
+            ))
         }
-        (Some(f), _) if size > limit(f.thickness) => out.push(format!(
+        (Some(f), _) if size > limit(f.thickness) => Some(format!(
             "warning: the design's thinnest feature ({} mm, {} mm across) is narrower than two cells of {option} {size}: it can vanish or break into loose pieces; {option} {} resolves it",
             f.what,
             f.thickness,
             size_below(limit(f.thickness))
         )),
-        _ => {}
+        _ => None,
     }
-    if !t.unknown.is_empty() {
-        out.push(match sampled {
-            Some(s) => format!(
-                "thin features of {} were measured by sampling every {} mm: features thinner than {} mm are not checked against {option} {size}",
+}
+
+/// The warning for the narrowest gap between parts (or slot), stated by
+/// the tree ([`Model::stated_gaps`]) or found by sampling.
+fn gap_note(model: &Model, sampled: Option<&Sampled>, size: f64, option: &str) -> Option<String> {
+    let stated = model.stated_gaps(CELLS_ACROSS * size).narrowest;
+    let found = sampled.and_then(|s| s.gap.as_ref().map(|g| (s.spacing, g)));
+    let (width, what) = match (stated, found) {
+        (Some(s), Some((_, g))) if s.width <= g.thickness => {
+            (s.width, format!("{} near {}", s.what, near(s.at)))
+        }
+        (_, Some((h, g))) => (
+            g.thickness,
+            format!(
+                "near {}, measured by sampling every {} mm",
+                near(g.at),
+                size_above(h)
+            ),
+        ),
+        (stated, None) => {
+            let s = stated?;
+            (s.width, format!("{} near {}", s.what, near(s.at)))
+        }
+    };
+    (size > limit(width)).then(|| format!(
+        "warning: a gap between parts about {} mm across ({what}) is narrower than two cells of {option} {size}: it can close and join the parts on either side; {option} {} keeps it open",
+        two_digits(width, f64::round),
+        size_below(limit(width))
+    ))
+}
+
+/// Which geometry was measured by sampling, at what spacing, or why not.
+fn unknown_note(
+    t: &Thinnest,
+    sampled: Option<&Sampled>,
+    spacing: Option<f64>,
+    size: f64,
+    option: &str,
+) -> String {
+    match sampled {
+        Some(s) => {
+            // Gaps are sampled within a band of the surface; wider ones
+            // matter only to cells larger than half the band's width.
+            let wide = 2.0 * GAP_BAND * s.spacing;
+            let gaps = if CELLS_ACROSS * size > wide {
+                format!(" (nor gaps wider than {} mm)", size_below(wide))
+            } else {
+                String::new()
+            };
+            format!(
+                "thin features of {} were measured by sampling every {} mm: features thinner than {} mm are not checked against {option} {size}{gaps}",
                 t.unknown.join(" and "),
                 size_above(s.spacing),
-                size_above(3.0 * s.spacing)
+                size_above(3.0 * s.spacing),
+            )
+        }
+        None => match spacing {
+            Some(h) => format!(
+                "thin features of {} were not sampled: sampling every {} mm finds features down to {} mm, which {option} {size} resolves",
+                t.unknown.join(" and "),
+                size_above(h),
+                size_above(2.0 * h)
             ),
-            None => match spacing {
-                Some(h) => format!(
-                    "thin features of {} were not sampled: sampling every {} mm finds features down to {} mm, which {option} {size} resolves",
-                    t.unknown.join(" and "),
-                    size_above(h),
-                    size_above(2.0 * h)
-                ),
-                None => format!(
-                    "thin features of {} are not checked against {option} {size} (their thickness is not stated in the design, and it is unbounded, so it cannot be sampled)",
-                    t.unknown.join(" and ")
-                ),
-            },
-        });
+            None => format!(
+                "thin features of {} are not checked against {option} {size} (their thickness is not stated in the design, and it is unbounded, so it cannot be sampled)",
+                t.unknown.join(" and ")
+            ),
+        },
     }
-    out
 }
 
 #[cfg(test)]

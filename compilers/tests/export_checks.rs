@@ -12,32 +12,14 @@ use std::path::Path;
 use std::process::Command;
 use std::sync::Arc;
 
-use common::{model, run, scratch};
-use glam::DVec3;
+use common::{mesh_stl, model, run, scratch};
 use volcad_compilers::fea::{Element, EndSets, FeaParams, StepParams, export_fea, read_frd};
-use volcad_compilers::mesh::{MeshFormats, MeshParams, export_meshes};
 use volcad_compilers::{ExportError, Summary};
 use volcad_core::Model;
 
 fn bcc_sphere() -> Arc<Model> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/examples/bcc_sphere.rhai");
     model(&std::fs::read_to_string(path).expect("the example design"))
-}
-
-fn mesh(m: &Arc<Model>, voxel: f64, dir: &Path) -> Summary {
-    let (m, p) = (
-        m.clone(),
-        MeshParams {
-            voxel: DVec3::splat(voxel),
-            formats: MeshFormats {
-                stl: true,
-                obj: false,
-                threemf: false,
-            },
-            ..MeshParams::default()
-        },
-    );
-    run(dir, move |ctx| export_meshes(&m, &p, ctx)).expect("mesh export")
 }
 
 fn bricks(voxel: f64) -> FeaParams {
@@ -64,7 +46,7 @@ fn warnings(s: &Summary) -> Vec<&String> {
 fn bcc_sphere_at_half_a_millimetre_warns_and_names_the_voxel_that_resolves_it() {
     let m = bcc_sphere();
     let (_t, dir) = scratch("mesh");
-    let s = mesh(&m, 0.5, &dir);
+    let s = mesh_stl(&m, 0.5, &dir);
     let w = warnings(&s);
     assert!(
         w.iter()
@@ -89,7 +71,7 @@ fn bcc_sphere_at_half_a_millimetre_warns_and_names_the_voxel_that_resolves_it() 
 fn bcc_sphere_at_a_quarter_millimetre_is_one_body_without_warnings() {
     let m = bcc_sphere();
     let (_t, dir) = scratch("mesh");
-    let s = mesh(&m, 0.25, &dir);
+    let s = mesh_stl(&m, 0.25, &dir);
     assert!(s.notes.iter().any(|n| n == "bodies: 1"), "{:?}", s.notes);
     assert!(warnings(&s).is_empty(), "{:?}", s.notes);
     let shape = s

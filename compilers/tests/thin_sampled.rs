@@ -4,24 +4,11 @@
 
 mod common;
 
-use std::path::Path;
 use std::sync::Arc;
 
-use common::{model, run, scratch};
-use glam::DVec3;
-use volcad_compilers::mesh::{MeshFormats, MeshParams, export_meshes};
+use common::{mesh_design, mesh_stl, model, scratch};
 use volcad_compilers::thin::thin_feature_notes;
 use volcad_core::Model;
-use volcad_core::script::{ScriptOptions, model_of};
-
-/// A design of one mesh from the test data.
-// A test helper: a design that fails to prepare fails the test.
-#[allow(clippy::expect_used)]
-fn mesh_design(name: &str) -> Arc<Model> {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/t.rhai");
-    let src = format!(r#"Mesh("{name}", default_materials().id("gray"))"#);
-    Arc::new(model_of(&src, "t.rhai", &ScriptOptions::for_file(&script)).expect("design prepares"))
-}
 
 /// A gyroid sheet about 0.3 mm thick (|g| < 0.2, |grad g| up to about
 /// 1.5), clipped to a 10 mm cube.
@@ -43,17 +30,7 @@ fn a_thin_mesh_plate_warns_at_half_a_millimetre_and_not_at_a_tenth() {
     assert!((f.thickness - 0.3).abs() < 0.01, "{f:?}");
 
     let (_t, dir) = scratch("mesh");
-    let p = MeshParams {
-        voxel: DVec3::splat(0.5),
-        formats: MeshFormats {
-            stl: true,
-            obj: false,
-            threemf: false,
-        },
-        ..MeshParams::default()
-    };
-    let mm = m.clone();
-    let summary = run(&dir, move |ctx| export_meshes(&mm, &p, ctx)).expect("mesh export");
+    let summary = mesh_stl(&m, 0.5, &dir);
     let w = warnings(&summary.notes);
     assert!(
         w.iter().any(|n| n.contains("a mesh about 0.3 mm across")

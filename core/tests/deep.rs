@@ -69,6 +69,9 @@ fn exercise(root: Node, p: DVec3, want: f64) {
         }
     }
     m.constant_fractions(&b);
+    // The thin-feature and gap walks of the exports' checks.
+    m.thinnest_feature();
+    m.stated_gaps(1.0);
     drop(m);
     drop(root);
 }

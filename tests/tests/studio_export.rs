@@ -147,6 +147,24 @@ fn an_empty_slice_stack_is_reported_as_a_warning() {
 }
 
 #[test]
+fn a_gap_the_voxel_closes_is_named_in_the_panel_and_the_job_list() {
+    // Two spheres 0.2 mm apart: 0.5 mm voxels can close the gap.
+    let spheres = "let m = default_materials();\nUnion(false, [Sphere(Vec3(0,0,0), 1, m.id(\"red\")), Sphere(Vec3(2.2,0,0), 1, m.id(\"red\"))])\n";
+    let (scratch, mut h) = studio(spheres, "gap");
+    wait_idle(&mut h);
+    let out = scratch.path().join("stack");
+    set_output_folder(&mut h, &out);
+    set_png_voxel(&mut h, 0.5);
+    wait_label(&mut h, "Estimate:");
+    let gap = "a gap between parts about 0.2 mm across";
+    let before = h.get_all_by_label_contains(gap).count();
+    assert!(before >= 1, "the panel's pre-flight warning");
+    export_to_the_end(&mut h, "Export PNG stack");
+    let after = h.get_all_by_label_contains(gap).count();
+    assert!(after > before, "the job list names the gap too");
+}
+
+#[test]
 fn mesh_and_fea_exports_run_from_their_panels() {
     let (scratch, mut h) = studio(BAR, "mesh-fea");
     let dir = scratch.path();

@@ -603,7 +603,9 @@ pub fn export_meshes(
         );
         let mut s = summary(model, p, &pl, &segs, files?, &checks);
         s.notes.extend(thin);
-        s.notes.extend(body_notes(&bodies, p.voxel.max_element()));
+        let design = model.stated_gaps(crate::thin::CELLS_ACROSS * p.voxel.max_element());
+        s.notes
+            .extend(body_notes(&bodies, p.voxel.max_element(), &design));
         Ok(s)
     })
 }

@@ -8,6 +8,7 @@ use std::io::{BufWriter, Write};
 use rayon::prelude::*;
 use serde_json::json;
 use volcad_core::Model;
+use volcad_core::model::StatedGaps;
 
 use super::{DEFAULT_INFILL, MeshParams, Plan, SegmentBy, SegmentMesh, bodies, obj, stl, threemf};
 use crate::job::{ExportError, JobContext, Summary};
@@ -87,16 +88,40 @@ pub(super) fn write_files(
         .collect()
 }
 
-/// The body count, and a warning when the part fell into several bodies.
-pub(super) fn body_notes(b: &bodies::Bodies, voxel: f64) -> Vec<String> {
+/// The body count, and a warning when the part fell into more bodies than
+/// the design has parts (thin features broke apart), or into fewer (a gap
+/// between parts closed), where the design states its parts
+/// ([`volcad_core::Model::stated_gaps`]).
+pub(super) fn body_notes(b: &bodies::Bodies, voxel: f64, design: &StatedGaps) -> Vec<String> {
     let total: f64 = b.volumes.iter().sum();
-    let mut out = vec![format!("bodies: {}", b.count())];
-    if b.count() > 1 {
+    let n = b.count();
+    let mut out = vec![match design.parts {
+        Some(parts) if parts > 1 => format!("bodies: {n} (the design has {parts} separate parts)"),
+        _ => format!("bodies: {n}"),
+    }];
+    let parts = design.parts.unwrap_or(1);
+    if n > parts {
+        let design = if parts > 1 {
+            format!("a design of {parts} parts")
+        } else {
+            "a design in one piece".into()
+        };
         out.push(format!(
-            "warning: the part is {} separate bodies (the largest holds {:.1} % of the volume); a design in one piece has features thinner than about two voxels of {voxel} mm that broke apart: use a smaller --voxel",
-            b.count(),
+            "warning: the part is {n} separate bodies (the largest holds {:.1} % of the volume); {design} has features thinner than about two voxels of {voxel} mm that broke apart: use a smaller --voxel",
             100.0 * b.volumes[0] / total.max(f64::MIN_POSITIVE)
         ));
+    } else if design.parts.is_some_and(|parts| n < parts) {
+        let bodies = if n == 1 { "body" } else { "bodies" };
+        out.push(match &design.narrowest {
+            Some(g) => format!(
+                "warning: {parts} parts of the design merged into {n} {bodies}: the gap between them, {} mm, is narrower than two voxels of {voxel} mm; --voxel {} keeps them apart",
+                crate::thin::size_above(g.width),
+                crate::thin::size_below(g.width / crate::thin::CELLS_ACROSS)
+            ),
+            None => format!(
+                "warning: {parts} parts of the design merged into {n} {bodies}: a gap between them is too narrow for voxels of {voxel} mm: use a smaller --voxel"
+            ),
+        });
     }
     out
 }

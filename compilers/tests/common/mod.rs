@@ -11,6 +11,7 @@ use std::process::Command;
 use std::sync::Arc;
 
 use volcad_compilers::job::{self, JobContext};
+use volcad_compilers::mesh::{MeshFormats, MeshParams, export_meshes};
 use volcad_compilers::{ExportError, Summary};
 use volcad_core::Model;
 use volcad_core::script::{ScriptOptions, model_of};
@@ -18,6 +19,30 @@ use volcad_core::script::{ScriptOptions, model_of};
 /// The prepared model of a Rhai design.
 pub fn model(src: &str) -> Arc<Model> {
     Arc::new(model_of(src, "t.rhai", &ScriptOptions::default()).expect("design prepares"))
+}
+
+/// A design of one mesh from the test data (`tests/data/NAME`).
+pub fn mesh_design(name: &str) -> Arc<Model> {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/t.rhai");
+    let src = format!(r#"Mesh("{name}", default_materials().id("gray"))"#);
+    Arc::new(model_of(&src, "t.rhai", &ScriptOptions::for_file(&script)).expect("design prepares"))
+}
+
+/// A mesh export of `m` at `voxel` mm, STL files only, into `dir`.
+pub fn mesh_stl(m: &Arc<Model>, voxel: f64, dir: &Path) -> Summary {
+    let (m, p) = (
+        m.clone(),
+        MeshParams {
+            voxel: glam::DVec3::splat(voxel),
+            formats: MeshFormats {
+                stl: true,
+                obj: false,
+                threemf: false,
+            },
+            ..MeshParams::default()
+        },
+    );
+    run(dir, move |ctx| export_meshes(&m, &p, ctx)).expect("mesh export")
 }
 
 /// Run `work` as a job writing to `dest`, and wait.

@@ -17,12 +17,14 @@ mod prepare;
 pub(crate) mod sdf;
 mod shapes;
 mod strut_grid;
+mod thin_gaps;
 mod thin_sampled;
 mod thinnest;
 mod tpms;
 mod union_index;
 
-pub use thin_sampled::{Sampled, SampledFeature};
+pub use thin_gaps::{Gap, StatedGaps};
+pub use thin_sampled::{GAP_BAND, Sampled, SampledFeature};
 pub use thinnest::{Feature, Thinnest};
 
 #[cfg(test)]

@@ -26,6 +26,16 @@
 //!    measured; a thinner one only when a sample falls near its middle,
 //!    and nothing thinner than `2 h` is reported: the note says so.
 //!
+//! Gaps between parts are measured the same way on the outside: the
+//! middle of a gap is where the outside distance has a crease with
+//! opposite slopes (its gradient on the grid nearly vanishes); the chord
+//! through empty space from one surface to the other, along a direction
+//! that meets both surfaces square (within 25°), is the gap's width. A
+//! concave corner's crease has a gradient of at least `cos 45°` and meets
+//! its walls at 45°, so it is never taken for a gap. Only the outside
+//! within [`GAP_BAND`] spacings of the surface is sampled exactly: gaps up
+//! to twice that are measured.
+//!
 //! Chords step by the distance where it is a bound (1-Lipschitz) and by
 //! `h / 4` elsewhere, so a math-string field is crossed, not jumped over.
 //! Every stage collects in index order and ties break by index: the result
@@ -46,6 +56,23 @@ pub const CANDIDATES: usize = 2048;
 
 /// Most steps of one half-chord; past them the chord counts as thick.
 const MAX_STEPS: usize = 256;
+
+/// Spacings outside the surface that are sampled exactly for gaps: a
+/// block of samples whose distance is certainly larger is filled with its
+/// lower bound (it holds no gap narrower than twice this).
+pub const GAP_BAND: f64 = 4.0;
+
+/// Largest grid gradient of the outside distance at a gap's middle: a
+/// sample within `h / 2` of the middle plane has a central difference of
+/// at most `1/2` across it, and one on a concave corner's crease at least
+/// `cos 45°`. For a distance that is not a bound the same test is made
+/// relative to the one-sided differences, whose scale is the field's.
+const GAP_GRADIENT: f64 = 0.6;
+
+/// Least `|cos|` between a gap's chord and the surface normal at each of
+/// its ends (25°): the two sides of a gap face each other; a concave
+/// corner's walls meet a chord through its crease at 45°.
+const SQUARE: f64 = 0.9;
 
 /// Bisection steps refining each exit: to within `h / 4 / 2^12`, far
 /// below `h` (an exit is crossed by a step of at most `h / 4`).
@@ -70,6 +97,27 @@ pub struct Sampled {
     /// The thinnest feature of at least `2 spacing`, if the design has
     /// one at this spacing.
     pub feature: Option<SampledFeature>,
+    /// The narrowest gap between surfaces (empty space between two parts,
+    /// or a slot) of at least `2 spacing`, if sampling found one.
+    pub gap: Option<SampledFeature>,
+}
+
+/// Which side of the surface a chord crosses: the solid (walls and
+/// struts) or the empty space around it (gaps).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Side {
+    Inside,
+    Outside,
+}
+
+impl Side {
+    /// True once a chord from this side has crossed the surface.
+    fn crossed(self, v: f64) -> bool {
+        match self {
+            Side::Inside => v > 0.0,
+            Side::Outside => v <= 0.0,
+        }
+    }
 }
 
 /// The sampling grid: `dims` samples from `origin`, `h` apart.
@@ -136,38 +184,54 @@ impl Model {
             .get_or_init(|| {
                 let g = Grid::over(&self.bbox)?;
                 let d = sample(self, &g);
-                let ridges = ridge_points(&g, &d);
                 let bound = self.distance_is_bound();
-                let feature = ridges
-                    .par_iter()
-                    .filter_map(|&(_, idx)| {
-                        let (chord, near) = thinnest_chord(self, g.point(idx), g.h, bound);
-                        (near >= g.h).then_some((chord, idx))
-                    })
-                    .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
-                    .map(|(thickness, idx)| SampledFeature {
-                        thickness,
-                        at: g.point(idx),
-                    });
+                let feature = shortest(self, &g, &ridge_points(&g, &d), bound, Side::Inside);
+                let gap = shortest(self, &g, &gap_points(&g, &d, bound), bound, Side::Outside);
                 Some(Sampled {
                     spacing: g.h,
                     feature,
+                    gap,
                 })
             })
             .as_ref()
     }
 }
 
+/// The shortest chord on `side` through the candidates at least `h` from
+/// the surface (their nearest exit), ties broken by index.
+fn shortest(
+    model: &Model,
+    g: &Grid,
+    candidates: &[(f64, usize)],
+    bound: bool,
+    side: Side,
+) -> Option<SampledFeature> {
+    candidates
+        .par_iter()
+        .filter_map(|&(_, idx)| {
+            let (chord, near) = thinnest_chord(model, g.point(idx), g.h, bound, side);
+            (near >= g.h && chord.is_finite()).then_some((chord, idx))
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
+        .map(|(thickness, idx)| SampledFeature {
+            thickness,
+            at: g.point(idx),
+        })
+}
+
 /// Samples per side of the blocks that [`sample`] bounds before sampling.
 const BLOCK: usize = 8;
 
-/// The distance at every grid point, x fastest. A block of samples whose
-/// distance interval lies wholly outside is filled with the interval's
-/// lower end instead: ridge points are inside samples compared with their
-/// neighbours, and any positive value outside compares the same.
+/// The distance at every grid point, x fastest. A block of samples (or an
+/// octant of a block that is not) whose distance interval lies wholly
+/// beyond [`GAP_BAND`] spacings outside is filled with the interval's
+/// lower end instead: ridge points are inside
+/// samples compared with their neighbours, and any positive value outside
+/// compares the same; gap points lie within the band.
 fn sample(model: &Model, g: &Grid) -> Vec<f64> {
     let [nx, ny, nz] = g.dims;
     let [bx, by, bz] = g.dims.map(|n| n.div_ceil(BLOCK));
+    let band = GAP_BAND * g.h;
     let blocks: Vec<Vec<f64>> = (0..bx * by * bz)
         .into_par_iter()
         .map(|b| {
@@ -179,9 +243,31 @@ fn sample(model: &Model, g: &Grid) -> Vec<f64> {
             );
             let bounds = Aabb::new(g.at(i0, j0, k0), g.at(i1 - 1, j1 - 1, k1 - 1));
             let lo = model.interval(&bounds).lo;
-            let at = |(i, j, k)| {
-                if lo > 0.0 {
-                    lo
+            // A block near the surface is bounded again by its eight
+            // octants, whose tighter intervals fill more of the band.
+            let mut octants = [lo; 8];
+            if lo <= band {
+                let half = BLOCK / 2;
+                for (o, v) in octants.iter_mut().enumerate() {
+                    let (a0, b0, c0) =
+                        (i0 + o % 2 * half, j0 + o / 2 % 2 * half, k0 + o / 4 * half);
+                    if a0 < i1 && b0 < j1 && c0 < k1 {
+                        let (a1, b1, c1) = (
+                            (a0 + half).min(i1),
+                            (b0 + half).min(j1),
+                            (c0 + half).min(k1),
+                        );
+                        *v = model
+                            .interval(&Aabb::new(g.at(a0, b0, c0), g.at(a1 - 1, b1 - 1, c1 - 1)))
+                            .lo;
+                    }
+                }
+            }
+            let at = |(i, j, k): (usize, usize, usize)| {
+                let half = BLOCK / 2;
+                let o = (i - i0) / half + 2 * ((j - j0) / half) + 4 * ((k - k0) / half);
+                if octants[o] > band {
+                    octants[o]
                 } else {
                     model.distance(g.at(i, j, k))
                 }
@@ -206,10 +292,34 @@ fn sample(model: &Model, g: &Grid) -> Vec<f64> {
     d
 }
 
+/// The [`CANDIDATES`] shallowest of `found` (depth, index), ordered by
+/// depth then index.
+fn shallowest(mut found: Vec<(f64, usize)>) -> Vec<(f64, usize)> {
+    found.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    found.truncate(CANDIDATES);
+    found
+}
+
+/// `test(idx)` at every sample off the grid's border, in index order.
+fn scan<F>(g: &Grid, test: F) -> Vec<(f64, usize)>
+where
+    F: Fn(usize) -> Option<(f64, usize)> + Sync,
+{
+    let [nx, ny, nz] = g.dims;
+    (1..nz.saturating_sub(1))
+        .into_par_iter()
+        .flat_map_iter(|k| {
+            let test = &test;
+            (1..ny - 1)
+                .flat_map(move |j| (1..nx - 1).filter_map(move |i| test(i + nx * (j + ny * k))))
+        })
+        .collect()
+}
+
 /// The [`CANDIDATES`] shallowest ridge points as (depth, index), ordered
 /// by depth then index.
 fn ridge_points(g: &Grid, d: &[f64]) -> Vec<(f64, usize)> {
-    let [nx, ny, nz] = g.dims;
+    let [nx, ny, _] = g.dims;
     let (sx, sy) = (1isize, nx as isize);
     let sz = (nx * ny) as isize;
     let mut offsets = Vec::with_capacity(26);
@@ -222,46 +332,61 @@ fn ridge_points(g: &Grid, d: &[f64]) -> Vec<(f64, usize)> {
             }
         }
     }
-    let mut ridges: Vec<(f64, usize)> = (1..nz.saturating_sub(1))
-        .into_par_iter()
-        .flat_map_iter(|k| {
-            let offsets = &offsets;
-            (1..ny - 1).flat_map(move |j| {
-                (1..nx - 1).filter_map(move |i| {
-                    let idx = i + nx * (j + ny * k);
-                    let v = d[idx];
-                    if v >= 0.0 {
-                        return None;
-                    }
-                    let mut inside_neighbour = false;
-                    for &o in offsets {
-                        let w = d[(idx as isize + o) as usize];
-                        if w < v {
-                            return None;
-                        }
-                        inside_neighbour |= w <= 0.0;
-                    }
-                    inside_neighbour.then_some((-v, idx))
-                })
-            })
-        })
-        .collect();
-    ridges.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-    ridges.truncate(CANDIDATES);
-    ridges
+    shallowest(scan(g, |idx| {
+        let v = d[idx];
+        if v >= 0.0 {
+            return None;
+        }
+        let mut inside_neighbour = false;
+        for &o in &offsets {
+            let w = d[(idx as isize + o) as usize];
+            if w < v {
+                return None;
+            }
+            inside_neighbour |= w <= 0.0;
+        }
+        inside_neighbour.then_some((-v, idx))
+    }))
 }
 
-/// The shortest chord of the solid through `p` (inside) along the
-/// distance's gradient and the 13 directions of a cube's axes, face and
-/// body diagonals (a strut's axis point has no gradient; some of them lie
-/// within 20° of any wall's normal), and the nearest exit along them.
-fn thinnest_chord(model: &Model, p: DVec3, h: f64, bound: bool) -> (f64, f64) {
+/// The [`CANDIDATES`] nearest samples outside, within [`GAP_BAND`]
+/// spacings of the surface, whose grid gradient nearly vanishes (see
+/// [`GAP_GRADIENT`]), as (distance, index) ordered by distance then index.
+fn gap_points(g: &Grid, d: &[f64], bound: bool) -> Vec<(f64, usize)> {
+    let [nx, ny, _] = g.dims;
+    let strides = [1, nx, nx * ny];
+    let band = GAP_BAND * g.h;
+    shallowest(scan(g, |idx| {
+        let v = d[idx];
+        // A gap of at least `2 h` has a sample within `h / 2` of its
+        // middle plane, at least `h / 2` from both sides: nearer samples
+        // of a distance are the surface's, not a gap's.
+        let least = if bound { 0.5 * g.h } else { 0.0 };
+        if !(v > least && v <= band) {
+            return None;
+        }
+        let (mut central, mut sides) = (0.0, 0.0);
+        for s in strides {
+            let (lo, hi) = (d[idx - s], d[idx + s]);
+            // Across a gap one side falls to each surface: either neighbour
+            // inside means the sample is at the surface, not mid-gap.
+            if lo <= 0.0 || hi <= 0.0 {
+                return None;
+            }
+            central += (0.5 * (hi - lo)).powi(2);
+            sides += (hi - v).abs().max((v - lo).abs()).powi(2);
+        }
+        let scale = if bound { g.h * g.h } else { sides };
+        (central < GAP_GRADIENT * GAP_GRADIENT * scale).then_some((v, idx))
+    }))
+}
+
+/// The 13 directions of a cube's axes, face and body diagonals (one of
+/// each opposite pair), after the distance's gradient at `p` when it has
+/// one.
+fn directions(model: &Model, p: DVec3, h: f64) -> Vec<DVec3> {
     let e = h / 4.0;
-    let grad = DVec3::new(
-        model.distance(p + DVec3::X * e) - model.distance(p - DVec3::X * e),
-        model.distance(p + DVec3::Y * e) - model.distance(p - DVec3::Y * e),
-        model.distance(p + DVec3::Z * e) - model.distance(p - DVec3::Z * e),
-    );
+    let grad = gradient(model, p, e);
     let mut dirs: Vec<DVec3> = Vec::with_capacity(14);
     if let Some(u) = grad.try_normalize() {
         dirs.push(u);
@@ -279,37 +404,88 @@ fn thinnest_chord(model: &Model, p: DVec3, h: f64, bound: bool) -> (f64, f64) {
             }
         }
     }
-    dirs.iter()
-        .map(|&u| (exit(model, p, u, h, bound), exit(model, p, -u, h, bound)))
-        .fold((f64::INFINITY, f64::INFINITY), |(chord, near), (a, b)| {
-            (chord.min(a + b), near.min(a).min(b))
-        })
+    dirs
 }
 
-/// How far from `p` (inside) along `u` the solid ends: the first sample
-/// outside, refined by bisection; the distance travelled when no exit is
-/// found within [`MAX_STEPS`].
-fn exit(model: &Model, p: DVec3, u: DVec3, h: f64, bound: bool) -> f64 {
+/// The distance's central differences at `p`, `e` apart (unscaled).
+fn gradient(model: &Model, p: DVec3, e: f64) -> DVec3 {
+    DVec3::new(
+        model.distance(p + DVec3::X * e) - model.distance(p - DVec3::X * e),
+        model.distance(p + DVec3::Y * e) - model.distance(p - DVec3::Y * e),
+        model.distance(p + DVec3::Z * e) - model.distance(p - DVec3::Z * e),
+    )
+}
+
+/// The shortest chord on `side` through `p` along the distance's gradient
+/// and the 13 directions of a cube's axes, face and body diagonals (a
+/// strut's axis point has no gradient; some of them lie within 20° of any
+/// wall's normal), and the nearest exit along them. A gap's chord counts
+/// only where it meets both surfaces square (see [`SQUARE`]).
+fn thinnest_chord(model: &Model, p: DVec3, h: f64, bound: bool, side: Side) -> (f64, f64) {
+    let (mut chord, mut near) = (f64::INFINITY, f64::INFINITY);
+    for u in directions(model, p, h) {
+        let (a, b) = (
+            exit(model, p, u, h, bound, side),
+            exit(model, p, -u, h, bound, side),
+        );
+        near = near.min(a).min(b);
+        if a + b < chord
+            && (side == Side::Inside
+                || [p + u * a, p - u * b].into_iter().all(|q| {
+                    gradient(model, q, h / 8.0)
+                        .try_normalize()
+                        .is_some_and(|n| n.dot(u).abs() >= SQUARE)
+                }))
+        {
+            chord = a + b;
+        }
+    }
+    (chord, near)
+}
+
+/// How far from `p` (on `side`) along `u` the surface is: the first
+/// sample across it, refined by bisection; the distance travelled when no
+/// crossing is found within [`MAX_STEPS`] (a wall that thick counts as
+/// thick), or infinity on the outside (empty space that does not end is no
+/// gap).
+fn exit(model: &Model, p: DVec3, u: DVec3, h: f64, bound: bool, side: Side) -> f64 {
     let min_step = h / 8.0;
-    let (mut inside, mut t) = (0.0, 0.0);
+    // Outside, a gap's half-chord through a point within the band is at
+    // most about the band's width; longer ones are no gap, and stepping
+    // through open space past them would cost most of the estimate.
+    let reach = match side {
+        Side::Inside => f64::INFINITY,
+        Side::Outside => 2.0 * GAP_BAND * h,
+    };
+    let (mut before, mut t) = (0.0, 0.0);
     for _ in 0..MAX_STEPS {
+        if t > reach {
+            break;
+        }
         let v = model.distance(p + u * t);
-        if v > 0.0 {
-            let mut outside = t;
+        if side.crossed(v) {
+            let mut after = t;
             for _ in 0..BISECT {
-                let mid = 0.5 * (inside + outside);
-                if model.distance(p + u * mid) > 0.0 {
-                    outside = mid;
+                let mid = 0.5 * (before + after);
+                if side.crossed(model.distance(p + u * mid)) {
+                    after = mid;
                 } else {
-                    inside = mid;
+                    before = mid;
                 }
             }
-            return 0.5 * (inside + outside);
+            return 0.5 * (before + after);
         }
-        inside = t;
-        t += if bound { (-v).max(min_step) } else { h / 4.0 };
+        before = t;
+        t += if bound {
+            v.abs().max(min_step)
+        } else {
+            h / 4.0
+        };
     }
-    t
+    match side {
+        Side::Inside => t,
+        Side::Outside => f64::INFINITY,
+    }
 }
 
 #[cfg(test)]
@@ -335,5 +511,23 @@ Intersection(false, [Function("abs(z) - 0.15", m.id("gray")), RectPrism(Vec3(0,0
         let s = sampled(r#"Function("x*x+y*y+z*z-25", default_materials().id("gray"))"#);
         let f = s.feature.expect("the ball");
         assert!(f.thickness > 9.0, "{f:?}");
+    }
+
+    #[test]
+    fn a_slot_between_function_plates_is_a_gap_and_a_concave_corner_is_not() {
+        let s = sampled(
+            r#"let m = default_materials();
+Intersection(false, [Function("0.15 - abs(x)", m.id("gray")), RectPrism(Vec3(0,0,0), Vec3(10,10,4), m.id("gray"))])"#,
+        );
+        let g = s.gap.expect("the slot");
+        assert!((g.thickness - 0.3).abs() < 0.01, "{g:?} at h {}", s.spacing);
+        assert!(g.at.x.abs() < s.spacing, "{g:?}");
+        // An L: the region where x or y is below zero, in a 10 mm box.
+        let s = sampled(
+            r#"let m = default_materials();
+Intersection(false, [Function("min(x, y)", m.id("gray")), RectPrism(Vec3(0,0,0), Vec3(10,10,4), m.id("gray"))])"#,
+        );
+        assert_eq!(s.gap, None, "{s:?}");
+        assert!(s.feature.is_some());
     }
 }

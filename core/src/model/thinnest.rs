@@ -10,8 +10,8 @@
 //!
 //! Geometry whose thickness the tree does not state (meshes, `Function`s,
 //! simulation fields) is listed as unknown here and measured by sampling
-//! ([`Model::sampled_thinnest`]); gaps between separate primitives are not
-//! measured.
+//! ([`Model::sampled_thinnest`]); gaps between parts are measured apart
+//! ([`Model::stated_gaps`]).
 
 use std::collections::HashSet;
 use std::sync::Arc;
