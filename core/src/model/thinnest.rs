@@ -66,7 +66,7 @@ impl Model {
                 ),
                 PNode::Cylinder { r, hh, .. } => {
                     let t = (2.0 * r).min(2.0 * hh);
-                    stated(t, format!("cylinder {} mm across", k * t));
+                    stated(t, format!("cylinder size {}", k * t));
                 }
                 PNode::Strut { s, .. } => stated(2.0 * s.r, format!("strut radius {}", k * s.r)),
                 PNode::Lattice { r, .. } => {
@@ -74,13 +74,13 @@ impl Model {
                 }
                 PNode::Prism { p, .. } => stated(
                     2.0 * p.w_half,
-                    format!("prism {} mm thick", 2.0 * k * p.w_half),
+                    format!("prism width {}", 2.0 * k * p.w_half),
                 ),
                 PNode::Tpms { t, .. } => {
                     stated(t.thickness(), format!("TPMS wall {}", k * t.thickness()))
                 }
                 PNode::Shell { t, child } => {
-                    stated(*t, format!("shell {} mm thick", k * t));
+                    stated(*t, format!("shell wall {}", k * t));
                     stack.push((child, k, off));
                 }
                 PNode::Mesh { .. } => out.unknown.push("a mesh"),
