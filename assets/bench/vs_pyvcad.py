@@ -20,9 +20,10 @@ ranges of the same material. Both write into TMPDIR (default /dev/shm, so
 a slow disk does not decide). PYVCAD_PRELOAD, if set, is preloaded into
 pyvcad (the isoc23 shim on glibc older than 2.38; README.md here).
 
-The voxel sizes are those at which pyvcad's compile takes 5 to 20 s of
-CPU time on a two-core x86-64 machine (the bunny lattice's 3,287-child
-union costs pyvcad about 1 ms a voxel, hence its coarse voxel). Depends on nothing outside the repository but pyvcad and
+The voxel sizes are those at which pyvcad's compile takes 5 to 60 s on a
+two-core AMD EPYC (x86-64) machine (the bunny lattice's 3,287-child union
+costs pyvcad about 1 ms a voxel, hence its coarse voxel); on a faster or
+slower machine, `--voxel` overrides them to calibrate. Depends on nothing outside the repository but pyvcad and
 the volcad binary.
 """
 import argparse
@@ -44,14 +45,14 @@ EX = os.path.join("assets", "examples")
 # design: (volcad script, {compiler: voxel mm}, volcad's mesh options that
 # make pyvcad's fraction ranges of red: one range is the whole part)
 CASES = {
-    "cube": (f"{EX}/hello_cube.rhai", {"png": 0.028, "stl": 0.028}, ["--segments", "1", "--by", "red"]),
-    "graded_bar": (f"{EX}/graded_bar.rhai", {"png": 0.04, "stl": 0.045}, ["--segments", "2", "--by", "red"]),
-    "color_sheet": (f"{EX}/color_sheet.rhai", {"png": 0.75, "stl": 1.0}, ["--segments", "1", "--by", "cyan"]),
-    "bcc_sphere": (f"{EX}/bcc_sphere.rhai", {"png": 0.085, "stl": 0.09}, ["--segments", "1", "--by", "gray"]),
-    "bunny_mesh": ("assets/bench/bunny_mesh.rhai", {"png": 0.22, "stl": 0.21}, ["--segments", "1", "--by", "clear"]),
-    "bunny_lattice": (f"{EX}/bunny_lattice.rhai", {"png": 2.5, "stl": 2.5}, ["--segments", "1", "--by", "yellow"]),
+    "cube": (f"{EX}/hello_cube.rhai", {"png": 0.028, "stl": 0.022}, ["--segments", "1", "--by", "red"]),
+    "graded_bar": (f"{EX}/graded_bar.rhai", {"png": 0.025, "stl": 0.03}, ["--segments", "2", "--by", "red"]),
+    "color_sheet": (f"{EX}/color_sheet.rhai", {"png": 0.5, "stl": 0.7}, ["--segments", "1", "--by", "cyan"]),
+    "bcc_sphere": (f"{EX}/bcc_sphere.rhai", {"png": 0.045, "stl": 0.055}, ["--segments", "1", "--by", "gray"]),
+    "bunny_mesh": ("assets/bench/bunny_mesh.rhai", {"png": 0.12, "stl": 0.13}, ["--segments", "1", "--by", "clear"]),
+    "bunny_lattice": (f"{EX}/bunny_lattice.rhai", {"png": 2.0, "stl": 2.5}, ["--segments", "1", "--by", "yellow"]),
 }
-GRID = re.compile(r"grid (\d+) x (\d+) x (\d+)")
+GRID = re.compile(r"(\d+) [x×] (\d+) [x×] (\d+) voxels")
 
 
 def run_pyvcad(py, preload, design, kind, voxel, tmp):
