@@ -423,7 +423,7 @@ impl Model {
     /// The design's narrowest stated gap below `below` mm and its number of
     /// separate parts where the tree states them (see the module doc).
     /// Walks the tree with an explicit stack, each shared subtree once per
-    /// frame; checks at most [`VERIFIED`] gaps against the whole design,
+    /// frame; checks at most `VERIFIED` gaps against the whole design,
     /// narrowest first.
     pub fn stated_gaps(&self, below: f64) -> StatedGaps {
         let (candidates, parts) = self.gap_candidates(below);
