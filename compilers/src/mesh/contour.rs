@@ -413,9 +413,7 @@ impl Contourer {
     fn outline(&mut self, pz: usize, id: u32, cube: &Cube, axis: usize, side: u8, reverse: bool) {
         let key = self.regions.key(id);
         if self.one_label {
-            let mut segs = Vec::with_capacity(2);
-            cube_loops::face_segments(corner_mask(cube, key.x), axis, side, &mut segs);
-            for (a, b) in segs {
+            for (a, b) in cube_loops::face_segments(corner_mask(cube, key.x), axis, side) {
                 let (a, b) = if reverse { (b, a) } else { (a, b) };
                 let r = [a, b].map(|p| self.resolve(cube, 0, &[0; 4], p));
                 let xi = r.map(|r| self.index_of(pz, key.x, r));

@@ -57,29 +57,32 @@ fn face_corners(axis: usize, side: u8) -> [u8; 4] {
 
 /// The cut segments of face (`axis`, `side`) for the inside corners
 /// `mask`, oriented as the contourer's tet faces are (from the edge
-/// entering the inside, counter-clockwise, to the edge leaving it).
-pub(super) fn face_segments(mask: u8, axis: usize, side: u8, out: &mut Vec<(Pt, Pt)>) {
+/// entering the inside, counter-clockwise, to the edge leaving it): none,
+/// one, or two on an ambiguous face.
+pub(super) fn face_segments(mask: u8, axis: usize, side: u8) -> impl Iterator<Item = (Pt, Pt)> {
     let q = face_corners(axis, side);
     let inside = q.map(|c| mask >> c & 1 == 1);
-    // Edge k runs from q[k] to q[k + 1].
-    let cut = |k: usize| edge(q[k], q[(k + 1) % 4]);
-    let entering: Vec<usize> = (0..4)
-        .filter(|&k| !inside[k] && inside[(k + 1) % 4])
-        .collect();
-    let leaving: Vec<usize> = (0..4)
-        .filter(|&k| inside[k] && !inside[(k + 1) % 4])
-        .collect();
-    if entering.len() == 1 {
-        out.push((cut(entering[0]), cut(leaving[0])));
-        return;
-    }
+    // Edge k runs from q[k] to q[k + 1]; it enters the inside when q[k]
+    // is out and q[k + 1] in.
+    let enters = move |k: usize| !inside[k] && inside[(k + 1) % 4];
+    let leaves = move |k: usize| inside[k] && !inside[(k + 1) % 4];
+    let cut = move |k: usize| edge(q[k], q[(k + 1) % 4]);
+    let ambiguous = (0..4).filter(|&k| enters(k)).count() == 2;
     // Ambiguous: inside corners alternate. Joined when they are the
-    // lowest and highest corners (q[0] and q[2]).
+    // lowest and highest corners (q[0] and q[2]); otherwise each entering
+    // edge pairs with the next leaving one, as on a plain face.
     let joined = inside[0];
-    for &k in &entering {
-        let to = if joined { (k + 3) % 4 } else { (k + 1) % 4 };
-        out.push((cut(k), cut(to)));
-    }
+    (0..4).filter(move |&k| enters(k)).map(move |k| {
+        let to = if ambiguous {
+            if joined { (k + 3) % 4 } else { (k + 1) % 4 }
+        } else {
+            (1..4)
+                .map(|d| (k + d) % 4)
+                .find(|&j| leaves(j))
+                .unwrap_or(k)
+        };
+        (cut(k), cut(to))
+    })
 }
 
 /// The faces (bit `2·axis + side`) an edge point lies on.
@@ -107,7 +110,7 @@ fn loops(mask: u8) -> Vec<Loop> {
     let mut segs = Vec::new();
     for axis in 0..3 {
         for side in 0..2 {
-            face_segments(mask, axis, side, &mut segs);
+            segs.extend(face_segments(mask, axis, side));
         }
     }
     let mut out = Vec::new();
@@ -155,9 +158,8 @@ mod tests {
             // Corners of face x = 1 (1, 3, 5, 7) and x = 0 (0, 2, 4, 6).
             let hi = (0..4).fold(0u8, |a, k| a | (m >> k & 1) << (2 * k + 1));
             let lo = hi >> 1;
-            let (mut a, mut b) = (Vec::new(), Vec::new());
-            face_segments(hi, 0, 1, &mut a);
-            face_segments(lo, 0, 0, &mut b);
+            let a: Vec<_> = face_segments(hi, 0, 1).collect();
+            let b: Vec<_> = face_segments(lo, 0, 0).collect();
             let shift = |p: Pt| match p {
                 Pt::Edge(x, y) => Pt::Edge(x >> 1 << 1, y >> 1 << 1),
                 other => other,

@@ -105,11 +105,9 @@ impl IndexedMesh {
         if self.triangles.is_empty() {
             return (180.0, f64::INFINITY);
         }
-        let (sine, edge) = self
-            .triangles
-            .par_iter()
-            .enumerate()
-            .map(|(t, _)| {
+        let (sine, edge) = (0..self.triangles.len())
+            .into_par_iter()
+            .map(|t| {
                 let p = self.corners(t);
                 let e = [0, 1, 2].map(|k| sub(p[(k + 1) % 3], p[k]));
                 let l = e.map(|v| dot(v, v));
