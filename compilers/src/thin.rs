@@ -59,13 +59,13 @@ pub fn thin_feature_notes(model: &Model, size: f64, option: &str) -> Vec<String>
     let sampled = if t.unknown.is_empty() || fine {
         None
     } else {
-        model.sampled_thinnest()
+        model.sampled_thinnest_below(CELLS_ACROSS * size)
     };
     let mut out = Vec::new();
-    out.extend(wall_note(&t, sampled, size, option));
-    out.extend(gap_note(model, sampled, size, option));
+    out.extend(wall_note(&t, sampled.as_ref(), size, option));
+    out.extend(gap_note(model, sampled.as_ref(), size, option));
     if !t.unknown.is_empty() {
-        out.push(unknown_note(&t, sampled, spacing, size, option));
+        out.push(unknown_note(&t, sampled.as_ref(), spacing, size, option));
     }
     out
 }

@@ -142,12 +142,7 @@ fn gaps_are_the_same_on_one_and_two_threads() {
             .num_threads(threads)
             .build()
             .expect("a pool")
-            .install(|| {
-                (
-                    m.sampled_thinnest().cloned(),
-                    model(SPHERES).stated_gaps(1.0),
-                )
-            })
+            .install(|| (m.sampled_thinnest(), model(SPHERES).stated_gaps(1.0)))
     };
     let one = on(1);
     assert!(one.0.as_ref().is_some_and(|s| s.gap.is_some()));

@@ -90,7 +90,7 @@ fn the_estimate_is_the_same_on_one_and_two_threads() {
             .num_threads(threads)
             .build()
             .expect("a pool")
-            .install(|| m.sampled_thinnest().cloned())
+            .install(|| m.sampled_thinnest())
     };
     let gyroid = || model(GYROID);
     let plate = || mesh_design("plate_0.3mm.obj");
@@ -118,4 +118,21 @@ fn cells_no_larger_than_the_sampling_spacing_skip_the_sampling() {
         notes.iter().any(|n| n.contains("were not sampled")),
         "{notes:?}"
     );
+}
+
+#[test]
+fn sampling_only_as_deep_as_the_export_needs_finds_the_same_thin_plate() {
+    // Half the plate is 0.15 mm deep: sampling to 0.5 mm finds it as the
+    // full sampling does; sampling to 0.1 mm (features under 0.2 mm)
+    // leaves it out, and a later full request samples again.
+    let m = mesh_design("plate_0.3mm.obj");
+    let full = m.sampled_thinnest().expect("a bounded mesh");
+    let fresh = mesh_design("plate_0.3mm.obj");
+    let capped = fresh.sampled_thinnest_below(1.0).expect("a bounded mesh");
+    assert_eq!(capped, full);
+    let shallow = mesh_design("plate_0.3mm.obj");
+    let s = shallow.sampled_thinnest_below(0.2).expect("a bounded mesh");
+    assert!(s.feature.is_none(), "{s:?}");
+    let again = shallow.sampled_thinnest().expect("a bounded mesh");
+    assert_eq!(again, full);
 }

@@ -25,6 +25,7 @@ mod union_index;
 
 pub use thin_gaps::{Gap, StatedGaps};
 pub use thin_sampled::{GAP_BAND, Sampled, SampledFeature};
+use thin_sampled::SampledMemo;
 pub use thinnest::{Feature, Thinnest};
 
 #[cfg(test)]
@@ -81,9 +82,10 @@ pub struct Model {
     /// The attribute evaluator, only when some node carries an attribute
     /// (kept apart from `root` so distances and fractions never look at it).
     pub(crate) attrs: Option<Arc<crate::attribute::Evaluator>>,
-    /// The sampled thin-feature estimate, made on first use and shared by
-    /// clones (see [`Model::sampled_thinnest`]).
-    sampled: Arc<std::sync::OnceLock<Option<Sampled>>>,
+    /// The sampled thin-feature estimate with the depth it was sampled to,
+    /// made on first use and shared by clones (see
+    /// [`Model::sampled_thinnest_below`]).
+    sampled: Arc<std::sync::Mutex<Option<SampledMemo>>>,
 }
 
 /// The distance of one script subtree in its own frame (the attribute

@@ -134,6 +134,9 @@ pub enum PNode {
     /// half size `clip_h`.
     Lattice {
         struts: Vec<Capsule>,
+        /// The cell is symmetric in the three axis planes: `struts` are
+        /// those of the positive octant, taken at `|p|`.
+        fold: bool,
         r: f64,
         /// Short strut lists per sub-cell of the clip box (see `strut_grid`).
         grid: Option<Box<StrutGrid>>,
@@ -312,35 +315,7 @@ impl PNode {
                 expr.eval(&slots).max(sdf::rect_prism(p, *clip_c, *clip_h))
             }
             PNode::Tpms { t, .. } => t.dist(p),
-            PNode::Lattice {
-                struts,
-                clip_h,
-                r,
-                grid,
-                ..
-            } => {
-                // min(√d²ᵢ − r) = √(min d²ᵢ) − r, bit for bit (the square
-                // root is monotone): one square root a point, not one a
-                // strut (they were most of an FCC lattice's time).
-                let mut d2 = f64::INFINITY;
-                match grid.as_ref().and_then(|g| g.candidates(p)) {
-                    Some(list) => {
-                        for &k in list {
-                            d2 = crate::fastmath::min_plain(d2, struts[k as usize].axis_dist2(p));
-                        }
-                    }
-                    None => {
-                        for s in struts {
-                            d2 = crate::fastmath::min_plain(d2, s.axis_dist2(p));
-                        }
-                    }
-                }
-                let d = d2.sqrt() - r;
-                match clip_h {
-                    Some(h) => d.max(sdf::rect_prism(p, DVec3::ZERO, *h)),
-                    None => d,
-                }
-            }
+            PNode::Lattice { .. } => self.lattice_dist(p),
             PNode::Translate { t, child } => child.dist(p - *t),
             PNode::Rotate {
                 to_local,
@@ -364,7 +339,11 @@ impl PNode {
                 let d = child.dist(p);
                 d.max(-*t - d)
             }
-            PNode::Tile { cell, child } => child.dist(tile_local(p, *cell)),
+            // A tiled unit cell, the common case, without a second call.
+            PNode::Tile { cell, child } => match &**child {
+                lattice @ PNode::Lattice { .. } => lattice.lattice_dist(tile_local(p, *cell)),
+                child => child.dist(tile_local(p, *cell)),
+            },
             PNode::FGrade(g) => g.child.dist(p),
             PNode::AttrGrade { child, .. } => child.dist(p),
             PNode::Blend { child, .. } => child.dist(p),
@@ -385,6 +364,57 @@ impl PNode {
 }
 
 impl PNode {
+    /// [`Self::dist`], with a sphere's, box's or cylinder's written in place:
+    /// the bounding shape of an intersection costs no second call.
+    #[inline(always)]
+    fn leaf_or_dist(&self, p: DVec3) -> f64 {
+        match self {
+            PNode::Sphere { c, r, .. } => sdf::sphere(p, *c, *r),
+            PNode::Box { c, h, .. } => sdf::rect_prism(p, *c, *h),
+            PNode::Cylinder { c, r, hh, .. } => sdf::cylinder(p, *c, *r, *hh),
+            _ => self.dist(p),
+        }
+    }
+
+    /// A [`PNode::Lattice`]'s distance (`NaN` for any other node).
+    #[inline(always)]
+    fn lattice_dist(&self, p: DVec3) -> f64 {
+        let PNode::Lattice {
+            struts,
+            clip_h,
+            r,
+            grid,
+            fold,
+            ..
+        } = self
+        else {
+            return f64::NAN;
+        };
+        // Mirror symmetry: the clip box and the struts alike.
+        let p = if *fold { p.abs() } else { p };
+        // min(√d²ᵢ − r) = √(min d²ᵢ) − r, bit for bit (the square
+        // root is monotone): one square root a point, not one a
+        // strut (they were most of an FCC lattice's time).
+        let mut d2 = f64::INFINITY;
+        match grid.as_ref().and_then(|g| g.candidates(p)) {
+            Some(list) => {
+                for &k in list {
+                    d2 = crate::fastmath::min_plain(d2, struts[k as usize].axis_dist2(p));
+                }
+            }
+            None => {
+                for s in struts {
+                    d2 = crate::fastmath::min_plain(d2, s.axis_dist2(p));
+                }
+            }
+        }
+        let d = d2.sqrt() - r;
+        match clip_h {
+            Some(h) => d.max(sdf::rect_prism(p, DVec3::ZERO, *h)),
+            None => d,
+        }
+    }
+
     /// The bits of a sphere, box, cylinder or strut (kind, parameters,
     /// material): two leaves with the same key are the same node.
     pub fn leaf_key(&self) -> Option<[u64; 9]> {
@@ -450,9 +480,9 @@ impl NAry {
         sharp: impl Fn(f64, f64) -> f64,
         smooth: impl Fn(f64, f64, f64) -> f64,
     ) -> f64 {
-        let mut d = self.children[0].dist(p);
+        let mut d = self.children[0].leaf_or_dist(p);
         for c in &self.children[1..] {
-            let e = c.dist(p);
+            let e = c.leaf_or_dist(p);
             d = if self.smooth > 0.0 {
                 smooth(d, e, self.smooth)
             } else {

@@ -11,7 +11,7 @@ use glam::{DMat3, DVec2, DVec3};
 use super::flatten::{self, Shape, compose_moves, rotation};
 use super::pnode::{Grade, LineCapsule, NAry, PNode, Prism, SimGrade, Slot};
 use super::shapes::Capsule;
-use super::strut_grid::StrutGrid;
+use super::strut_grid::{StrutGrid, octant_struts};
 use super::tpms::Tpms;
 use super::union_index::UnionIndex;
 use super::{MAX_MATERIALS, PrepareError};
@@ -456,10 +456,17 @@ impl Preparer {
                     Some(c) => Aabb::from_center_size(DVec3::ZERO, *c),
                     None => struts.iter().fold(Aabb::EMPTY, |b, s| b.union(&s.bbox())),
                 };
+                // Symmetric cells are evaluated at `|p|` over the struts of
+                // the positive octant (see `octant_struts`).
+                let (struts, fold) = match octant_struts(&struts) {
+                    Some(few) => (few, true),
+                    None => (struts, false),
+                };
                 (
                     PNode::Lattice {
                         grid: cell.and_then(|c| StrutGrid::new(&struts, c * 0.5).map(Box::new)),
                         struts,
+                        fold,
                         r: *radius,
                         clip_h: cell.map(|c| c * 0.5),
                         m: self.slot(*material),

@@ -89,6 +89,80 @@ impl StrutGrid {
     }
 }
 
+/// The struts that can be nearest to a point of the positive octant, when
+/// the cell's struts are symmetric under the three axis reflections (every
+/// built-in cell is): then `d(p) = d(|p|)` and the minimum over all struts
+/// at `|p|` is the minimum over those that meet the closed octant `[0, ∞)³`,
+/// a quarter to an eighth of them (BCC: one of four). `None` when the set
+/// is not symmetric (a custom cell), or too large to check.
+///
+/// Why: for `q ≥ 0` and any `x`, `|qᵢ − |xᵢ|| ≤ |qᵢ − xᵢ|`, so a strut `S`
+/// is no nearer to `q` than its fold `|S|`; each piece of `|S|` is a piece
+/// of a mirror image of `S` (a strut of the set) inside the octant, so of a
+/// strut that meets the octant.
+pub fn octant_struts(struts: &[Capsule]) -> Option<Vec<Capsule>> {
+    if struts.is_empty() || struts.len() > 512 {
+        return None;
+    }
+    let scale = struts
+        .iter()
+        .map(|s| s.a.abs().max((s.a + s.ab).abs()).max_element())
+        .fold(0.0, f64::max);
+    let tol = 1e-9 * scale.max(f64::MIN_POSITIVE);
+    let near = |u: DVec3, v: DVec3| (u - v).abs().max_element() <= tol;
+    let ends = |s: &Capsule| (s.a, s.a + s.ab);
+    for axis in 0..3 {
+        let mut flip = DVec3::ONE;
+        flip[axis] = -1.0;
+        let mirrored = struts.iter().all(|s| {
+            let (a, b) = ends(s);
+            let (a, b) = (a * flip, b * flip);
+            struts.iter().any(|t| {
+                let (c, d) = ends(t);
+                (near(a, c) && near(b, d)) || (near(a, d) && near(b, c))
+            })
+        });
+        if !mirrored {
+            return None;
+        }
+    }
+    // The part of a strut in the octant: the `t ∈ [0, 1]` with every
+    // coordinate of `a + t·ab` at least `−tol`, or `None`.
+    let span = |s: &Capsule| {
+        let (mut lo, mut hi) = (0.0f64, 1.0f64);
+        for i in 0..3 {
+            let (a, d) = (s.a[i] + tol, s.ab[i]);
+            if d == 0.0 {
+                if a < 0.0 {
+                    return None;
+                }
+            } else if d > 0.0 {
+                lo = lo.max(-a / d);
+            } else {
+                hi = hi.min(-a / d);
+            }
+        }
+        (lo <= hi).then_some((lo, hi))
+    };
+    // Struts with a length inside; one that only touches the octant (BCC's
+    // diagonals at the centre) is kept when no kept strut passes there.
+    let mut few: Vec<Capsule> = Vec::new();
+    let mut touching = Vec::new();
+    for s in struts {
+        match span(s) {
+            Some((lo, hi)) if (hi - lo) * s.ab.length() > 8.0 * tol => few.push(*s),
+            Some((lo, _)) => touching.push((s, s.a + s.ab * lo)),
+            None => {}
+        }
+    }
+    for (s, at) in touching {
+        if !few.iter().any(|k| k.axis_dist2(at) <= 16.0 * tol * tol) {
+            few.push(*s);
+        }
+    }
+    Some(few)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -146,5 +220,62 @@ mod tests {
             assert!(g.candidates(cell).is_none());
             assert!(g.candidates(DVec3::NAN).is_none());
         }
+    }
+
+    #[test]
+    fn octant_struts_give_the_same_minimum_at_the_folded_point() {
+        let cell = DVec3::new(5.0, 4.0, 6.0);
+        let mut rng = crate::xorshift::XorShift::new(0x0DDC_0FFE_E123_4567u64);
+        for (kind, kept) in [
+            (LatticeType::BodyCenteredCubic, 1),
+            (LatticeType::FaceCenteredCubic, 3),
+            (LatticeType::Cubic, 3),
+            (LatticeType::KelvinCell, 0),
+            (LatticeType::Octet, 0),
+        ] {
+            let struts: Vec<Capsule> = unit_cell_edges(kind, cell)
+                .iter()
+                .map(|(a, b)| Capsule::new(*a, *b, 0.3))
+                .collect();
+            let octant = octant_struts(&struts).expect("built-in cells are symmetric");
+            if kept > 0 {
+                assert_eq!(octant.len(), kept, "{kind:?}");
+            }
+            assert!(
+                octant.len() * 2 <= struts.len(),
+                "{kind:?} {}",
+                octant.len()
+            );
+            for _ in 0..20_000 {
+                // Inside the cell, on its mid planes, and outside it.
+                let mut f = DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64());
+                if rng.next_f64() < 0.2 {
+                    f.x = 0.5;
+                }
+                let p = (f - 0.5) * cell * if rng.next_f64() < 0.2 { 3.0 } else { 1.0 };
+                let all = struts
+                    .iter()
+                    .map(|s| s.axis_dist2(p))
+                    .fold(f64::INFINITY, f64::min);
+                let q = p.abs();
+                let few = octant
+                    .iter()
+                    .map(|s| s.axis_dist2(q))
+                    .fold(f64::INFINITY, f64::min);
+                assert!(
+                    (all.sqrt() - few.sqrt()).abs() < 1e-9,
+                    "{kind:?} {p}: {all} {few}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_lopsided_cell_is_not_folded() {
+        let struts = [
+            Capsule::new(DVec3::new(-1.0, -1.0, -1.0), DVec3::new(1.0, 1.0, 1.0), 0.1),
+            Capsule::new(DVec3::new(-1.0, 0.0, 0.0), DVec3::new(0.0, 1.0, 0.0), 0.1),
+        ];
+        assert!(octant_struts(&struts).is_none());
     }
 }

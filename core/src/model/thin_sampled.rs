@@ -102,6 +102,9 @@ pub struct Sampled {
     pub gap: Option<SampledFeature>,
 }
 
+/// A kept estimate: the depth it was sampled to, and what it found.
+pub(super) type SampledMemo = (f64, Option<Sampled>);
+
 /// Which side of the surface a chord crosses: the solid (walls and
 /// struts) or the empty space around it (gaps).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -179,21 +182,46 @@ impl Model {
     /// The design's thinnest feature estimated by sampling (see the module
     /// doc); `None` when the design's box is unbounded. Computed once per
     /// model and kept.
-    pub fn sampled_thinnest(&self) -> Option<&Sampled> {
-        self.sampled
-            .get_or_init(|| {
-                let g = Grid::over(&self.bbox)?;
-                let d = sample(self, &g);
-                let bound = self.distance_is_bound();
-                let feature = shortest(self, &g, &ridge_points(&g, &d), bound, Side::Inside);
-                let gap = shortest(self, &g, &gap_points(&g, &d, bound), bound, Side::Outside);
-                Some(Sampled {
-                    spacing: g.h,
-                    feature,
-                    gap,
-                })
-            })
-            .as_ref()
+    pub fn sampled_thinnest(&self) -> Option<Sampled> {
+        self.sampled_thinnest_below(f64::INFINITY)
+    }
+
+    /// [`Self::sampled_thinnest`] where only features thinner than `widest`
+    /// mm need be found (an export warns of those under two cells): where
+    /// the distance is a bound, a chord through a sample at depth `δ` is at
+    /// least `2δ` long, so samples deeper than `widest / 2` are bounded, not
+    /// evaluated (the inside of a large solid, most of a coarse export's
+    /// sampling). A thicker feature may then go unreported. Kept per model
+    /// with the widest it was made for; a wider request makes it again.
+    pub fn sampled_thinnest_below(&self, widest: f64) -> Option<Sampled> {
+        let deepest = if self.distance_is_bound() {
+            widest / 2.0
+        } else {
+            f64::INFINITY
+        };
+        let mut memo = self
+            .sampled
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        if let Some((made_for, s)) = &*memo
+            && *made_for >= deepest
+        {
+            return s.clone();
+        }
+        let made = Grid::over(&self.bbox).map(|g| {
+            let d = sample(self, &g, deepest);
+            let bound = self.distance_is_bound();
+            let ridges = ridge_points(&g, &d, deepest);
+            let feature = shortest(self, &g, &ridges, bound, Side::Inside);
+            let gap = shortest(self, &g, &gap_points(&g, &d, bound), bound, Side::Outside);
+            Sampled {
+                spacing: g.h,
+                feature,
+                gap,
+            }
+        });
+        *memo = Some((deepest, made.clone()));
+        made
     }
 }
 
@@ -227,11 +255,26 @@ const BLOCK: usize = 8;
 /// beyond [`GAP_BAND`] spacings outside is filled with the interval's
 /// lower end instead: ridge points are inside
 /// samples compared with their neighbours, and any positive value outside
-/// compares the same; gap points lie within the band.
-fn sample(model: &Model, g: &Grid) -> Vec<f64> {
+/// compares the same; gap points lie within the band. Likewise a block
+/// deeper inside than `deepest` is filled with its interval's upper end:
+/// ridge points are kept only above that depth, and a filled sample is
+/// never shallower than `−deepest`, so it compares with a shallower
+/// neighbour as its true (deeper) value would.
+fn sample(model: &Model, g: &Grid, deepest: f64) -> Vec<f64> {
     let [nx, ny, nz] = g.dims;
     let [bx, by, bz] = g.dims.map(|n| n.div_ceil(BLOCK));
     let band = GAP_BAND * g.h;
+    // The value a box of samples takes without evaluation, if any.
+    let settled = |b: &Aabb| {
+        let iv = model.interval(b);
+        if iv.lo > band {
+            Some(iv.lo)
+        } else if iv.hi < -deepest {
+            Some(iv.hi)
+        } else {
+            None
+        }
+    };
     let blocks: Vec<Vec<f64>> = (0..bx * by * bz)
         .into_par_iter()
         .map(|b| {
@@ -241,12 +284,11 @@ fn sample(model: &Model, g: &Grid) -> Vec<f64> {
                 (j0 + BLOCK).min(ny),
                 (k0 + BLOCK).min(nz),
             );
-            let bounds = Aabb::new(g.at(i0, j0, k0), g.at(i1 - 1, j1 - 1, k1 - 1));
-            let lo = model.interval(&bounds).lo;
+            let whole = settled(&Aabb::new(g.at(i0, j0, k0), g.at(i1 - 1, j1 - 1, k1 - 1)));
             // A block near the surface is bounded again by its eight
-            // octants, whose tighter intervals fill more of the band.
-            let mut octants = [lo; 8];
-            if lo <= band {
+            // octants, whose tighter intervals settle more of it.
+            let mut octants = [whole; 8];
+            if whole.is_none() {
                 let half = BLOCK / 2;
                 for (o, v) in octants.iter_mut().enumerate() {
                     let (a0, b0, c0) =
@@ -257,20 +299,14 @@ fn sample(model: &Model, g: &Grid) -> Vec<f64> {
                             (b0 + half).min(j1),
                             (c0 + half).min(k1),
                         );
-                        *v = model
-                            .interval(&Aabb::new(g.at(a0, b0, c0), g.at(a1 - 1, b1 - 1, c1 - 1)))
-                            .lo;
+                        *v = settled(&Aabb::new(g.at(a0, b0, c0), g.at(a1 - 1, b1 - 1, c1 - 1)));
                     }
                 }
             }
             let at = |(i, j, k): (usize, usize, usize)| {
                 let half = BLOCK / 2;
                 let o = (i - i0) / half + 2 * ((j - j0) / half) + 4 * ((k - k0) / half);
-                if octants[o] > band {
-                    octants[o]
-                } else {
-                    model.distance(g.at(i, j, k))
-                }
+                octants[o].unwrap_or_else(|| model.distance(g.at(i, j, k)))
             };
             (k0..k1)
                 .flat_map(|k| (j0..j1).flat_map(move |j| (i0..i1).map(move |i| (i, j, k))))
@@ -318,7 +354,7 @@ where
 
 /// The [`CANDIDATES`] shallowest ridge points as (depth, index), ordered
 /// by depth then index.
-fn ridge_points(g: &Grid, d: &[f64]) -> Vec<(f64, usize)> {
+fn ridge_points(g: &Grid, d: &[f64], deepest: f64) -> Vec<(f64, usize)> {
     let [nx, ny, _] = g.dims;
     let (sx, sy) = (1isize, nx as isize);
     let sz = (nx * ny) as isize;
@@ -334,7 +370,7 @@ fn ridge_points(g: &Grid, d: &[f64]) -> Vec<(f64, usize)> {
     }
     shallowest(scan(g, |idx| {
         let v = d[idx];
-        if v >= 0.0 {
+        if v >= 0.0 || -v >= deepest {
             return None;
         }
         let mut inside_neighbour = false;
@@ -496,7 +532,6 @@ mod tests {
         model_of(src, "t.rhai", &ScriptOptions::default())
             .expect("design prepares")
             .sampled_thinnest()
-            .cloned()
             .expect("a bounded design")
     }
 
