@@ -14,13 +14,7 @@ pub(super) fn estimate(model: &Model, p: &GcvfParams) -> Result<Assessment, Expo
     let (est, mats) = gcvf::estimate(model, p)?;
     let names: Vec<&str> = mats.iter().map(|m| m.name.as_str()).collect();
     let counts = format!("resins {}, about ", names.join(", "));
-    Ok(Assessment::voxel_grid(
-        est.grid.dims,
-        est.voxels,
-        &counts,
-        est.disk_bytes,
-        est.memory_bytes,
-    ))
+    Ok(Assessment::voxel_grid(&est, &counts))
 }
 
 /// The verdict on writing the package to `dest`: none when nothing is

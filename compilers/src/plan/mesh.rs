@@ -13,13 +13,7 @@ pub(super) fn estimate(model: &Model, p: &MeshParams) -> Result<Assessment, Expo
         "{} segments, about {} triangles, ",
         est.segments, est.triangles
     );
-    Ok(Assessment::voxel_grid(
-        est.grid.dims,
-        est.voxels,
-        &counts,
-        est.disk_bytes,
-        est.memory_bytes,
-    ))
+    Ok(Assessment::voxel_grid(&est, &counts))
 }
 
 pub(super) fn run(model: &Model, p: &MeshParams, ctx: &JobContext) -> Result<Summary, ExportError> {

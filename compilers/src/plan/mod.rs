@@ -254,12 +254,41 @@ pub struct Assessment {
     pub verdicts: Vec<Verdict>,
 }
 
+/// What a voxel-grid export's estimate line shows of its estimate: the
+/// grid's size, its voxels, and the bytes on disk and in memory.
+trait GridEstimate {
+    /// `(dims, voxels, disk bytes, memory bytes)`.
+    fn sizes(&self) -> ([usize; 3], u64, u64, u64);
+}
+
+impl GridEstimate for crate::png_stack::Estimate {
+    fn sizes(&self) -> ([usize; 3], u64, u64, u64) {
+        (
+            self.grid.dims,
+            self.voxels,
+            self.disk_bytes,
+            self.memory_bytes,
+        )
+    }
+}
+
+impl GridEstimate for crate::mesh::MeshEstimate {
+    fn sizes(&self) -> ([usize; 3], u64, u64, u64) {
+        (
+            self.grid.dims,
+            self.voxels,
+            self.disk_bytes,
+            self.memory_bytes,
+        )
+    }
+}
+
 impl Assessment {
     /// A voxel-grid export's estimate, checked against its disk size:
     /// "NX × NY × NZ voxels (N), {counts}{disk} on disk, {memory} memory"
     /// (`counts` ends with its separator, and "about " where it applies).
-    fn voxel_grid(dims: [usize; 3], voxels: u64, counts: &str, disk: u64, memory: u64) -> Self {
-        let [nx, ny, nz] = dims;
+    fn voxel_grid(est: &impl GridEstimate, counts: &str) -> Self {
+        let ([nx, ny, nz], voxels, disk, memory) = est.sizes();
         Assessment {
             text: format!(
                 "{nx} × {ny} × {nz} voxels ({:.3e}), {counts}{} on disk, {} memory",

@@ -17,13 +17,7 @@ pub(super) fn estimate(model: &Model, p: &PngParams) -> Result<Assessment, Expor
         est.grid.dims[2],
         est.files
     );
-    Ok(Assessment::voxel_grid(
-        est.grid.dims,
-        est.voxels,
-        &counts,
-        est.disk_bytes,
-        est.memory_bytes,
-    ))
+    Ok(Assessment::voxel_grid(&est, &counts))
 }
 
 pub(super) fn run(model: &Model, p: &PngParams, ctx: &JobContext) -> Result<Summary, ExportError> {
