@@ -60,6 +60,9 @@ pub fn rgba_pixels(nx: usize, ny: usize, codes: &[u8], pal: &[[u8; 4]], o: Orien
 }
 
 /// The layer's RGBA PNG.
+// Speed copy of compilers/src/row_png.rs::rgba_png (same bytes): this one
+// holds the whole RGBA image and costs less CPU (docs/PERFORMANCE.md,
+// "Speed copies").
 pub fn rgba_png(
     nx: usize,
     ny: usize,

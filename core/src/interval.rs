@@ -404,13 +404,10 @@ mod tests {
     use super::*;
 
     /// Deterministic xorshift generator, so failures reproduce.
-    struct Rng(u64);
+    struct Rng(crate::xorshift::XorShift);
     impl Rng {
         fn next(&mut self) -> f64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+            self.0.next_f64()
         }
         fn interval(&mut self) -> Interval {
             let scale = [0.5, 2.0, 10.0, 1000.0][(self.next() * 4.0) as usize];
@@ -520,7 +517,7 @@ mod tests {
             ("min", Interval::min, f64::min),
             ("max", Interval::max, f64::max),
         ];
-        let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
+        let mut rng = Rng(crate::xorshift::XorShift::new(0x9E37_79B9_7F4A_7C15));
         for _ in 0..3000 {
             let (a, b) = (rng.interval(), rng.interval());
             for (name, fi, fs) in unary {

@@ -15,8 +15,12 @@ use crate::settings::{ViewMode, ViewSettings};
 use crate::upscale::Upscaler;
 use crate::wgpu_parts::{sampler_entry, texture_entry};
 
-/// The ray-march shader (WGSL).
-pub const RENDER_SHADER: &str = include_str!("shaders/raymarch.wgsl");
+/// The ray-march shader (WGSL), after the full-screen triangle it shares
+/// with the upscale pass.
+pub const RENDER_SHADER: &str = concat!(
+    include_str!("shaders/fullscreen.wgsl"),
+    include_str!("shaders/raymarch.wgsl")
+);
 
 /// The surface is drawn at `d = THIN_BIAS_VOXELS · voxel` (mm) instead of 0,
 /// so features thinner than a voxel still cross the level in the

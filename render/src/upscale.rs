@@ -3,8 +3,12 @@
 //! [`Upscaler::paint`] draws it into the viewport with bilinear filtering.
 //! The texture is made again only when its size changes.
 
-/// The upscale pass's shader (WGSL).
-pub const BLIT_SHADER: &str = include_str!("shaders/blit.wgsl");
+/// The upscale pass's shader (WGSL), after the full-screen triangle it
+/// shares with the ray march.
+pub const BLIT_SHADER: &str = concat!(
+    include_str!("shaders/fullscreen.wgsl"),
+    include_str!("shaders/blit.wgsl")
+);
 
 pub(crate) struct Upscaler {
     pipeline: wgpu::RenderPipeline,

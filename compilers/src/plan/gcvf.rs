@@ -9,23 +9,12 @@ use volcad_core::Model;
 use super::{Assessment, Opt, Severity, Verdict};
 use crate::gcvf::{self, GcvfParams};
 use crate::job::{ExportError, JobContext, Summary};
-use crate::resources::human_bytes;
 
 pub(super) fn estimate(model: &Model, p: &GcvfParams) -> Result<Assessment, ExportError> {
     let (est, mats) = gcvf::estimate(model, p)?;
-    let [nx, ny, nz] = est.grid.dims;
     let names: Vec<&str> = mats.iter().map(|m| m.name.as_str()).collect();
-    Ok(Assessment {
-        text: format!(
-            "{nx} × {ny} × {nz} voxels ({:.3e}), resins {}, about {} on disk, {} memory",
-            est.voxels as f64,
-            names.join(", "),
-            human_bytes(est.disk_bytes),
-            human_bytes(est.memory_bytes)
-        ),
-        disk_bytes: Some(est.disk_bytes),
-        verdicts: Vec::new(),
-    })
+    let counts = format!("resins {}, about ", names.join(", "));
+    Ok(Assessment::voxel_grid(&est, &counts))
 }
 
 /// The verdict on writing the package to `dest`: none when nothing is

@@ -45,7 +45,7 @@ use crate::gcvf::GcvfParams;
 use crate::job::{self, ExportError, JobHandle};
 use crate::mesh::MeshParams;
 use crate::png_stack::PngParams;
-use crate::resources::check_disk_for;
+use crate::resources::{check_disk_for, human_bytes};
 use crate::thin::thin_feature_notes;
 use crate::vat::VatParams;
 
@@ -252,6 +252,54 @@ pub struct Assessment {
     /// Warnings and questions that follow from the design and the
     /// parameters (thin features, solver memory).
     pub verdicts: Vec<Verdict>,
+}
+
+/// What a voxel-grid export's estimate line shows of its estimate: the
+/// grid's size, its voxels, and the bytes on disk and in memory.
+trait GridEstimate {
+    /// `(dims, voxels, disk bytes, memory bytes)`.
+    fn sizes(&self) -> ([usize; 3], u64, u64, u64);
+}
+
+impl GridEstimate for crate::png_stack::Estimate {
+    fn sizes(&self) -> ([usize; 3], u64, u64, u64) {
+        (
+            self.grid.dims,
+            self.voxels,
+            self.disk_bytes,
+            self.memory_bytes,
+        )
+    }
+}
+
+impl GridEstimate for crate::mesh::MeshEstimate {
+    fn sizes(&self) -> ([usize; 3], u64, u64, u64) {
+        (
+            self.grid.dims,
+            self.voxels,
+            self.disk_bytes,
+            self.memory_bytes,
+        )
+    }
+}
+
+impl Assessment {
+    /// A voxel-grid export's estimate, checked against its disk size:
+    /// "NX × NY × NZ voxels (N), {counts}{disk} on disk, {memory} memory"
+    /// (`counts` ends with its separator, and "about " where it applies).
+    fn voxel_grid(est: &impl GridEstimate, counts: &str) -> Self {
+        let ([nx, ny, nz], voxels, disk, memory) = est.sizes();
+        Assessment {
+            text: format!(
+                "{nx} × {ny} × {nz} voxels ({:.3e}), {counts}{} on disk, {} memory",
+                voxels as f64,
+                human_bytes(disk),
+                human_bytes(memory)
+            ),
+            disk_bytes: Some(disk),
+            verdicts: Vec::new(),
+        }
+    }
 }
 
 impl ExportParams {

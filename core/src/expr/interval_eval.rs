@@ -395,13 +395,10 @@ mod tests {
     use super::*;
 
     /// Deterministic xorshift generator.
-    struct Rng(u64);
+    struct Rng(crate::xorshift::XorShift);
     impl Rng {
         fn unit(&mut self) -> f64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+            self.0.next_f64()
         }
         fn pick<T: Copy>(&mut self, xs: &[T]) -> T {
             xs[((self.unit() * xs.len() as f64) as usize).min(xs.len() - 1)]
@@ -452,7 +449,7 @@ mod tests {
     /// interval must be `EVERYTHING` when the scalar is NaN).
     #[test]
     fn every_op_is_conservative() {
-        let mut rng = Rng(0x2545_F491_4F6C_DD1D);
+        let mut rng = Rng(crate::xorshift::XorShift::new(0x2545_F491_4F6C_DD1D));
         for &op in Op::ALL {
             if op == Op::Var {
                 continue;

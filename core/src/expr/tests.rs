@@ -423,13 +423,10 @@ fn expr_is_send_sync_clone() {
 /// must contain its value at random points of random boxes.
 #[test]
 fn interval_containment_end_to_end() {
-    struct Rng(u64);
+    struct Rng(crate::xorshift::XorShift);
     impl Rng {
         fn unit(&mut self) -> f64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+            self.0.next_f64()
         }
         fn below(&mut self, n: usize) -> usize {
             ((self.unit() * n as f64) as usize).min(n - 1)
@@ -476,7 +473,7 @@ fn interval_containment_end_to_end() {
             ),
         }
     }
-    let mut rng = Rng(0xD1B5_4A32_D192_ED03);
+    let mut rng = Rng(crate::xorshift::XorShift::new(0xD1B5_4A32_D192_ED03));
     for _ in 0..400 {
         let src = random_expr(&mut rng, 4);
         let expr = Expr::compile(&src, &["x", "y", "z"]).unwrap_or_else(|e| panic!("{e}"));

@@ -132,19 +132,16 @@ impl PNode {
     /// True when some part's fractions depend on the point (see
     /// `Model::varying_fractions`).
     pub fn varying_fractions(&self) -> bool {
-        if self.leaf_material().is_some() {
-            return false;
+        if let PNode::Union(n) | PNode::Intersection(n) = self
+            && n.blend
+        {
+            return true;
         }
-        if let Some(child) = self.fraction_child() {
-            return child.varying_fractions();
+        // Which child of a union or sum holds p changes: any varying child.
+        if let Some(any) = self.any_fraction_part(PNode::varying_fractions) {
+            return any;
         }
         match self {
-            PNode::Union(n) | PNode::Intersection(n) => {
-                n.blend || n.children.iter().any(|c| c.varying_fractions())
-            }
-            // Which child holds p changes, as in a union.
-            PNode::Sum { children, .. } => children.iter().any(|c| c.varying_fractions()),
-            PNode::Difference { a, .. } => a.varying_fractions(),
             PNode::FGrade(g) => {
                 g.exprs.iter().any(|e| e.constant().is_none()) || g.child.varying_fractions()
             }
@@ -155,22 +152,33 @@ impl PNode {
     /// True when some part's fractions are averages over many samples of
     /// a child (a `Blend`: 125 or 216 evaluations a point).
     pub fn averages_fractions(&self) -> bool {
-        if self.leaf_material().is_some() {
-            return false;
-        }
-        if let Some(child) = self.fraction_child() {
-            return child.averages_fractions();
+        if let Some(any) = self.any_fraction_part(PNode::averages_fractions) {
+            return any;
         }
         match self {
-            PNode::Union(n) | PNode::Intersection(n) => {
-                n.children.iter().any(|c| c.averages_fractions())
-            }
-            PNode::Sum { children, .. } => children.iter().any(|c| c.averages_fractions()),
-            PNode::Difference { a, .. } => a.averages_fractions(),
             PNode::FGrade(g) => g.child.averages_fractions(),
             PNode::AttrGrade { child, .. } => child.averages_fractions(),
             PNode::Blend { .. } => true,
             _ => false,
+        }
+    }
+
+    /// The walk both questions above share: false at a leaf (one material),
+    /// else whether `part` holds for a part whose fractions this node
+    /// passes on (a transform's child, a union's, intersection's or sum's
+    /// children, a difference's kept side); `None` for other nodes.
+    fn any_fraction_part(&self, part: fn(&PNode) -> bool) -> Option<bool> {
+        if self.leaf_material().is_some() {
+            return Some(false);
+        }
+        if let Some(child) = self.fraction_child() {
+            return Some(part(child));
+        }
+        match self {
+            PNode::Union(n) | PNode::Intersection(n) => Some(n.children.iter().any(|c| part(c))),
+            PNode::Sum { children, .. } => Some(children.iter().any(|c| part(c))),
+            PNode::Difference { a, .. } => Some(part(a)),
+            _ => None,
         }
     }
 }

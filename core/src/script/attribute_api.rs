@@ -84,6 +84,30 @@ pub(super) fn register(engine: &mut Engine, ctx: &super::RunContext) {
     );
 }
 
+/// `node.set_attribute(name, value)` for a value that carries its own
+/// source (an image, a points column): check the name and that `kind`
+/// agrees with the attribute's declared kind (`hint` is appended to that
+/// refusal), then set it.
+pub(super) fn set_sourced(
+    n: &mut Node,
+    name: &str,
+    kind: AttributeKind,
+    source: AttrSource,
+    p: Position,
+    hint: &str,
+) -> RResult<()> {
+    let what = format!("set_attribute(\"{name}\")");
+    check_name(name, p)?;
+    check_kind(name, kind, &what).or_else(|e| fail(p, format!("{e}{hint}")))?;
+    n.attributes_mut().set(AttrDef {
+        name: name.to_owned(),
+        kind,
+        source,
+        origin: origin(p),
+    });
+    Ok(())
+}
+
 /// Refuse names a math string could not tell from a coordinate.
 pub(super) fn check_name(name: &str, p: Position) -> RResult<()> {
     if name.trim().is_empty() {

@@ -7,10 +7,10 @@ use std::sync::Arc;
 
 use rhai::{Array, Engine, NativeCallContext as Ctx, Position};
 
+use super::attribute_api::set_sourced;
 use super::values::*;
 use crate::attribute::{
-    AttrDef, AttrSource, AttributeKind, CHANNELS, ImageAxis, ImageChannel, ImageMap, Picture,
-    check_kind,
+    AttrSource, AttributeKind, CHANNELS, ImageAxis, ImageChannel, ImageMap, Picture,
 };
 use crate::node::Node;
 
@@ -92,30 +92,21 @@ pub(super) fn register(engine: &mut Engine, ctx: &super::RunContext) {
     engine.register_fn(
         "set_attribute",
         |cc: Ctx, n: &mut Node, name: &str, v: ImageValue| -> RResult<()> {
-            let p = cc.call_position();
-            let what = format!("set_attribute(\"{name}\")");
-            super::attribute_api::check_name(name, p)?;
-            let kind = match v.channel {
-                Some(_) => AttributeKind::Scalar,
-                None => AttributeKind::Vec4,
+            let (kind, hint) = match v.channel {
+                Some(_) => (
+                    AttributeKind::Scalar,
+                    "; drop the channel argument for a colour",
+                ),
+                None => (
+                    AttributeKind::Vec4,
+                    "; add a channel argument (\"luminance\", \"r\", ...) for a number",
+                ),
             };
-            check_kind(name, kind, &what).or_else(|e| {
-                let hint = match v.channel {
-                    Some(_) => "; drop the channel argument for a colour",
-                    None => "; add a channel argument (\"luminance\", \"r\", ...) for a number",
-                };
-                fail(p, format!("{e}{hint}"))
-            })?;
-            n.attributes_mut().set(AttrDef {
-                name: name.to_owned(),
-                kind,
-                source: AttrSource::Image {
-                    map: v.map,
-                    channel: v.channel,
-                },
-                origin: origin(p),
-            });
-            Ok(())
+            let source = AttrSource::Image {
+                map: v.map,
+                channel: v.channel,
+            };
+            set_sourced(n, name, kind, source, cc.call_position(), hint)
         },
     );
 }

@@ -5,7 +5,7 @@
 use glam::DVec3;
 use rhai::{Dynamic, Engine, NativeCallContext as Ctx};
 
-use super::nodes_api::{compile, mk};
+use super::nodes_api::{compile, mk, register_empty};
 use super::values::*;
 use crate::expr::COORD_VARS;
 use crate::lattice::unit_cell_edges;
@@ -22,15 +22,10 @@ pub fn register_leaves(engine: &mut Engine) {
 /// `Sphere` and `RectPrism`.
 fn register_sphere_and_box(engine: &mut Engine) {
     // Sphere
-    engine.register_fn("Sphere", |c: Ctx| -> RResult<Node> {
-        Ok(mk(
-            NodeKind::Sphere {
-                center: DVec3::ZERO,
-                radius: 1.0,
-                material: 1,
-            },
-            c.call_position(),
-        ))
+    register_empty(engine, "Sphere", || NodeKind::Sphere {
+        center: DVec3::ZERO,
+        radius: 1.0,
+        material: 1,
     });
     let sphere = |c: &Ctx, center: &Dynamic, r: &Dynamic, m: Option<&Dynamic>| -> RResult<Node> {
         let p = c.call_position();
@@ -64,15 +59,10 @@ fn register_sphere_and_box(engine: &mut Engine) {
     );
 
     // RectPrism
-    engine.register_fn("RectPrism", |c: Ctx| -> RResult<Node> {
-        Ok(mk(
-            NodeKind::RectPrism {
-                center: DVec3::ZERO,
-                size: DVec3::ONE,
-                material: 1,
-            },
-            c.call_position(),
-        ))
+    register_empty(engine, "RectPrism", || NodeKind::RectPrism {
+        center: DVec3::ZERO,
+        size: DVec3::ONE,
+        material: 1,
     });
     let prism = |c: &Ctx, center: &Dynamic, size: &Dynamic, m: Option<&Dynamic>| -> RResult<Node> {
         let p = c.call_position();
@@ -101,16 +91,11 @@ fn register_sphere_and_box(engine: &mut Engine) {
 /// `Cylinder` and `Strut` (pyvcad 3's tapered strut is in `shapes_api`).
 fn register_cylinder_and_strut(engine: &mut Engine) {
     // Cylinder
-    engine.register_fn("Cylinder", |c: Ctx| -> RResult<Node> {
-        Ok(mk(
-            NodeKind::Cylinder {
-                center: DVec3::ZERO,
-                radius: 1.0,
-                height: 1.0,
-                material: 1,
-            },
-            c.call_position(),
-        ))
+    register_empty(engine, "Cylinder", || NodeKind::Cylinder {
+        center: DVec3::ZERO,
+        radius: 1.0,
+        height: 1.0,
+        material: 1,
     });
     let cyl = |c: &Ctx,
                center: &Dynamic,

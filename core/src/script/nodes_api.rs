@@ -17,6 +17,14 @@ pub(super) fn mk(kind: NodeKind, pos: Position) -> Node {
     Node::with_origin(kind, origin(pos))
 }
 
+/// `name()` in scripts: the node `kind` makes, with pyvcad's defaults
+/// (children are added later).
+pub(super) fn register_empty(engine: &mut Engine, name: &str, kind: fn() -> NodeKind) {
+    engine.register_fn(name, move |c: Ctx| -> RResult<Node> {
+        Ok(mk(kind(), c.call_position()))
+    });
+}
+
 pub(super) fn compile(src: &str, vars: &[&str], what: &str, pos: Position) -> RResult<Arc<Expr>> {
     Expr::compile(src, vars)
         .map(Arc::new)
@@ -219,15 +227,10 @@ fn register_union_intersection(engine: &mut Engine) {
 /// `Difference`.
 fn register_difference(engine: &mut Engine) {
     // Difference: (), (L, R), (k), (k, L, R)
-    engine.register_fn("Difference", |c: Ctx| -> RResult<Node> {
-        Ok(mk(
-            NodeKind::Difference {
-                smooth: 0.0,
-                left: None,
-                right: None,
-            },
-            c.call_position(),
-        ))
+    register_empty(engine, "Difference", || NodeKind::Difference {
+        smooth: 0.0,
+        left: None,
+        right: None,
     });
     engine.register_fn("Difference", |c: Ctx, k: Dynamic| -> RResult<Node> {
         let p = c.call_position();
@@ -273,14 +276,9 @@ fn register_difference(engine: &mut Engine) {
 /// `Offset`, `Shell` and `Tile`.
 fn register_offset_shell_tile(engine: &mut Engine) {
     // Offset(o[, child]) and Shell(t[, child]): both signs accepted.
-    engine.register_fn("Offset", |c: Ctx| -> RResult<Node> {
-        Ok(mk(
-            NodeKind::Offset {
-                distance: 0.0,
-                child: None,
-            },
-            c.call_position(),
-        ))
+    register_empty(engine, "Offset", || NodeKind::Offset {
+        distance: 0.0,
+        child: None,
     });
     for arity in [1usize, 2] {
         let off = move |c: &Ctx, o: &Dynamic, ch: Option<&Dynamic>| -> RResult<Node> {
@@ -321,14 +319,9 @@ fn register_offset_shell_tile(engine: &mut Engine) {
     }
 
     // Tile: (), (child), (cx, cy, cz), (cx, cy, cz, child)
-    engine.register_fn("Tile", |c: Ctx| -> RResult<Node> {
-        Ok(mk(
-            NodeKind::Tile {
-                cell: None,
-                child: None,
-            },
-            c.call_position(),
-        ))
+    register_empty(engine, "Tile", || NodeKind::Tile {
+        cell: None,
+        child: None,
     });
     engine.register_fn("Tile", |c: Ctx, ch: Dynamic| -> RResult<Node> {
         let p = c.call_position();

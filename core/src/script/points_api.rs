@@ -6,8 +6,9 @@ use std::sync::Arc;
 
 use rhai::{Engine, NativeCallContext as Ctx};
 
+use super::attribute_api::set_sourced;
 use super::values::*;
-use crate::attribute::{AttrDef, AttrSource, AttributeKind, PointCloud, check_kind};
+use crate::attribute::{AttrSource, AttributeKind, PointCloud};
 use crate::node::Node;
 
 /// `PointsField(file, column)` in scripts: one value column of a points
@@ -57,20 +58,12 @@ pub(super) fn register(engine: &mut Engine, ctx: &super::RunContext) {
     engine.register_fn(
         "set_attribute",
         |cc: Ctx, n: &mut Node, name: &str, v: PointsValue| -> RResult<()> {
+            let source = AttrSource::Points {
+                cloud: v.cloud,
+                column: v.column,
+            };
             let p = cc.call_position();
-            let what = format!("set_attribute(\"{name}\")");
-            super::attribute_api::check_name(name, p)?;
-            check_kind(name, AttributeKind::Scalar, &what).or_else(|e| fail(p, e.to_string()))?;
-            n.attributes_mut().set(AttrDef {
-                name: name.to_owned(),
-                kind: AttributeKind::Scalar,
-                source: AttrSource::Points {
-                    cloud: v.cloud,
-                    column: v.column,
-                },
-                origin: origin(p),
-            });
-            Ok(())
+            set_sourced(n, name, AttributeKind::Scalar, source, p, "")
         },
     );
 }

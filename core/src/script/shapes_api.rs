@@ -6,7 +6,7 @@
 use glam::DVec3;
 use rhai::{Dynamic, Engine, NativeCallContext as Ctx, Position};
 
-use super::nodes_api::{mk, optional_child};
+use super::nodes_api::{mk, optional_child, register_empty};
 use super::values::*;
 use crate::node::{CapMode, Node, NodeKind};
 
@@ -296,9 +296,7 @@ fn register_mirror(engine: &mut Engine) {
 }
 
 fn register_identity_sum(engine: &mut Engine) {
-    engine.register_fn("Identity", |c: Ctx| -> RResult<Node> {
-        Ok(mk(NodeKind::Identity { child: None }, c.call_position()))
-    });
+    register_empty(engine, "Identity", || NodeKind::Identity { child: None });
     engine.register_fn("Identity", |c: Ctx, ch: Dynamic| -> RResult<Node> {
         let p = c.call_position();
         Ok(mk(

@@ -1,5 +1,5 @@
-// Volcad viewport: one fullscreen triangle; per pixel a ray is marched
-// through the baked volume (distance R16Float, colour and fractions
+// Volcad viewport: one fullscreen triangle (fullscreen.wgsl, prepended);
+// per pixel a ray is marched through the baked volume (distance R16Float, colour and fractions
 // Rgba8Unorm, all trilinear), then overlays (ground grid, bounding box,
 // axis triad) are composited analytically.
 //
@@ -40,21 +40,6 @@ const MAX_STEPS: i32 = 384;
 const MAX_VOLUME_STEPS: i32 = 320;
 const VOLUME_SAMPLES: f32 = 224.0;
 const BIG: f32 = 1.0e30;
-
-struct VsOut {
-    @builtin(position) pos: vec4f,
-    @location(0) ndc: vec2f,
-};
-
-@vertex
-fn vs_main(@builtin(vertex_index) i: u32) -> VsOut {
-    let x = f32((i << 1u) & 2u) * 2.0 - 1.0;
-    let y = f32(i & 2u) * 2.0 - 1.0;
-    var out: VsOut;
-    out.pos = vec4f(x, y, 0.0, 1.0);
-    out.ndc = vec2f(x, y);
-    return out;
-}
 
 // ---- volume lookups -------------------------------------------------------
 

@@ -17,6 +17,30 @@ use super::ExportPanels;
 /// material table.
 const GENERIC: &str = "Generic (custom voxel)";
 
+/// One grid row of the export panels: `label`, then a one-line text field
+/// `width` points wide that shows `hint` while empty, labelled by the label
+/// (for screen readers). The caller adds hover text and ends the row.
+pub(super) fn text_row(
+    ui: &mut egui::Ui,
+    label: &str,
+    text: &mut String,
+    hint: &str,
+    width: f32,
+) -> egui::Response {
+    let label = ui.label(label).id;
+    ui.add(
+        egui::TextEdit::singleline(text)
+            .hint_text(hint)
+            .desired_width(width),
+    )
+    .labelled_by(label)
+}
+
+/// A length in mm for the FEA fields: 0.01 to 100 mm, dragged in 0.01 mm steps.
+fn fea_mm(v: &mut f64) -> egui::DragValue<'_> {
+    egui::DragValue::new(v).speed(0.01).range(0.01..=100.0)
+}
+
 impl ExportPanels {
     pub(super) fn png_ui(&mut self, ui: &mut egui::Ui) {
         let presets = png_stack::presets();
@@ -140,22 +164,14 @@ impl ExportPanels {
             self.png.color_profile = None;
             return;
         }
-        let label = ui.label("Colour profile").id;
         let mut text = self
             .png
             .color_profile
             .as_ref()
             .map(|p| p.display().to_string())
             .unwrap_or_default();
-        if ui
-            .add(
-                egui::TextEdit::singleline(&mut text)
-                    .hint_text("CSV of measured resins (optional)")
-                    .desired_width(180.0),
-            )
-            .labelled_by(label)
-            .changed()
-        {
+        let hint = "CSV of measured resins (optional)";
+        if text_row(ui, "Colour profile", &mut text, hint, 180.0).changed() {
             self.png.color_profile = (!text.is_empty()).then(|| PathBuf::from(text));
         }
         ui.end_row();
@@ -224,18 +240,9 @@ impl ExportPanels {
                     ui.checkbox(threemf, "3MF");
                 });
                 ui.end_row();
-                let label = ui.label("3MF infill % of f").id;
                 let mut expr = self.mesh.infill_expr.clone().unwrap_or_default();
                 let hint = volcad_compilers::mesh::DEFAULT_INFILL;
-                if ui
-                    .add(
-                        egui::TextEdit::singleline(&mut expr)
-                            .hint_text(hint)
-                            .desired_width(140.0),
-                    )
-                    .labelled_by(label)
-                    .changed()
-                {
+                if text_row(ui, "3MF infill % of f", &mut expr, hint, 140.0).changed() {
                     self.mesh.infill_expr =
                         (!expr.trim().is_empty()).then(|| expr.trim().to_owned());
                 }
@@ -254,38 +261,23 @@ impl ExportPanels {
             match self.fea.element {
                 Element::C3D8R => {
                     let label = ui.label("Brick (mm)").id;
-                    ui.add(
-                        egui::DragValue::new(&mut self.fea.voxel)
-                            .speed(0.01)
-                            .range(0.01..=100.0),
-                    )
-                    .labelled_by(label);
+                    ui.add(fea_mm(&mut self.fea.voxel)).labelled_by(label);
                     ui.end_row();
                 }
                 Element::C3D4 => {
                     let label = ui.label("Cell min / max (mm)").id;
                     ui.horizontal(|ui| {
-                        ui.add(
-                            egui::DragValue::new(&mut self.fea.min_cell)
-                                .speed(0.01)
-                                .range(0.01..=100.0),
-                        )
-                        .labelled_by(label);
-                        ui.add(
-                            egui::DragValue::new(&mut self.fea.max_cell)
-                                .speed(0.01)
-                                .range(0.01..=100.0),
-                        )
-                        .labelled_by(label);
+                        ui.add(fea_mm(&mut self.fea.min_cell)).labelled_by(label);
+                        ui.add(fea_mm(&mut self.fea.max_cell)).labelled_by(label);
                     });
                     ui.end_row();
-                    let label = ui.label("Size of h (mm)").id;
-                    ui.add(
-                        egui::TextEdit::singleline(&mut self.fea_expr)
-                            .hint_text("linear in h")
-                            .desired_width(140.0),
-                    )
-                    .labelled_by(label);
+                    text_row(
+                        ui,
+                        "Size of h (mm)",
+                        &mut self.fea_expr,
+                        "linear in h",
+                        140.0,
+                    );
                     ui.end_row();
                 }
             }

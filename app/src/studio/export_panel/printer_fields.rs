@@ -14,6 +14,7 @@ use volcad_compilers::vat::{Intensity, VatParams, VatPrinter, vat_presets};
 use volcad_core::Model;
 use volcad_core::attribute::AttributeKind;
 
+use super::fields::text_row;
 use crate::studio::jobs::in_panel_words;
 
 /// The fields of the GCVF and vat panels.
@@ -139,14 +140,9 @@ impl PrinterFields {
 
     /// The resin map row (GCVF, and PNG stacks for a J750).
     pub(super) fn map_row(&mut self, ui: &mut egui::Ui) {
-        let label = ui.label("Resin map").id;
-        ui.add(
-            egui::TextEdit::singleline(&mut self.map)
-                .hint_text("red=VeroMgnt,blue=VeroCyan")
-                .desired_width(220.0),
-        )
-        .labelled_by(label)
-        .on_hover_text("Design material = J750 resin, for names the J750 table lacks");
+        let hint = "red=VeroMgnt,blue=VeroCyan";
+        text_row(ui, "Resin map", &mut self.map, hint, 220.0)
+            .on_hover_text("Design material = J750 resin, for names the J750 table lacks");
         ui.end_row();
     }
 
@@ -220,13 +216,8 @@ impl PrinterFields {
                 self.custom_rows(ui);
             }
             self.intensity_row(ui, model);
-            let label = ui.label("Vat materials").id;
-            ui.add(
-                egui::TextEdit::singleline(&mut self.vats)
-                    .hint_text("one vat; or a,b (a+c,b)")
-                    .desired_width(220.0),
-            )
-            .labelled_by(label);
+            let hint = "one vat; or a,b (a+c,b)";
+            text_row(ui, "Vat materials", &mut self.vats, hint, 220.0);
             ui.end_row();
             self.draw_rows(ui);
             ui.label("");
@@ -259,14 +250,7 @@ impl PrinterFields {
             ),
         ];
         for (name, hint, text, tip) in rows {
-            let label = ui.label(name).id;
-            ui.add(
-                egui::TextEdit::singleline(text)
-                    .hint_text(hint)
-                    .desired_width(220.0),
-            )
-            .labelled_by(label)
-            .on_hover_text(tip);
+            text_row(ui, name, text, hint, 220.0).on_hover_text(tip);
             ui.end_row();
         }
     }
@@ -337,14 +321,9 @@ impl PrinterFields {
             .labelled_by(label);
         ui.end_row();
         if matches!(self.intensity, Intensity::Attribute { .. }) {
-            let label = ui.label("Range").id;
-            ui.add(
-                egui::TextEdit::singleline(&mut self.range)
-                    .hint_text("the attribute's bound; or LO,HI")
-                    .desired_width(220.0),
-            )
-            .labelled_by(label)
-            .on_hover_text("The attribute values shown as black and white");
+            let hint = "the attribute's bound; or LO,HI";
+            text_row(ui, "Range", &mut self.range, hint, 220.0)
+                .on_hover_text("The attribute values shown as black and white");
             ui.end_row();
         } else {
             self.range.clear();
