@@ -87,6 +87,9 @@ fn zlib(
 
 /// The layer's RGBA PNG (`codes` x fastest from min Y, each its colour
 /// `pal[code]`), byte for byte [`crate::slice_image::rgba_png`]'s.
+// Speed copy of compilers/src/slice_image.rs::rgba_png (same bytes): this
+// one encodes row by row and holds no RGBA image (docs/PERFORMANCE.md,
+// "Speed copies").
 pub fn rgba_png(
     nx: usize,
     ny: usize,
