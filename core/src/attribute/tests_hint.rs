@@ -94,11 +94,30 @@ fn a_later_child_still_gives_its_value() {
     );
     assert!(m.attrs.as_ref().unwrap().hint.is_some());
     assert!(agree(&m) > 500);
-    // A nested union is spliced into the top one: no hint, the search.
+    // A nested union is spliced into the top one: its children's run of
+    // the top union's children hands over the nested union.
     let m = model(&format!(
         "let b = RectPrism(Vec3(20, 0, 0), Vec3(50, 3, 3), m.id(\"blue\")); {SPHERES} let w = Union(); w.add_child(b); w.add_child(u); w"
     ));
+    assert!(m.attrs.as_ref().unwrap().hint.is_some());
     assert!(agree(&m) > 500);
+}
+
+#[test]
+fn a_union_graded_as_a_whole_is_handed_over_when_spliced() {
+    // The bunny lattice graded by one `set_attribute` on its union, a body
+    // after it: `flatten` splices the struts into the top union.
+    let lattice = "let l = Union(); for i in 0..30 { l.add_child(Sphere(Vec3(1.5 * i, 0, 0), 1.0, m.id(\"red\"))); } l.set_attribute(\"temperature\", \"20 + x\");";
+    let body = "RectPrism(Vec3(20, 0, 0), Vec3(50, 3, 3), m.id(\"blue\"))";
+    let m = model(&format!("{lattice} Union(false, [l, {body}])"));
+    assert!(m.attrs.as_ref().unwrap().hint.is_some());
+    assert!(agree(&m) > 1000);
+    // Body first, then two graded runs (a later run still gives its value).
+    let m = model(&format!(
+        "{lattice} let l2 = Union(); for i in 0..5 {{ l2.add_child(Sphere(Vec3(3.0 * i, 1, 0), 1.5, m.id(\"green\"))); }} l2.set_attribute(\"temperature\", 7.0); Union(false, [{body}, l, l2])"
+    ));
+    assert!(m.attrs.as_ref().unwrap().hint.is_some());
+    assert!(agree(&m) > 1000);
 }
 
 #[test]
