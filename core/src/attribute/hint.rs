@@ -9,8 +9,11 @@
 //! lattice, whose 3,286 struts each set a modulus, that second search cost
 //! more than the fractions of per-strut FGrades. When the design's top node
 //! is a sharp union whose children carrying attributes are children of the
-//! prepared union in the same order, the attribute is read from the child
-//! the distance walk found: no containment test at all.
+//! prepared union in the same order (or nested unions spliced into it, each
+//! a run of its children), the attribute is read from the child the
+//! distance walk found: no containment test at all. A union that carries an
+//! attribute itself is not spliced (`model::flatten`), so a lattice graded
+//! as a whole is one child here and shares its prepared distance.
 //!
 //! The child found is the one whose distance is ≤ 0 first in child order;
 //! the attribute tree's own search asks each child `contains`, which for a

@@ -104,9 +104,9 @@ fn a_later_child_still_gives_its_value() {
 }
 
 #[test]
-fn a_union_graded_as_a_whole_is_handed_over_when_spliced() {
+fn a_union_graded_as_a_whole_is_handed_over() {
     // The bunny lattice graded by one `set_attribute` on its union, a body
-    // after it: `flatten` splices the struts into the top union.
+    // after it: the graded union stays one child of the top union.
     let lattice = "let l = Union(); for i in 0..30 { l.add_child(Sphere(Vec3(1.5 * i, 0, 0), 1.0, m.id(\"red\"))); } l.set_attribute(\"temperature\", \"20 + x\");";
     let body = "RectPrism(Vec3(20, 0, 0), Vec3(50, 3, 3), m.id(\"blue\"))";
     let m = model(&format!("{lattice} Union(false, [l, {body}])"));
@@ -118,6 +118,39 @@ fn a_union_graded_as_a_whole_is_handed_over_when_spliced() {
     ));
     assert!(m.attrs.as_ref().unwrap().hint.is_some());
     assert!(agree(&m) > 1000);
+}
+
+#[test]
+fn a_graded_union_kept_whole_gives_the_distance_and_fractions_of_the_plain_one() {
+    // The graded union is not spliced into the top union and its one
+    // material is read without a search: bit for bit what the plain
+    // (spliced) design gives.
+    let lattice = "let l = Union(); for i in 0..30 { l.add_child(Sphere(Vec3(1.5 * i, 0.1 * i, 0), 1.0, m.id(\"red\"))); }";
+    let top = "Union(false, [l, RectPrism(Vec3(20, 0, 0), Vec3(50, 3, 3), m.id(\"blue\"))])";
+    let plain = model(&format!("{lattice} {top}"));
+    let graded = model(&format!(
+        "{lattice} l.set_attribute(\"temperature\", \"20 + x\"); {top}"
+    ));
+    let b = plain.bbox();
+    let (mut fa, mut fb) = (vec![0.0; 2], vec![0.0; 2]);
+    let mut inside = 0;
+    for i in 0..20_000 {
+        let t = DVec3::new(
+            (i % 40) as f64 / 39.0,
+            (i / 40 % 25) as f64 / 24.0,
+            (i / 1000) as f64 / 19.0,
+        );
+        let p = b.min + (b.max - b.min) * t;
+        let da = plain.eval_into(p, &mut fa);
+        let db = graded.eval_into(p, &mut fb);
+        assert_eq!(da.to_bits(), db.to_bits(), "{p}");
+        assert!(
+            fa.iter().zip(&fb).all(|(x, y)| x.to_bits() == y.to_bits()),
+            "{p}: {fa:?} {fb:?}"
+        );
+        inside += usize::from(da <= 0.0 && fa[0] > 0.0);
+    }
+    assert!(inside > 500, "{inside}");
 }
 
 #[test]
