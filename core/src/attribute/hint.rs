@@ -31,7 +31,7 @@ use crate::model::{Model, SubDistance};
 pub(super) struct RootHint {
     /// Per child of the prepared union: its position among the attribute
     /// tree's children, `u32::MAX` where it carries no attribute.
-    of_child: Vec<u32>,
+    pub(super) of_child: Vec<u32>,
     /// Per attribute: the last child (prepared union's numbering) that
     /// defines it; a point whose first containing child is at or after it
     /// has no value from a later child.
@@ -124,29 +124,7 @@ impl Model {
         wanted: &[usize],
         values: &mut [f64],
     ) -> Result<f64, AttributeError> {
-        let mut need = 0;
-        for &i in wanted {
-            let Some(info) = self.attributes().get(i) else {
-                return Err(AttributeError {
-                    node: "design".into(),
-                    message: format!(
-                        "has {} attributes; there is no attribute {i}",
-                        self.attributes().len()
-                    ),
-                });
-            };
-            need += info.kind.width();
-        }
-        if values.len() != need {
-            return Err(AttributeError {
-                node: "design".into(),
-                message: format!(
-                    "the {} attributes asked for need {need} numbers a point, the buffer has {}",
-                    wanted.len(),
-                    values.len()
-                ),
-            });
-        }
+        self.check_wanted(wanted, 1, values.len())?;
         fracs.fill(0.0);
         let (d, first) = self.root.eval_first(p, fracs);
         let mut at = 0;
@@ -163,5 +141,39 @@ impl Model {
             }
         }
         Ok(d)
+    }
+
+    /// The numbers a point of `wanted` takes, checked against a buffer of
+    /// `len` for `points` points.
+    pub(super) fn check_wanted(
+        &self,
+        wanted: &[usize],
+        points: usize,
+        len: usize,
+    ) -> Result<usize, AttributeError> {
+        let mut need = 0;
+        for &i in wanted {
+            let Some(info) = self.attributes().get(i) else {
+                return Err(AttributeError {
+                    node: "design".into(),
+                    message: format!(
+                        "has {} attributes; there is no attribute {i}",
+                        self.attributes().len()
+                    ),
+                });
+            };
+            need += info.kind.width();
+        }
+        if len != need * points {
+            return Err(AttributeError {
+                node: "design".into(),
+                message: format!(
+                    "the {} attributes asked for need {need} numbers a point, {} for {points} points; the buffer has {len}",
+                    wanted.len(),
+                    need * points
+                ),
+            });
+        }
+        Ok(need)
     }
 }

@@ -13,6 +13,7 @@
 //! unless the node names a resolver ([`Resolver`]); a smooth union blends by
 //! its distance blend weight.
 
+mod batch;
 mod convert;
 mod describe;
 mod eval;

@@ -30,13 +30,18 @@ fn agree(m: &Model) -> usize {
     let mut found = 0;
     let all: Vec<usize> = (0..m.attributes().len()).collect();
     let width: usize = m.attributes().iter().map(|a| a.kind.width()).sum();
-    for i in 0..n * n * n {
-        let t = DVec3::new(
-            (i % n) as f64 + 0.37,
-            (i / n % n) as f64 + 0.61,
-            (i / (n * n)) as f64 + 0.23,
-        ) / n as f64;
-        let p = b.min + (b.max - b.min) * t;
+    let pts: Vec<DVec3> = (0..n * n * n)
+        .map(|i| {
+            let t = DVec3::new(
+                (i % n) as f64 + 0.37,
+                (i / n % n) as f64 + 0.61,
+                (i / (n * n)) as f64 + 0.23,
+            ) / n as f64;
+            b.min + (b.max - b.min) * t
+        })
+        .collect();
+    batch_agrees(m, &pts, &all);
+    for &p in &pts {
         let mut f = vec![0.0; k];
         let d = m.eval_into(p, &mut f);
         let mut f2 = vec![0.0; k];
@@ -65,6 +70,31 @@ fn agree(m: &Model) -> usize {
         }
     }
     found
+}
+
+/// `eval_with_attributes_batch` gives what `eval_with_attributes` gives
+/// point by point, bit for bit.
+fn batch_agrees(m: &Model, pts: &[DVec3], wanted: &[usize]) {
+    let k = m.materials().len();
+    let width: usize = wanted.iter().map(|&i| m.attributes()[i].kind.width()).sum();
+    let (mut d, mut f, mut v) = (
+        vec![0.0; pts.len()],
+        vec![0.0; k * pts.len()],
+        vec![0.0; width * pts.len()],
+    );
+    m.eval_with_attributes_batch(pts, &mut d, &mut f, wanted, &mut v)
+        .unwrap();
+    let (mut f1, mut v1) = (vec![0.0; k], vec![0.0; width]);
+    for (i, p) in pts.iter().enumerate() {
+        let d1 = m
+            .eval_with_attributes(*p, &mut f1, wanted, &mut v1)
+            .unwrap();
+        assert!(same(d1, d[i]), "{p}");
+        assert_eq!(f1, f[i * k..(i + 1) * k], "{p}");
+        for (a, b) in v1.iter().zip(&v[i * width..(i + 1) * width]) {
+            assert!(same(*a, *b), "{p}: one point {a}, batch {b}");
+        }
+    }
 }
 
 /// 30 overlapping spheres, each with its index as `temperature`, some
@@ -151,6 +181,41 @@ fn a_graded_union_kept_whole_gives_the_distance_and_fractions_of_the_plain_one()
         inside += usize::from(da <= 0.0 && fa[0] > 0.0);
     }
     assert!(inside > 500, "{inside}");
+}
+
+#[test]
+fn a_batch_runs_shared_math_strings_and_refuses_the_first_bad_point() {
+    // Per-child strings shared by every child (one tape), a union graded
+    // as a whole, an affine string (its own per-point form) and a colour.
+    let per_child = "let u = Union(); for i in 0..30 { let s = Sphere(Vec3(1.5 * i, 0, 0), 1.0, m.id(\"red\")); s.set_attribute(\"modulus\", \"500 + 20*clamp(0, x, 40)\"); s.set_attribute(\"temperature\", \"20 + 2*x\"); s.set_attribute(\"color\", Vec4(0.5, 0.5, 0.5, 1.0)); u.add_child(s); } u.add_child(RectPrism(Vec3(20, 0, 0), Vec3(50, 3, 3), m.id(\"blue\"))); u";
+    assert!(agree(&model(per_child)) > 1000);
+    // A modulus that turns negative: the batch names the first such point
+    // in order, as one point at a time does.
+    let bad = model(
+        "let l = Union(); for i in 0..30 { l.add_child(Sphere(Vec3(1.5 * i, 0, 0), 1.0, m.id(\"red\"))); } l.set_attribute(\"modulus\", \"100 - 5*abs(x - 10)\"); Union(false, [l, RectPrism(Vec3(60, 0, 0), Vec3(2, 2, 2), m.id(\"blue\"))])",
+    );
+    let pts: Vec<DVec3> = (0..400)
+        .map(|i| DVec3::new(0.11 * i as f64, 0.1, 0.0))
+        .collect();
+    let k = bad.materials().len();
+    let (mut d, mut f, mut v) = (vec![0.0; 400], vec![0.0; 400 * k], vec![0.0; 400]);
+    let e = bad
+        .eval_with_attributes_batch(&pts, &mut d, &mut f, &[0], &mut v)
+        .unwrap_err();
+    let first = pts
+        .iter()
+        .find_map(|p| {
+            bad.eval_with_attributes(*p, &mut vec![0.0; k], &[0], &mut [0.0])
+                .err()
+        })
+        .unwrap();
+    assert_eq!(e.message, first.message);
+    assert!(e.message.contains("modulus"), "{}", e.message);
+    // Buffers of the wrong size are refused before any work.
+    let e = bad
+        .eval_with_attributes_batch(&pts, &mut d, &mut f, &[0], &mut v[..10])
+        .unwrap_err();
+    assert!(e.message.contains("the buffer has 10"), "{}", e.message);
 }
 
 #[test]
