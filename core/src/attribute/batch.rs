@@ -54,11 +54,10 @@ impl Evaluator {
     /// that child's own math string of the coordinates.
     fn batch_tape(&self, idx: usize, first: usize) -> Option<(&Arc<Expr>, &ANode)> {
         let h = self.hint.as_ref()?;
-        let root = &self.root;
-        if root.own_of[idx].is_some() || !matches!(root.resolver(idx), super::Resolver::First) {
+        if !h.first_wins[idx] {
             return None;
         }
-        let Op::Pick { children, .. } = &root.op else {
+        let Op::Pick { children, .. } = &self.root.op else {
             return None;
         };
         let c = children.get(*h.of_child.get(first)? as usize)?;

@@ -36,6 +36,9 @@ pub(super) struct RootHint {
     /// defines it; a point whose first containing child is at or after it
     /// has no value from a later child.
     last: Vec<Option<u32>>,
+    /// Per attribute: the root neither sets it nor names a resolver for
+    /// it, so the first child containing a point gives it.
+    pub(super) first_wins: Vec<bool>,
 }
 
 impl Evaluator {
@@ -61,8 +64,7 @@ impl Evaluator {
         let root = &self.root;
         if let Some(h) = &self.hint
             && first != usize::MAX
-            && root.own_of[idx].is_none()
-            && matches!(root.resolver(idx), Resolver::First)
+            && h.first_wins[idx]
             && let Op::Pick { children, .. } = &root.op
         {
             // Children before `first` do not contain p; `first` does.
@@ -107,7 +109,14 @@ fn root_hint(root: &ANode, top: &SubDistance) -> Option<RootHint> {
             }
         }
     }
-    Some(RootHint { of_child, last })
+    let first_wins = (0..root.defines.len())
+        .map(|i| root.own_of[i].is_none() && matches!(root.resolver(i), Resolver::First))
+        .collect();
+    Some(RootHint {
+        of_child,
+        last,
+        first_wins,
+    })
 }
 
 impl Model {
