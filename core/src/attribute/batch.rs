@@ -157,14 +157,22 @@ impl Batch<'_> {
     /// Attribute `idx` at every point into its columns of `values`.
     fn attribute(&self, idx: usize, values: &mut [f64]) -> Result<(), AttributeError> {
         let mut groups: Vec<Group<'_>> = Vec::new();
+        let hint = self.a.hint.as_ref().filter(|h| h.first_wins[idx]);
         for (i, p) in self.pts.iter().enumerate() {
             let o = &mut values[i * self.need + self.at..][..self.w];
-            if self.dists[i] > 0.0 {
+            let first = self.firsts[i];
+            // Outside, or in a child without attributes after the last that
+            // defines it (the bunny's body): no value, as `eval_first` says.
+            let none_after = |h: &super::hint::RootHint| {
+                h.of_child.get(first) == Some(&u32::MAX)
+                    && h.last[idx].is_none_or(|l| l as usize <= first)
+            };
+            if self.dists[i] > 0.0 || hint.is_some_and(none_after) {
                 o.fill(f64::NAN);
                 continue;
             }
             if self.w == 1
-                && let Some((e, node)) = self.a.batch_tape(idx, self.firsts[i])
+                && let Some((e, node)) = self.a.batch_tape(idx, first)
             {
                 match groups.iter_mut().find(|(g, _, _)| Arc::ptr_eq(g, e)) {
                     Some((_, _, list)) => list.push(i),
@@ -172,7 +180,7 @@ impl Batch<'_> {
                 }
                 continue;
             }
-            if !self.a.eval_first(idx, *p, self.firsts[i], o)? {
+            if !self.a.eval_first(idx, *p, first, o)? {
                 o.fill(f64::NAN);
             }
         }

@@ -35,7 +35,7 @@ pub(super) struct RootHint {
     /// Per attribute: the last child (prepared union's numbering) that
     /// defines it; a point whose first containing child is at or after it
     /// has no value from a later child.
-    last: Vec<Option<u32>>,
+    pub(super) last: Vec<Option<u32>>,
     /// Per attribute: the root neither sets it nor names a resolver for
     /// it, so the first child containing a point gives it.
     pub(super) first_wins: Vec<bool>,
