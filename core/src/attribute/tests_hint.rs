@@ -97,6 +97,14 @@ fn batch_agrees(m: &Model, pts: &[DVec3], wanted: &[usize]) {
     }
 }
 
+/// [`agree`] on the design `src`, whose top union must hand over the
+/// child it found.
+fn hinted(src: &str) -> usize {
+    let m = model(src);
+    assert!(m.attrs.as_ref().unwrap().hint.is_some(), "{src}");
+    agree(&m)
+}
+
 /// 30 overlapping spheres, each with its index as `temperature`, some
 /// without one, in a union at the top.
 const SPHERES: &str = "let u = Union(); for i in 0..30 { let s = Sphere(Vec3(1.5 * i, 0, 0), 1.0, m.id(\"red\")); if i % 4 != 3 { s.set_attribute(\"temperature\", 1.0 * i); } u.add_child(s); }";
@@ -105,32 +113,28 @@ const SPHERES: &str = "let u = Union(); for i in 0..30 { let s = Sphere(Vec3(1.5
 fn the_top_union_hands_over_the_child_it_found() {
     // Children with the attribute, without it, and a plain box after them
     // (the bunny lattice's clear body).
-    let m = model(&format!(
-        "{SPHERES} u.add_child(RectPrism(Vec3(20, 0, 0), Vec3(50, 3, 3), m.id(\"blue\"))); u"
-    ));
-    assert!(m.attrs.as_ref().unwrap().hint.is_some());
-    assert!(agree(&m) > 1000);
+    assert!(
+        hinted(&format!(
+            "{SPHERES} u.add_child(RectPrism(Vec3(20, 0, 0), Vec3(50, 3, 3), m.id(\"blue\"))); u"
+        )) > 1000
+    );
 }
 
 #[test]
 fn a_later_child_still_gives_its_value() {
     // A plain box comes first: where it holds a point, a child after it
     // that holds the point too gives the value (moved children, a colour).
-    let m = model(
-        "let u = Union(); u.add_child(RectPrism(Vec3(20, 0, 0), Vec3(50, 3, 3), m.id(\"blue\")));
+    assert!(hinted("let u = Union(); u.add_child(RectPrism(Vec3(20, 0, 0), Vec3(50, 3, 3), m.id(\"blue\")));
          for i in 0..30 { let s = Sphere(Vec3(1.5 * i, 0, 0), 1.0, m.id(\"red\")); if i % 4 != 3 { s.set_attribute(\"temperature\", 1.0 * i); } u.add_child(s); }
          for c in 0..3 { let s = Sphere(Vec3(10.0 * c, 0, 0), 2.0, m.id(\"green\")); s.set_attribute(\"temperature\", 100.0 + c); s.set_attribute(\"color\", Vec4(0.1 * c, 0.5, 0.5, 1.0)); u.add_child(Translate(1.0, 0.0, 0.0, s)); }
-         u",
-    );
-    assert!(m.attrs.as_ref().unwrap().hint.is_some());
-    assert!(agree(&m) > 500);
+         u",) > 500);
     // A nested union is spliced into the top one: its children's run of
     // the top union's children hands over the nested union.
-    let m = model(&format!(
-        "let b = RectPrism(Vec3(20, 0, 0), Vec3(50, 3, 3), m.id(\"blue\")); {SPHERES} let w = Union(); w.add_child(b); w.add_child(u); w"
-    ));
-    assert!(m.attrs.as_ref().unwrap().hint.is_some());
-    assert!(agree(&m) > 500);
+    assert!(
+        hinted(&format!(
+            "let b = RectPrism(Vec3(20, 0, 0), Vec3(50, 3, 3), m.id(\"blue\")); {SPHERES} let w = Union(); w.add_child(b); w.add_child(u); w"
+        )) > 500
+    );
 }
 
 #[test]
@@ -139,15 +143,13 @@ fn a_union_graded_as_a_whole_is_handed_over() {
     // after it: the graded union stays one child of the top union.
     let lattice = "let l = Union(); for i in 0..30 { l.add_child(Sphere(Vec3(1.5 * i, 0, 0), 1.0, m.id(\"red\"))); } l.set_attribute(\"temperature\", \"20 + x\");";
     let body = "RectPrism(Vec3(20, 0, 0), Vec3(50, 3, 3), m.id(\"blue\"))";
-    let m = model(&format!("{lattice} Union(false, [l, {body}])"));
-    assert!(m.attrs.as_ref().unwrap().hint.is_some());
-    assert!(agree(&m) > 1000);
+    assert!(hinted(&format!("{lattice} Union(false, [l, {body}])")) > 1000);
     // Body first, then two graded runs (a later run still gives its value).
-    let m = model(&format!(
-        "{lattice} let l2 = Union(); for i in 0..5 {{ l2.add_child(Sphere(Vec3(3.0 * i, 1, 0), 1.5, m.id(\"green\"))); }} l2.set_attribute(\"temperature\", 7.0); Union(false, [{body}, l, l2])"
-    ));
-    assert!(m.attrs.as_ref().unwrap().hint.is_some());
-    assert!(agree(&m) > 1000);
+    assert!(
+        hinted(&format!(
+            "{lattice} let l2 = Union(); for i in 0..5 {{ l2.add_child(Sphere(Vec3(3.0 * i, 1, 0), 1.5, m.id(\"green\"))); }} l2.set_attribute(\"temperature\", 7.0); Union(false, [{body}, l, l2])"
+        )) > 1000
+    );
 }
 
 #[test]
