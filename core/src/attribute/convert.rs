@@ -172,11 +172,16 @@ mod tests {
     #[test]
     fn lookup_interpolates_and_clamps() {
         let t = Table::new(&[(20.0, 0.0), (60.0, 0.5), (90.0, 1.0)], "t").unwrap();
-        assert_eq!(t.lookup(40.0), (0.25, false));
-        assert_eq!(t.lookup(75.0), (0.75, false));
-        assert_eq!(t.lookup(60.0), (0.5, false));
-        assert_eq!(t.lookup(10.0), (0.0, true));
-        assert_eq!(t.lookup(95.0), (1.0, true));
+        crate::attribute::assert_maps(
+            |x| t.lookup(x),
+            &[
+                (40.0, 0.25, false),
+                (75.0, 0.75, false),
+                (60.0, 0.5, false),
+                (10.0, 0.0, true),
+                (95.0, 1.0, true),
+            ],
+        );
     }
 
     #[test]

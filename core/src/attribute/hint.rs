@@ -9,8 +9,11 @@
 //! lattice, whose 3,286 struts each set a modulus, that second search cost
 //! more than the fractions of per-strut FGrades. When the design's top node
 //! is a sharp union whose children carrying attributes are children of the
-//! prepared union in the same order, the attribute is read from the child
-//! the distance walk found: no containment test at all.
+//! prepared union in the same order (or nested unions spliced into it, each
+//! a run of its children), the attribute is read from the child the
+//! distance walk found: no containment test at all. A union that carries an
+//! attribute itself is not spliced (`model::flatten`), so a lattice graded
+//! as a whole is one child here and shares its prepared distance.
 //!
 //! The child found is the one whose distance is ≤ 0 first in child order;
 //! the attribute tree's own search asks each child `contains`, which for a
@@ -28,11 +31,14 @@ use crate::model::{Model, SubDistance};
 pub(super) struct RootHint {
     /// Per child of the prepared union: its position among the attribute
     /// tree's children, `u32::MAX` where it carries no attribute.
-    of_child: Vec<u32>,
+    pub(super) of_child: Vec<u32>,
     /// Per attribute: the last child (prepared union's numbering) that
     /// defines it; a point whose first containing child is at or after it
     /// has no value from a later child.
-    last: Vec<Option<u32>>,
+    pub(super) last: Vec<Option<u32>>,
+    /// Per attribute: the root neither sets it nor names a resolver for
+    /// it, so the first child containing a point gives it.
+    pub(super) first_wins: Vec<bool>,
 }
 
 impl Evaluator {
@@ -58,8 +64,7 @@ impl Evaluator {
         let root = &self.root;
         if let Some(h) = &self.hint
             && first != usize::MAX
-            && root.own_of[idx].is_none()
-            && matches!(root.resolver(idx), Resolver::First)
+            && h.first_wins[idx]
             && let Op::Pick { children, .. } = &root.op
         {
             // Children before `first` do not contain p; `first` does.
@@ -104,7 +109,14 @@ fn root_hint(root: &ANode, top: &SubDistance) -> Option<RootHint> {
             }
         }
     }
-    Some(RootHint { of_child, last })
+    let first_wins = (0..root.defines.len())
+        .map(|i| root.own_of[i].is_none() && matches!(root.resolver(i), Resolver::First))
+        .collect();
+    Some(RootHint {
+        of_child,
+        last,
+        first_wins,
+    })
 }
 
 impl Model {
@@ -121,29 +133,7 @@ impl Model {
         wanted: &[usize],
         values: &mut [f64],
     ) -> Result<f64, AttributeError> {
-        let mut need = 0;
-        for &i in wanted {
-            let Some(info) = self.attributes().get(i) else {
-                return Err(AttributeError {
-                    node: "design".into(),
-                    message: format!(
-                        "has {} attributes; there is no attribute {i}",
-                        self.attributes().len()
-                    ),
-                });
-            };
-            need += info.kind.width();
-        }
-        if values.len() != need {
-            return Err(AttributeError {
-                node: "design".into(),
-                message: format!(
-                    "the {} attributes asked for need {need} numbers a point, the buffer has {}",
-                    wanted.len(),
-                    values.len()
-                ),
-            });
-        }
+        self.check_wanted(wanted, 1, values.len())?;
         fracs.fill(0.0);
         let (d, first) = self.root.eval_first(p, fracs);
         let mut at = 0;
@@ -160,5 +150,39 @@ impl Model {
             }
         }
         Ok(d)
+    }
+
+    /// The numbers a point of `wanted` takes, checked against a buffer of
+    /// `len` for `points` points.
+    pub(super) fn check_wanted(
+        &self,
+        wanted: &[usize],
+        points: usize,
+        len: usize,
+    ) -> Result<usize, AttributeError> {
+        let mut need = 0;
+        for &i in wanted {
+            let Some(info) = self.attributes().get(i) else {
+                return Err(AttributeError {
+                    node: "design".into(),
+                    message: format!(
+                        "has {} attributes; there is no attribute {i}",
+                        self.attributes().len()
+                    ),
+                });
+            };
+            need += info.kind.width();
+        }
+        if len != need * points {
+            return Err(AttributeError {
+                node: "design".into(),
+                message: format!(
+                    "the {} attributes asked for need {need} numbers a point, {} for {points} points; the buffer has {len}",
+                    wanted.len(),
+                    need * points
+                ),
+            });
+        }
+        Ok(need)
     }
 }

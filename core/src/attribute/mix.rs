@@ -264,10 +264,9 @@ mod tests {
     #[test]
     fn two_rows_give_the_linear_mix() {
         let t = MixTable::new(&[(0.0, 30.0), (1.0, 95.0)], "t").unwrap();
-        assert_eq!(t.share(30.0), (0.0, false));
-        assert_eq!(t.share(95.0), (1.0, false));
         // (62.5 − 30) / 65 = 0.5.
-        assert_eq!(t.share(62.5), (0.5, false));
+        let rows = [(30.0, 0.0, false), (95.0, 1.0, false), (62.5, 0.5, false)];
+        crate::attribute::assert_maps(|v| t.share(v), &rows);
         assert!((t.share(43.0).0 - 0.2).abs() < 1e-15);
     }
 
@@ -276,26 +275,27 @@ mod tests {
         // Shares 0, 0.5, 1 measure 30, 50, 95: below 50 the share rises
         // 0.5 per 20, above it 0.5 per 45.
         let t = MixTable::new(&[(0.0, 30.0), (0.5, 50.0), (1.0, 95.0)], "t").unwrap();
-        assert_eq!(t.share(40.0), (0.25, false));
-        assert_eq!(t.share(50.0), (0.5, false));
-        assert_eq!(t.share(72.5), (0.75, false));
+        let rows = [(40.0, 0.25, false), (50.0, 0.5, false), (72.5, 0.75, false)];
+        crate::attribute::assert_maps(|v| t.share(v), &rows);
     }
 
     #[test]
     fn falling_values_invert_too() {
         let t = MixTable::new(&[(0.0, 90.0), (0.5, 60.0), (1.0, 20.0)], "t").unwrap();
-        assert_eq!(t.share(75.0), (0.25, false));
-        assert_eq!(t.share(40.0), (0.75, false));
-        assert_eq!(t.share(100.0), (0.0, true));
-        assert_eq!(t.share(10.0), (1.0, true));
+        let rows = [
+            (75.0, 0.25, false),
+            (40.0, 0.75, false),
+            (100.0, 0.0, true),
+            (10.0, 1.0, true),
+        ];
+        crate::attribute::assert_maps(|v| t.share(v), &rows);
         assert_eq!(t.value_range(), (20.0, 90.0));
     }
 
     #[test]
     fn clamps_at_the_ends() {
         let t = MixTable::new(&[(0.0, 30.0), (1.0, 95.0)], "t").unwrap();
-        assert_eq!(t.share(20.0), (0.0, true));
-        assert_eq!(t.share(99.0), (1.0, true));
+        crate::attribute::assert_maps(|v| t.share(v), &[(20.0, 0.0, true), (99.0, 1.0, true)]);
     }
 
     #[test]

@@ -13,6 +13,7 @@
 //! unless the node names a resolver ([`Resolver`]); a smooth union blends by
 //! its distance blend weight.
 
+mod batch;
 mod convert;
 mod describe;
 mod eval;
@@ -209,6 +210,13 @@ impl NodeAttributes {
 
 #[cfg(test)]
 mod tests;
+/// Checks a table's map `f` at inputs: `(x, value, clamped)` rows.
+#[cfg(test)]
+fn assert_maps(f: impl Fn(f64) -> (f64, bool), rows: &[(f64, f64, bool)]) {
+    for &(x, y, clamped) in rows {
+        assert_eq!(f(x), (y, clamped), "at {x}");
+    }
+}
 #[cfg(test)]
 mod tests_fractions;
 #[cfg(test)]

@@ -269,24 +269,24 @@ mod tests {
 
     #[test]
     fn bad_files_say_where() {
-        let e = PointCloud::parse("", "t.csv").unwrap_err();
-        assert!(e.contains("t.csv: the file is empty"), "{e}");
-        let e = PointCloud::parse("x,y,t\n1,2,3\n", "t.csv").unwrap_err();
-        assert!(
-            e.contains("t.csv:1: the header has no \"z\" column; it has x, y, t"),
-            "{e}"
-        );
-        let e = PointCloud::parse("x,y,z,t\n1,2,3,4\n1,2,oops,4\n", "t.csv").unwrap_err();
-        assert!(e.contains("t.csv:3: column 3 (\"z\") is \"oops\""), "{e}");
-        let e = PointCloud::parse("x,y,z,t\n1,2,3\n", "t.csv").unwrap_err();
-        assert!(e.contains("t.csv:2: 3 cells, the header has 4"), "{e}");
-        let e = PointCloud::parse("x,y,z,t\n", "t.csv").unwrap_err();
-        assert!(e.contains("no rows"), "{e}");
-        let e = PointCloud::parse("x,y,z\n1,2,3\n", "t.csv").unwrap_err();
-        assert!(e.contains("only x, y, z"), "{e}");
-        let e = PointCloud::parse("x,y,z,t,t\n1,2,3,4,5\n", "t.csv").unwrap_err();
-        assert!(e.contains("\"t\" appears twice"), "{e}");
-        let e = PointCloud::parse("x,y,z,t\n1,2,3,inf\n", "t.csv").unwrap_err();
-        assert!(e.contains("column 4 (\"t\")"), "{e}");
+        for (text, says) in [
+            ("", "t.csv: the file is empty"),
+            (
+                "x,y,t\n1,2,3\n",
+                "t.csv:1: the header has no \"z\" column; it has x, y, t",
+            ),
+            (
+                "x,y,z,t\n1,2,3,4\n1,2,oops,4\n",
+                "t.csv:3: column 3 (\"z\") is \"oops\"",
+            ),
+            ("x,y,z,t\n1,2,3\n", "t.csv:2: 3 cells, the header has 4"),
+            ("x,y,z,t\n", "no rows"),
+            ("x,y,z\n1,2,3\n", "only x, y, z"),
+            ("x,y,z,t,t\n1,2,3,4,5\n", "\"t\" appears twice"),
+            ("x,y,z,t\n1,2,3,inf\n", "column 4 (\"t\")"),
+        ] {
+            let e = PointCloud::parse(text, "t.csv").unwrap_err();
+            assert!(e.contains(says), "{text:?}: {e}");
+        }
     }
 }

@@ -144,7 +144,11 @@ pub(super) fn shape(n: &Node) -> Shape<'_> {
 
 /// The operands of a union or intersection with several children: each
 /// child past single-child wrappers, and, for a sharp non-blending one,
-/// the children of nested ones of the same kind in order, each once.
+/// the children of nested ones of the same kind in order, each once. A
+/// nested one that carries attributes stays one operand: the attribute
+/// evaluator then shares its prepared distance (not a second index of its
+/// children) and the top union's walk names it as the child a point is in
+/// (`attribute::hint`).
 fn nary_operands<'a>(n: &'a Node, children: &'a [Node]) -> Vec<&'a Node> {
     let Some(key) = flat_key(n) else {
         return children.iter().map(through_single).collect();
@@ -159,7 +163,7 @@ fn nary_operands<'a>(n: &'a Node, children: &'a [Node]) -> Vec<&'a Node> {
         }
         match c.kind() {
             NodeKind::Union { children, .. } | NodeKind::Intersection { children, .. }
-                if flat_key(c) == Some(key) && !children.is_empty() =>
+                if flat_key(c) == Some(key) && !children.is_empty() && c.attributes().is_none() =>
             {
                 stack.extend(children.iter().rev());
             }

@@ -164,6 +164,17 @@ impl PNode {
         match self {
             PNode::Difference { a, .. } => a.fixed_fractions(),
             PNode::Intersection(n) if !n.blend => n.children[0].fixed_fractions(),
+            // A sharp union writes one child's fractions, so children that
+            // all have the same fixed ones give them wherever it is asked
+            // (a lattice of one material kept whole because it carries an
+            // attribute: no search for the strut holding the point).
+            PNode::Union(n) if !n.blend && n.smooth <= 0.0 => {
+                let first = (*n.fixed.first()?)?;
+                n.fixed
+                    .iter()
+                    .all(|f| f.is_some_and(|f| same_fixed(&f, &first)))
+                    .then_some(first)
+            }
             PNode::FGrade(g) if g.exprs.len() <= 4 => {
                 if g.exprs.iter().any(|e| e.constant().is_none()) {
                     return None;
@@ -191,6 +202,17 @@ impl PNode {
             _ => None,
         }
     }
+}
+
+/// True when `a` and `b` write the same values into the same slots.
+fn same_fixed(a: &FixedFractions, b: &FixedFractions) -> bool {
+    let n = a.len as usize;
+    a.len == b.len
+        && a.slots[..n] == b.slots[..n]
+        && a.values[..n]
+            .iter()
+            .zip(&b.values[..n])
+            .all(|(x, y)| x.to_bits() == y.to_bits())
 }
 
 impl NAry {

@@ -137,8 +137,9 @@ impl SubDistance {
 
     /// When this is a sharp union whose children are distinct prepared
     /// nodes: for each child, the position in `parts` of the part that is
-    /// it (`u32::MAX` for none); `None` when it is not such a union, some
-    /// part is not one of its children, or the parts are in another order.
+    /// it or, for a part that is itself a sharp union flattened into this
+    /// one, holds it (`u32::MAX` for none); `None` when it is not such a
+    /// union, some part is neither, or the parts are in another order.
     pub(crate) fn union_positions(&self, parts: &[&SubDistance]) -> Option<Vec<u32>> {
         let PNode::Union(u) = &*self.node else {
             return None;
@@ -155,22 +156,45 @@ impl SubDistance {
         }
         let mut of_child = vec![u32::MAX; u.children.len()];
         for (k, part) in parts.iter().enumerate() {
-            let j = *at.get(&Arc::as_ptr(&part.node))?;
-            if of_child[j] != u32::MAX {
-                return None;
+            let k = u32::try_from(k).ok()?;
+            for j in flattened_into(&at, &part.node)? {
+                if of_child[j] != u32::MAX {
+                    return None;
+                }
+                of_child[j] = k;
             }
-            of_child[j] = u32::try_from(k).ok()?;
         }
-        // The parts in the children's order: "first" means the same in both.
+        // The parts in the children's order, each a run of children: the
+        // first child containing a point is in the first part containing it.
         let mut order = of_child.iter().filter(|&&k| k != u32::MAX);
         let mut last = order.next();
         for k in order {
-            if last.is_some_and(|l| l >= k) {
+            if last.is_some_and(|l| l > k) {
                 return None;
             }
             last = Some(k);
         }
         Some(of_child)
+    }
+}
+
+/// Positions among a union's children (`at`) of `part`: itself, or the
+/// children of a sharp union that `flatten` read into that union (each
+/// prepared once, so the same `Arc`s); `None` when neither.
+fn flattened_into(
+    at: &std::collections::HashMap<*const PNode, usize>,
+    part: &Arc<PNode>,
+) -> Option<Vec<usize>> {
+    if let Some(&j) = at.get(&Arc::as_ptr(part)) {
+        return Some(vec![j]);
+    }
+    match &**part {
+        PNode::Union(p) if !p.blend && p.smooth <= 0.0 => p
+            .children
+            .iter()
+            .map(|c| at.get(&Arc::as_ptr(c)).copied())
+            .collect(),
+        _ => None,
     }
 }
 
