@@ -24,8 +24,8 @@ mod tpms;
 mod union_index;
 
 pub use thin_gaps::{Gap, StatedGaps};
-pub use thin_sampled::{GAP_BAND, Sampled, SampledFeature};
 use thin_sampled::SampledMemo;
+pub use thin_sampled::{GAP_BAND, Sampled, SampledFeature};
 pub use thinnest::{Feature, Thinnest};
 
 #[cfg(test)]
