@@ -45,15 +45,30 @@ pub struct ImageStyle {
 }
 
 /// The layer's RGBA pixels (4 bytes a pixel, rows from the top): each
-/// voxel its material's colour `pal[code]`.
+/// voxel its material's colour `pal[code]` (a code past the palette is
+/// transparent black).
 pub fn rgba_pixels(nx: usize, ny: usize, codes: &[u8], pal: &[[u8; 4]], o: Orientation) -> Vec<u8> {
+    // One table lookup and one 4-byte store a pixel, without bounds checks
+    // or the orientation's branch in the loop.
+    let mut table = [[0u8; 4]; 256];
+    for (t, c) in table.iter_mut().zip(pal) {
+        *t = *c;
+    }
     let mut rgba = vec![0u8; nx * ny * 4];
     for (j, row) in codes.chunks_exact(nx).enumerate() {
         let r = o.row(j, ny);
-        let out = &mut rgba[r * nx * 4..(r + 1) * nx * 4];
-        for (i, c) in row.iter().enumerate() {
-            let x = o.col(i, nx);
-            out[x * 4..x * 4 + 4].copy_from_slice(&pal[*c as usize]);
+        let out = rgba[r * nx * 4..(r + 1) * nx * 4].chunks_exact_mut(4);
+        match o {
+            Orientation::TopView => {
+                for (px, c) in out.zip(row) {
+                    px.copy_from_slice(&table[*c as usize]);
+                }
+            }
+            Orientation::Pyvcad => {
+                for (px, c) in out.rev().zip(row) {
+                    px.copy_from_slice(&table[*c as usize]);
+                }
+            }
         }
     }
     rgba
