@@ -527,8 +527,10 @@ fn pick_codes(
             .par_chunks_mut(nx)
             .zip(slab.dist.par_chunks(nx))
             .for_each(|(c, d)| {
+                // Branch-free, so the loop vectorises (NaN counts as inside,
+                // as `d > 0` false did).
                 for (o, d) in c.iter_mut().zip(d) {
-                    *o = if *d > 0.0 { 0 } else { code };
+                    *o = code - code * u8::from(*d > 0.0);
                 }
             }),
         None => codes.par_chunks_mut(nx).enumerate().for_each(|(row, c)| {
@@ -619,12 +621,12 @@ fn write_layer(
     bits: BitmapStyle,
 ) -> Result<LayerOut, ExportError> {
     let name = png_io::slice_name(z, digits);
-    let mut counts = vec![0u64; pal.len() - 1];
+    // A histogram of every code, without a branch or bounds check a voxel.
+    let mut hist = [0u64; 256];
     for c in codes {
-        if *c > 0 {
-            counts[*c as usize - 1] += 1;
-        }
+        hist[*c as usize] += 1;
     }
+    let counts: Vec<u64> = hist[1..pal.len()].to_vec();
     let path = ctx.staging().join(&name);
     let bytes = rgba_png(nx, ny, codes, pal, bits.image)
         .map_err(|e| ExportError::Other(format!("{}: PNG encoding: {e}", path.display())))?;

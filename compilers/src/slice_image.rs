@@ -48,30 +48,36 @@ pub struct ImageStyle {
 /// voxel its material's colour `pal[code]` (a code past the palette is
 /// transparent black).
 pub fn rgba_pixels(nx: usize, ny: usize, codes: &[u8], pal: &[[u8; 4]], o: Orientation) -> Vec<u8> {
+    let mut rgba = vec![0u8; nx * ny * 4];
+    rgba_into(nx, codes, pal, o, &mut rgba);
+    rgba
+}
+
+/// [`rgba_pixels`] into `out` (`4·nx·ny` bytes, every one written).
+fn rgba_into(nx: usize, codes: &[u8], pal: &[[u8; 4]], o: Orientation, out: &mut [u8]) {
     // One table lookup and one 4-byte store a pixel, without bounds checks
     // or the orientation's branch in the loop.
     let mut table = [[0u8; 4]; 256];
     for (t, c) in table.iter_mut().zip(pal) {
         *t = *c;
     }
-    let mut rgba = vec![0u8; nx * ny * 4];
+    let ny = codes.len() / nx.max(1);
     for (j, row) in codes.chunks_exact(nx).enumerate() {
         let r = o.row(j, ny);
-        let out = rgba[r * nx * 4..(r + 1) * nx * 4].chunks_exact_mut(4);
+        let px = out[r * nx * 4..(r + 1) * nx * 4].chunks_exact_mut(4);
         match o {
             Orientation::TopView => {
-                for (px, c) in out.zip(row) {
+                for (px, c) in px.zip(row) {
                     px.copy_from_slice(&table[*c as usize]);
                 }
             }
             Orientation::Pyvcad => {
-                for (px, c) in out.rev().zip(row) {
+                for (px, c) in px.rev().zip(row) {
                     px.copy_from_slice(&table[*c as usize]);
                 }
             }
         }
     }
-    rgba
 }
 
 /// The layer's RGBA PNG.
@@ -85,8 +91,16 @@ pub fn rgba_png(
     pal: &[[u8; 4]],
     style: ImageStyle,
 ) -> Result<Vec<u8>, png::EncodingError> {
-    let rgba = rgba_pixels(nx, ny, codes, pal, style.orientation);
-    png_io::encode_rgba(nx, ny, &rgba, style.pixel)
+    // One pixel buffer a thread, reused layer after layer: a fresh one is
+    // zeroed by the allocator before every pixel is written anyway.
+    thread_local! {
+        static RGBA: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
+    }
+    RGBA.with_borrow_mut(|rgba| {
+        rgba.resize(nx * ny * 4, 0);
+        rgba_into(nx, codes, pal, style.orientation, rgba);
+        png_io::encode_rgba(nx, ny, rgba, style.pixel)
+    })
 }
 
 /// The layer's mask of material `code` into `bits` (rows of
