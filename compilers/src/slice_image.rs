@@ -44,16 +44,9 @@ pub struct ImageStyle {
     pub pixel: Option<PixelsPerMetre>,
 }
 
-/// The layer's RGBA pixels (4 bytes a pixel, rows from the top): each
-/// voxel its material's colour `pal[code]` (a code past the palette is
-/// transparent black).
-pub fn rgba_pixels(nx: usize, ny: usize, codes: &[u8], pal: &[[u8; 4]], o: Orientation) -> Vec<u8> {
-    let mut rgba = vec![0u8; nx * ny * 4];
-    rgba_into(nx, codes, pal, o, &mut rgba);
-    rgba
-}
-
-/// [`rgba_pixels`] into `out` (`4·nx·ny` bytes, every one written).
+/// The layer's RGBA pixels into `out` (`4·nx·ny` bytes, every one
+/// written; rows from the top): each voxel its material's colour
+/// `pal[code]` (a code past the palette is transparent black).
 fn rgba_into(nx: usize, codes: &[u8], pal: &[[u8; 4]], o: Orientation, out: &mut [u8]) {
     // One table lookup and one 4-byte store a pixel, without bounds checks
     // or the orientation's branch in the loop.
@@ -154,8 +147,9 @@ mod tests {
         // bottom left, pyvcad top right.
         let codes = [1, 0, 0, 0, 0, 0];
         let pal = [[0; 4], [9; 4]];
-        let top = rgba_pixels(3, 2, &codes, &pal, Orientation::TopView);
-        let py = rgba_pixels(3, 2, &codes, &pal, Orientation::Pyvcad);
+        let (mut top, mut py) = (vec![0u8; 24], vec![0u8; 24]);
+        rgba_into(3, &codes, &pal, Orientation::TopView, &mut top);
+        rgba_into(3, &codes, &pal, Orientation::Pyvcad, &mut py);
         assert_eq!(top[12], 9);
         assert_eq!(py[8], 9);
         assert_eq!(top.iter().filter(|v| **v == 9).count(), 4);

@@ -43,8 +43,7 @@ impl ANode {
 
     /// True where `own_value` refuses `v` as this node's own `idx`.
     fn out_of_range(&self, idx: usize, v: f64) -> bool {
-        let range = self.own_of[idx].and_then(|pos| self.own[pos as usize].range);
-        range.is_some_and(|(lo, hi, _)| v < lo || v > hi)
+        self.own_of[idx].is_some_and(|pos| self.own[pos as usize].refuses(v))
     }
 }
 

@@ -157,7 +157,7 @@ impl ANode {
             self.own_value_in::<64>(pos, q, pw, out)?;
         }
         if let Some((lo, hi, unit)) = own.range
-            && let Some(v) = out.iter().find(|v| **v < lo || **v > hi)
+            && let Some(v) = out.iter().find(|v| own.refuses(**v))
         {
             {
                 return Err(AttributeError {

@@ -101,6 +101,13 @@ pub(super) struct Own {
     pub call: String,
 }
 
+impl Own {
+    /// True where `v` lies outside the common name's range.
+    pub fn refuses(&self, v: f64) -> bool {
+        self.range.is_some_and(|(lo, hi, _)| v < lo || v > hi)
+    }
+}
+
 /// How a node passes a point to its children.
 pub(super) enum Op {
     Leaf,

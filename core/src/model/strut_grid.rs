@@ -93,7 +93,8 @@ impl StrutGrid {
 /// the cell's struts are symmetric under the three axis reflections (every
 /// built-in cell is): then `d(p) = d(|p|)` and the minimum over all struts
 /// at `|p|` is the minimum over those that meet the closed octant `[0, ∞)³`,
-/// a quarter to an eighth of them (BCC: one of four). `None` when the set
+/// at most half of them (BCC keeps one of four, FCC and Cubic three of
+/// twelve). `None` when the set
 /// is not symmetric (a custom cell), or too large to check.
 ///
 /// Why: for `q ≥ 0` and any `x`, `|qᵢ − |xᵢ|| ≤ |qᵢ − xᵢ|`, so a strut `S`

@@ -194,11 +194,8 @@ impl Model {
     /// sampling). A thicker feature may then go unreported. Kept per model
     /// with the widest it was made for; a wider request makes it again.
     pub fn sampled_thinnest_below(&self, widest: f64) -> Option<Sampled> {
-        let deepest = if self.distance_is_bound() {
-            widest / 2.0
-        } else {
-            f64::INFINITY
-        };
+        let bound = self.distance_is_bound();
+        let deepest = if bound { widest / 2.0 } else { f64::INFINITY };
         let mut memo = self
             .sampled
             .lock()
@@ -210,7 +207,6 @@ impl Model {
         }
         let made = Grid::over(&self.bbox).map(|g| {
             let d = sample(self, &g, deepest);
-            let bound = self.distance_is_bound();
             let ridges = ridge_points(&g, &d, deepest);
             let feature = shortest(self, &g, &ridges, bound, Side::Inside);
             let gap = shortest(self, &g, &gap_points(&g, &d, bound), bound, Side::Outside);
