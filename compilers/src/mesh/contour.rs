@@ -54,6 +54,7 @@ use super::kuhn::{
 };
 use super::layer_dist::LayerDist;
 use super::mixed::mixed_cubes;
+use super::one_label::{EdgeSlots, OneLabelBand};
 use super::vertex_keys::{BandMesh, KeyMap};
 use super::vertex_keys::{Tri, VRef};
 
@@ -79,8 +80,8 @@ const T_MIN: f64 = 0.05;
 const FACE_KEY: u64 = 8;
 const TET_KEY: u64 = 72;
 /// Centre points of one-label loops (up to four a cube): 78..=81.
-const LOOP_KEY: u64 = 78;
-const KEY_TYPES: u64 = 128;
+pub(super) const LOOP_KEY: u64 = 78;
+pub(super) const KEY_TYPES: u64 = 128;
 
 /// A band's flat cubes: row, column, key and the corners of the key's `x`
 /// label (bit mask), with their samples kept for the fallback.
@@ -102,7 +103,7 @@ impl BandFlats {
 /// Rows of cubes a contouring task takes: fewer, larger tasks cost less
 /// to schedule and allocate for than one per row (most rows of a solid
 /// part hold two surface cubes).
-const BAND: usize = 8;
+pub(super) const BAND: usize = 8;
 
 /// No flat cube here (layer tables of region ids).
 const NOT_FLAT: u32 = u32::MAX;
@@ -205,14 +206,14 @@ impl Contourer {
         let sizes = &self.band_sizes;
         let bands: Vec<(BandMesh, BandFlats, (usize, usize))> = (0..rows.div_ceil(BAND))
             .into_par_iter()
-            .map(|b| {
+            .map_init(EdgeSlots::default, |slots, b| {
                 let js = b * BAND..((b + 1) * BAND).min(rows);
                 let hint = sizes
                     .get(b)
                     .map_or((0, 0), |&(t, f)| (t + t / 8, f + f / 8));
-                let (tris, flats) = self.band(pz, js, &lo, &plane, hint);
-                let made = (tris.len(), flats.at.len());
-                (BandMesh::new(tris), flats, made)
+                let (mesh, flats) = self.band(pz, js, &lo, &plane, hint, slots);
+                let made = (mesh.tris.len(), flats.at.len());
+                (mesh, flats, made)
             })
             .collect();
         self.band_sizes = bands.iter().map(|b| b.2).collect();
@@ -293,7 +294,8 @@ impl Contourer {
     }
 
     /// Triangles of the cubes in rows `js` between planes `z` and `z + 1`,
-    /// and the band's flat cubes (left for [`Self::flat_layer`]).
+    /// over the band's own vertices, and the band's flat cubes (left for
+    /// [`Self::flat_layer`]).
     fn band(
         &self,
         z: usize,
@@ -301,9 +303,13 @@ impl Contourer {
         lo: &Plane,
         hi: &Plane,
         (tris, flat): (usize, usize),
-    ) -> (Vec<Tri>, BandFlats) {
+        slots: &mut EdgeSlots,
+    ) -> (BandMesh, BandFlats) {
         let nx = self.grid.dims[0];
-        let mut out = Vec::with_capacity(tris);
+        let mut out = Vec::with_capacity(if self.one_label { 0 } else { tris });
+        let mut one = self
+            .one_label
+            .then(|| OneLabelBand::new(js.start, nx, tris, slots));
         let mut flats = BandFlats::with_capacity(flat, self.grid.dims);
         let mut scratch = Scratch::default();
         let mut memo = FlatMemo::default();
@@ -324,10 +330,17 @@ impl Contourer {
                     flats.kept.push(cube.base, mask);
                     continue;
                 }
-                self.contour_cube(&cube, &mut scratch, &mut out);
+                match &mut one {
+                    Some(one) => self.loops_into(&cube, &mut scratch, one),
+                    None => self.contour_cube(&cube, &mut scratch, &mut out),
+                }
             }
         }
-        (out, flats)
+        let mesh = match one {
+            Some(one) => one.mesh,
+            None => BandMesh::new(out),
+        };
+        (mesh, flats)
     }
 
     /// Register one layer's flat cubes: join them with flat neighbours of
@@ -455,7 +468,7 @@ impl Contourer {
     }
 
     /// Grid index (i, j, k) of corner `m` of the cube.
-    fn corner(cube: &Cube, m: u8) -> [usize; 3] {
+    pub(super) fn corner(cube: &Cube, m: u8) -> [usize; 3] {
         let [i, j, k] = cube.base;
         [
             i + (m & 1) as usize,
@@ -464,12 +477,12 @@ impl Contourer {
         ]
     }
 
-    fn global(&self, c: [usize; 3]) -> u64 {
+    pub(super) fn global(&self, c: [usize; 3]) -> u64 {
         let [nx, ny, _] = self.grid.dims;
         ((c[2] * ny + c[1]) * nx + c[0]) as u64
     }
 
-    fn center(&self, c: [usize; 3]) -> DVec3 {
+    pub(super) fn center(&self, c: [usize; 3]) -> DVec3 {
         self.grid.center(c[0], c[1], c[2])
     }
 
@@ -519,7 +532,7 @@ impl Contourer {
     }
 
     /// Key and position of a point of tet `perm` (corners `v`).
-    fn resolve(&self, cube: &Cube, perm: usize, v: &[u8; 4], p: Pt) -> VRef {
+    pub(super) fn resolve(&self, cube: &Cube, perm: usize, v: &[u8; 4], p: Pt) -> VRef {
         let (key, pos) = match p {
             Pt::Edge(a, b) => {
                 let key = self.global(Self::corner(cube, a)) * KEY_TYPES + u64::from(b & !a);
@@ -559,42 +572,7 @@ impl Contourer {
             }
             return;
         }
-        for (n, l) in cube_loops::case(corner_mask(cube, 1)).iter().enumerate() {
-            let refs = &mut scratch.refs;
-            refs.clear();
-            refs.extend(l.points.iter().map(|p| self.resolve(cube, 0, &[0; 4], *p)));
-            let k = refs.len();
-            let apex = match l.apex {
-                Some(a) => a,
-                None => {
-                    // The loop's centroid, a quarter of the way to the
-                    // cube's centre: a loop on one face's four edges (a
-                    // sheet across that face) has its centroid on the face,
-                    // where the cube across may put its own.
-                    let mid = (self.center(cube.base) + self.center(Self::corner(cube, 7))) * 0.5;
-                    let mut c = DVec3::ZERO;
-                    for r in refs.iter() {
-                        c += DVec3::from(r.pos.map(f64::from)) / k as f64;
-                    }
-                    refs.push(VRef {
-                        key: self.global(cube.base) * KEY_TYPES + LOOP_KEY + n as u64,
-                        pos: (c * 0.75 + mid * 0.25).as_vec3().to_array(),
-                    });
-                    k
-                }
-            };
-            // The fan over the loop's points from the apex (the loop's own
-            // points skip it; an added centre closes the whole loop).
-            let steps = if apex == k { k } else { k - 2 };
-            let first = if apex == k { 0 } else { apex + 1 };
-            for d in 0..steps {
-                let (i, j) = ((first + d) % k, (first + d + 1) % k);
-                out.push(Tri {
-                    label: 1,
-                    v: [refs[apex], refs[i], refs[j]],
-                });
-            }
-        }
+        self.loops_to_tris(cube, scratch, out);
     }
 
     /// Contour tet `perm` of `cube` into `out` (`scratch`: buffers reused
@@ -679,13 +657,13 @@ impl Contourer {
 }
 
 /// The corners of `cube` labelled `label`, as bits.
-fn corner_mask(cube: &Cube, label: u16) -> u8 {
+pub(super) fn corner_mask(cube: &Cube, label: u16) -> u8 {
     (0..8).fold(0, |m, c| m | u8::from(cube.label[c] == label) << c)
 }
 
 /// Buffers one row's tets reuse.
 #[derive(Default)]
-struct Scratch {
+pub(super) struct Scratch {
     /// Oriented curve segments on the tet's faces: (label, from, to).
     segs: Vec<(u16, Pt, Pt)>,
     /// One label's segments.
@@ -693,5 +671,5 @@ struct Scratch {
     /// Their loop.
     ring: Vec<Pt>,
     /// The loop's vertices.
-    refs: Vec<VRef>,
+    pub refs: Vec<VRef>,
 }

@@ -146,6 +146,16 @@ impl IndexedMesh {
     /// groups are checked in parallel. `a → b` repeated is counted once per
     /// extra copy; an edge is open when `a → b` occurs more often than `b → a` (each copy
     /// of `b → a` pairs with one copy of `a → b`).
+    ///
+    /// A vertex is clean when its out-neighbours `O(a)` are distinct and
+    /// equal, as a multiset, to its in-neighbours `I(a)` (every `a → b`
+    /// then has exactly one `b → a`). The multisets are compared by their
+    /// sums of a 64-bit mix of each neighbour, `Σ_{b ∈ O(a)} h(b) =
+    /// Σ_{b ∈ I(a)} h(b)` (mod 2⁶⁴), gathered in the same pass as the sort:
+    /// one comparison a vertex instead of a search of every neighbour's
+    /// list. Two different multisets with equal sums would take a collision
+    /// of the mix (odds about 2⁻⁶⁴ a vertex); a vertex whose sums differ, or
+    /// whose out-neighbours repeat, is counted exactly as described above.
     pub fn edge_report(&self) -> EdgeReport {
         let mut r = EdgeReport::default();
         let nv = self.vertices.len();
@@ -163,10 +173,15 @@ impl IndexedMesh {
         }
         let mut fill = start.clone();
         let mut ends = vec![0u32; start[nv] as usize];
+        // Σ h(b) over the in-neighbours b of each vertex.
+        let mut into = vec![0u64; nv];
         for t in &self.triangles {
-            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+            let h = t.map(neighbour_mix);
+            for (i, j) in [(0, 1), (1, 2), (2, 0)] {
+                let (a, b) = (t[i], t[j]);
                 ends[fill[a as usize] as usize] = b;
                 fill[a as usize] += 1;
+                into[b as usize] = into[b as usize].wrapping_add(h[i]);
             }
         }
         // A vertex has a handful of edges: its list is scanned. Long lists
@@ -187,19 +202,27 @@ impl IndexedMesh {
                 list.iter().filter(|&&e| e == x).count()
             }
         };
+        let seen = |list: &[u32], i: usize| {
+            if list.len() > SHORT {
+                i > 0 && list[i - 1] == list[i]
+            } else {
+                list[..i].contains(&list[i])
+            }
+        };
         let (repeated, open) = (0..nv as u32)
             .into_par_iter()
             .with_min_len(1 << 14)
             .map(|a| {
                 let list = out(a);
+                let sum = list
+                    .iter()
+                    .fold(0u64, |s, &b| s.wrapping_add(neighbour_mix(b)));
+                if sum == into[a as usize] && (0..list.len()).all(|i| !seen(list, i)) {
+                    return (0, 0);
+                }
                 let (mut repeated, mut open) = (0, 0);
                 for (i, &b) in list.iter().enumerate() {
-                    let seen = if list.len() > SHORT {
-                        i > 0 && list[i - 1] == b
-                    } else {
-                        list[..i].contains(&b)
-                    };
-                    if seen {
+                    if seen(list, i) {
                         continue; // counted at its first copy
                     }
                     let m = count(list, b);
@@ -218,6 +241,16 @@ impl IndexedMesh {
     pub fn is_watertight(&self) -> bool {
         !self.is_empty() && self.edge_report().is_clean()
     }
+}
+
+/// The 64-bit mix of a vertex index whose sums fingerprint a vertex's
+/// neighbours in [`IndexedMesh::edge_report`] (splitmix64's finaliser: a
+/// bijection that spreads every input bit over the output).
+fn neighbour_mix(v: u32) -> u64 {
+    let mut z = u64::from(v).wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
 }
 
 /// Triangles by vertex positions (bits), each rotated to start at its

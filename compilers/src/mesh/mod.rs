@@ -39,6 +39,7 @@ pub(crate) mod kuhn;
 mod layer_dist;
 mod mixed;
 pub mod obj;
+mod one_label;
 mod outline;
 mod output;
 pub mod segment;

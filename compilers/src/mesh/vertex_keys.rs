@@ -2,8 +2,9 @@
 //! share them: every contour point has a 64-bit key naming the grid edge,
 //! face or tet it lies on, so neighbouring cubes (and segments) that compute
 //! the same point give it the same key. A contouring task deduplicates its
-//! band's vertices by key ([`BandMesh`]); the contourer then gives each new
-//! key its index in its label's mesh ([`KeyMap`]).
+//! band's vertices by key ([`BandMesh`]; the one-label path builds it
+//! directly, see `one_label`); the contourer then gives each new key its
+//! index in its label's mesh ([`KeyMap`]).
 
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};

@@ -1,0 +1,238 @@
+//! The contourer's one-label path: each cube's marching-cubes loops (see
+//! [`super::cube_loops`]) fanned into triangles. Within a band of rows,
+//! each grid edge's point is placed once and found again by its edge's
+//! slot, not by hashing its key: four cubes share each grid edge.
+
+use glam::DVec3;
+
+use super::contour::{BAND, Contourer, KEY_TYPES, LOOP_KEY, Scratch, corner_mask};
+use super::cube_loops;
+use super::interface::Cube;
+use super::kuhn::Pt;
+use super::vertex_keys::{BandMesh, Tri, VRef};
+
+impl Contourer {
+    /// [`Contourer::contour_cube`] with one label: the cube's
+    /// marching-cubes loops, each fanned into triangles.
+    pub(super) fn loops_to_tris(&self, cube: &Cube, scratch: &mut Scratch, out: &mut Vec<Tri>) {
+        for (n, l) in cube_loops::case(corner_mask(cube, 1)).iter().enumerate() {
+            let refs = &mut scratch.refs;
+            refs.clear();
+            refs.extend(l.points.iter().map(|p| self.resolve(cube, 0, &[0; 4], *p)));
+            let apex = match l.apex {
+                Some(a) => a,
+                None => {
+                    refs.push(self.loop_centre(cube, n, refs));
+                    refs.len() - 1
+                }
+            };
+            for [a, i, j] in fan(l.points.len(), apex) {
+                out.push(Tri {
+                    label: 1,
+                    v: [refs[a], refs[i], refs[j]],
+                });
+            }
+        }
+    }
+
+    /// The point a loop without an apex is fanned from: the loop's
+    /// centroid, a quarter of the way to the cube's centre (a loop on one
+    /// face's four edges, a sheet across that face, has its centroid on the
+    /// face, where the cube across may put its own).
+    fn loop_centre(&self, cube: &Cube, n: usize, points: &[VRef]) -> VRef {
+        let mid = (self.center(cube.base) + self.center(Self::corner(cube, 7))) * 0.5;
+        let k = points.len() as f64;
+        let mut c = DVec3::ZERO;
+        for r in points {
+            c += DVec3::from(r.pos.map(f64::from)) / k;
+        }
+        VRef {
+            key: self.global(cube.base) * KEY_TYPES + LOOP_KEY + n as u64,
+            pos: (c * 0.75 + mid * 0.25).as_vec3().to_array(),
+        }
+    }
+
+    /// [`Self::contour_cube`]'s loops for one label, straight into the
+    /// band's mesh: an edge point's position is computed only the first
+    /// time the band uses it (four cubes share each grid edge), and the
+    /// vertices come in the order `BandMesh::new` gives them (first use by
+    /// a triangle corner).
+    pub(super) fn loops_into(&self, cube: &Cube, scratch: &mut Scratch, band: &mut OneLabelBand) {
+        for (n, l) in cube_loops::case(corner_mask(cube, 1)).iter().enumerate() {
+            let k = l.points.len();
+            if let Some(apex) = l.apex {
+                for t in fan(k, apex) {
+                    let v = t.map(|m| band.vertex(self, cube, l.points[m], None));
+                    band.mesh.tris.push((1, v));
+                }
+                continue;
+            }
+            // Rare: every point's position is needed for the centre.
+            let refs = &mut scratch.refs;
+            refs.clear();
+            refs.extend(l.points.iter().map(|p| self.resolve(cube, 0, &[0; 4], *p)));
+            let centre = self.loop_centre(cube, n, refs);
+            let mut centre_at = None;
+            for t in fan(k, k) {
+                let v = t.map(|m| match l.points.get(m) {
+                    Some(&p) => band.vertex(self, cube, p, Some(refs[m])),
+                    None => *centre_at.get_or_insert_with(|| band.push(centre)),
+                });
+                band.mesh.tris.push((1, v));
+            }
+        }
+    }
+}
+
+/// The triangles `(apex, i, j)` of the fan over a loop of `k` points from
+/// `apex`: the loop's own points skip it and its two neighbours; an added
+/// centre (`apex == k`) closes the whole loop.
+fn fan(k: usize, apex: usize) -> impl Iterator<Item = [usize; 3]> {
+    let steps = if apex == k { k } else { k - 2 };
+    let first = if apex == k { 0 } else { apex + 1 };
+    (0..steps).map(move |d| [apex, (first + d) % k, (first + d + 1) % k])
+}
+
+/// Vertex index per grid edge of a band (two planes of `BAND + 1` rows,
+/// three directions), stamped with the band it was set in: reused band
+/// after band by one thread, with nothing to clear between bands.
+#[derive(Default)]
+pub(super) struct EdgeSlots {
+    /// `band << 32 | vertex`.
+    slot: Vec<u64>,
+    band: u64,
+}
+
+/// One band's mesh as the one-label path builds it: an edge point is found
+/// by its edge's slot, not by hashing its key.
+pub(super) struct OneLabelBand<'a> {
+    pub mesh: BandMesh,
+    /// First row of cubes.
+    j0: usize,
+    nx: usize,
+    slots: &'a mut EdgeSlots,
+}
+
+impl<'a> OneLabelBand<'a> {
+    pub fn new(j0: usize, nx: usize, tris: usize, slots: &'a mut EdgeSlots) -> Self {
+        let len = 2 * (BAND + 1) * nx * 3;
+        if slots.slot.len() != len {
+            *slots = EdgeSlots {
+                slot: vec![0; len],
+                band: 0,
+            };
+        }
+        slots.band += 1;
+        OneLabelBand {
+            mesh: BandMesh {
+                verts: Vec::with_capacity(tris / 2),
+                tris: Vec::with_capacity(tris),
+            },
+            j0,
+            nx,
+            slots,
+        }
+    }
+
+    /// Index of point `p` of `cube` (placed now when new, or given as
+    /// `placed`); an edge point is looked up by its edge's slot.
+    fn vertex(&mut self, c: &Contourer, cube: &Cube, p: Pt, placed: Option<VRef>) -> u32 {
+        let Pt::Edge(a, b) = p else {
+            // (Marching-cubes loops hold edge points only.)
+            return self.push(placed.unwrap_or_else(|| c.resolve(cube, 0, &[0; 4], p)));
+        };
+        let [i, j, _] = cube.base;
+        let (ci, cj, ck) = (
+            i + usize::from(a & 1),
+            j + usize::from(a >> 1 & 1) - self.j0,
+            usize::from(a >> 2 & 1),
+        );
+        let dir = (b & !a).trailing_zeros() as usize;
+        let s = ((ck * (BAND + 1) + cj) * self.nx + ci) * 3 + dir;
+        let band = self.slots.band;
+        let set = self.slots.slot[s];
+        if set >> 32 == band {
+            return set as u32;
+        }
+        let r = placed.unwrap_or_else(|| c.resolve(cube, 0, &[0; 4], p));
+        let v = self.push(r);
+        self.slots.slot[s] = band << 32 | u64::from(v);
+        v
+    }
+
+    fn push(&mut self, r: VRef) -> u32 {
+        self.mesh.verts.push((1, r.key, r.pos));
+        (self.mesh.verts.len() - 1) as u32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use volcad_core::bench::XorShift;
+    use volcad_core::sampler::Grid;
+
+    use super::*;
+    use crate::mesh::interface::Interface;
+
+    /// Two bands of random cubes (every one of the 256 corner cases many
+    /// times, with loops that need a centre): the band path gives exactly
+    /// the mesh that deduplicating the triangle path's output gives, the
+    /// same vertices in the same order and the same triangles.
+    #[test]
+    fn the_band_path_matches_deduplicating_the_triangle_path() {
+        let nx = 40;
+        let grid = Grid {
+            origin: DVec3::new(-1.0, 2.0, 0.5),
+            voxel: DVec3::new(0.5, 0.4, 0.3),
+            dims: [nx, 2 * BAND + 1, 2],
+        };
+        let c = Contourer::new(grid, 1, Interface::Midpoint);
+        let mut rng = XorShift::new(11);
+        let mut slots = EdgeSlots::default();
+        let mut centres = 0;
+        for j0 in [0, BAND] {
+            // Corner samples of this band: labels and distances whose
+            // sign agrees with the label (inside at or below zero).
+            let corners = |rng: &mut XorShift| -> ([u16; 8], [f32; 8]) {
+                let mut label = [0; 8];
+                let mut dist = [0.0; 8];
+                for (l, d) in label.iter_mut().zip(&mut dist) {
+                    *l = u16::from(rng.next_f64() < 0.5);
+                    let mag = (rng.next_f64() * 0.4 + 0.01) as f32;
+                    *d = if *l == 1 { -mag } else { mag };
+                }
+                (label, dist)
+            };
+            let mut band = OneLabelBand::new(j0, nx, 0, &mut slots);
+            let mut tris = Vec::new();
+            let mut scratch = Scratch::default();
+            for j in j0..j0 + BAND {
+                for i in 0..nx - 1 {
+                    let (label, dist) = corners(&mut rng);
+                    let cube = Cube {
+                        base: [i, j, 0],
+                        label,
+                        dist,
+                        value: [&[]; 8],
+                    };
+                    let mask = corner_mask(&cube, 1);
+                    centres += cube_loops::case(mask)
+                        .iter()
+                        .filter(|l| l.apex.is_none())
+                        .count();
+                    c.loops_into(&cube, &mut scratch, &mut band);
+                    c.loops_to_tris(&cube, &mut scratch, &mut tris);
+                }
+            }
+            let want = BandMesh::new(tris);
+            assert_eq!(band.mesh.tris, want.tris, "band at row {j0}");
+            let bits = |v: &[(u16, u64, [f32; 3])]| -> Vec<(u16, u64, [u32; 3])> {
+                v.iter()
+                    .map(|&(l, k, p)| (l, k, p.map(f32::to_bits)))
+                    .collect()
+            };
+            assert_eq!(bits(&band.mesh.verts), bits(&want.verts), "band at {j0}");
+        }
+        assert!(centres > 0, "no loop without an apex was drawn");
+    }
+}
