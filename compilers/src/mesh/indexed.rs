@@ -244,13 +244,10 @@ impl IndexedMesh {
 }
 
 /// The 64-bit mix of a vertex index whose sums fingerprint a vertex's
-/// neighbours in [`IndexedMesh::edge_report`] (splitmix64's finaliser: a
-/// bijection that spreads every input bit over the output).
+/// neighbours in [`IndexedMesh::edge_report`] (splitmix64: a bijection of
+/// the index that spreads every input bit over the output).
 fn neighbour_mix(v: u32) -> u64 {
-    let mut z = u64::from(v).wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
+    crate::dither::splitmix64(0, u64::from(v))
 }
 
 /// Triangles by vertex positions (bits), each rotated to start at its

@@ -130,11 +130,19 @@ pub(super) fn body_notes(b: &bodies::Bodies, voxel: f64, design: &StatedGaps) ->
 /// every segment. The contouring guarantees watertightness; checked anyway
 /// (a linear pass over the edges), every segment on its own thread.
 pub(super) fn checks(segs: &[SegmentMesh]) -> Vec<Check> {
+    // The three at once: the edge check's sort and the volume's sum run
+    // on one thread each, beside the writers and the body count.
     segs.par_iter()
-        .map(|s| Check {
-            volume: s.mesh.volume(),
-            watertight: s.mesh.is_watertight(),
-            shape: s.mesh.shape(),
+        .map(|s| {
+            let (watertight, (volume, shape)) = rayon::join(
+                || s.mesh.is_watertight(),
+                || rayon::join(|| s.mesh.volume(), || s.mesh.shape()),
+            );
+            Check {
+                volume,
+                watertight,
+                shape,
+            }
         })
         .collect()
 }
