@@ -54,7 +54,7 @@ use super::kuhn::{
 };
 use super::layer_dist::LayerDist;
 use super::mixed::mixed_cubes;
-use super::one_label::{EdgeSlots, OneLabelBand};
+use super::one_label::{EdgeSlots, OneLabelBand, SlotPool};
 use super::vertex_keys::{BandMesh, KeyMap};
 use super::vertex_keys::{Tri, VRef};
 
@@ -138,6 +138,9 @@ pub struct Contourer {
     /// since growing them by doubling copies and faults in their memory
     /// again and again.
     band_sizes: Vec<(usize, usize)>,
+    /// Edge slots of the one-label path, lent to contouring tasks and
+    /// given back, so a plane does not allocate and zero fresh ones.
+    slot_pool: SlotPool,
 }
 
 impl Contourer {
@@ -159,6 +162,7 @@ impl Contourer {
             spare_flat: Vec::new(),
             spare_list: Vec::new(),
             band_sizes: Vec::new(),
+            slot_pool: SlotPool::default(),
         }
     }
 
@@ -206,15 +210,18 @@ impl Contourer {
         let sizes = &self.band_sizes;
         let bands: Vec<(BandMesh, BandFlats, (usize, usize))> = (0..rows.div_ceil(BAND))
             .into_par_iter()
-            .map_init(EdgeSlots::default, |slots, b| {
-                let js = b * BAND..((b + 1) * BAND).min(rows);
-                let hint = sizes
-                    .get(b)
-                    .map_or((0, 0), |&(t, f)| (t + t / 8, f + f / 8));
-                let (mesh, flats) = self.band(pz, js, &lo, &plane, hint, slots);
-                let made = (mesh.tris.len(), flats.at.len());
-                (mesh, flats, made)
-            })
+            .map_init(
+                || self.slot_pool.lend(),
+                |slots, b| {
+                    let js = b * BAND..((b + 1) * BAND).min(rows);
+                    let hint = sizes
+                        .get(b)
+                        .map_or((0, 0), |&(t, f)| (t + t / 8, f + f / 8));
+                    let (mesh, flats) = self.band(pz, js, &lo, &plane, hint, slots);
+                    let made = (mesh.tris.len(), flats.at.len());
+                    (mesh, flats, made)
+                },
+            )
             .collect();
         self.band_sizes = bands.iter().map(|b| b.2).collect();
         let mut global = Vec::new();
