@@ -89,6 +89,20 @@ def bunny_lattice():
     return lattice
 
 
+def pyvcad_sphere():
+    """assets/bench/pyvcad_sphere.rhai: pyvcad's own benchmark sphere"""
+    return pv.Sphere(pv.Vec3(0, 0, 0), 10, M.id("red"))
+
+
+def pyvcad_bcc_box():
+    """assets/bench/pyvcad_bcc_box.rhai: pyvcad's own benchmark lattice"""
+    cell = pv.GraphLattice(
+        pv.LatticeType.BodyCenteredCubic, pv.Vec3(2, 2, 2), 0.2, M.id("red")
+    )
+    box = pv.RectPrism(pv.Vec3(0, 0, 0), pv.Vec3(10, 10, 10), M.id("blue"))
+    return pv.Intersection(False, [pv.Tile(cell), box])
+
+
 # name -> (builder, MeshCompiler's fraction ranges of red)
 DESIGNS = {
     "cube": (cube, 1),
@@ -97,6 +111,8 @@ DESIGNS = {
     "bcc_sphere": (bcc_sphere, 1),
     "bunny_mesh": (bunny_mesh, 1),
     "bunny_lattice": (bunny_lattice, 1),
+    "pyvcad_sphere": (pyvcad_sphere, 1),
+    "pyvcad_bcc_box": (pyvcad_bcc_box, 1),
 }
 
 

@@ -38,9 +38,6 @@ struct Case {
     mesh_voxel: f64,
     by: SegmentBy,
     segments: usize,
-    /// pyvcad 2.3.4's slice-stack rate on the same design and voxel size,
-    /// measured on this kind of machine (pyvcad 2.3.4), M voxels/s.
-    pyvcad_png: Option<f64>,
 }
 
 fn load(file: &str) -> Arc<Model> {
@@ -66,35 +63,22 @@ fn stage_times(model: &Model, voxel: f64, dither: Dither) -> (u64, f64, f64) {
     let grid = Grid::covering(&model.bbox(), DVec3::splat(voxel), 1 << 44).expect("grid");
     let [nx, ny, nz] = grid.dims;
     let k = model.materials().len();
-    let cancel = AtomicBool::new(false);
     // As the export: random picks leave graded fractions to the chooser.
     let sampler = match dither {
         Dither::Random => Sampler::new(model, grid, Consumer::PngStackRandom),
         Dither::Diffusion => Sampler::new(model, grid, Consumer::PngStackDiffusion),
     };
     let mut slab = Slab::default();
-    let layers = 16;
     let t = Instant::now();
-    let mut z = 0;
-    while z < nz {
-        let z1 = (z + layers).min(nz);
-        sampler
-            .sample_layers(z, z1, &mut slab, &cancel)
-            .expect("sample");
-        z = z1;
-    }
+    each_slab(&sampler, nz, &mut slab, |_| {});
     let sample = t.elapsed().as_secs_f64();
     let layer = nx * ny;
     let mut codes = vec![0u8; layer];
     let mut diffuser = Diffuser::new(nx, ny, k);
     let t = Instant::now();
-    let mut z = 0;
-    while z < nz {
-        let z1 = (z + layers).min(nz);
-        sampler
-            .sample_layers(z, z1, &mut slab, &cancel)
-            .expect("sample");
-        for l in 0..z1 - z {
+    each_slab(&sampler, nz, &mut slab, |slab| {
+        let z = slab.z0;
+        for l in 0..slab.layers {
             let (d, f) = (
                 &slab.dist[l * layer..(l + 1) * layer],
                 &slab.fracs[l * layer * k..(l + 1) * layer * k],
@@ -119,9 +103,21 @@ fn stage_times(model: &Model, voxel: f64, dither: Dither) -> (u64, f64, f64) {
                 Dither::Diffusion => diffuser.layer(z + l, d, f, &mut codes),
             }
         }
+    });
+    (grid.count(), sample, t.elapsed().as_secs_f64())
+}
+
+/// Samples layers `0..nz` sixteen at a time into `slab`, handing each
+/// batch to `per`.
+fn each_slab(sampler: &Sampler, nz: usize, slab: &mut Slab, mut per: impl FnMut(&Slab)) {
+    let cancel = AtomicBool::new(false);
+    let mut z = 0;
+    while z < nz {
+        let z1 = (z + 16).min(nz);
+        sampler.sample_layers(z, z1, slab, &cancel).expect("sample");
+        per(slab);
         z = z1;
     }
-    (grid.count(), sample, t.elapsed().as_secs_f64())
 }
 
 fn run_job<F>(dir: &Path, work: F) -> (f64, volcad_compilers::Summary)
@@ -186,7 +182,6 @@ fn cases() -> [Case; 6] {
             mesh_voxel: 0.05,
             by: SegmentBy::Dominant,
             segments: 1,
-            pyvcad_png: None,
         },
         Case {
             name: "graded_bar",
@@ -195,7 +190,6 @@ fn cases() -> [Case; 6] {
             mesh_voxel: 0.05,
             by: SegmentBy::Material(1),
             segments: 4,
-            pyvcad_png: None,
         },
         Case {
             name: "bcc_sphere",
@@ -204,7 +198,6 @@ fn cases() -> [Case; 6] {
             mesh_voxel: 0.05,
             by: SegmentBy::Dominant,
             segments: 1,
-            pyvcad_png: None,
         },
         Case {
             name: "bunny_lattice",
@@ -213,9 +206,10 @@ fn cases() -> [Case; 6] {
             mesh_voxel: 0.2,
             by: SegmentBy::Dominant,
             segments: 1,
-            pyvcad_png: None,
         },
-        // pyvcad's own measured designs at its 200³ grids (assets/bench).
+        // pyvcad's own benchmark designs at its 200³ grids (assets/bench);
+        // `assets/bench/pyvcad_designs.py pyvcad_sphere png 0.1` (and
+        // `pyvcad_bcc_box png 0.05`) times pyvcad 2.3.4 on the same stack.
         Case {
             name: "pyvcad_sphere",
             model: || load_from("bench", "pyvcad_sphere.rhai"),
@@ -223,7 +217,6 @@ fn cases() -> [Case; 6] {
             mesh_voxel: 0.1,
             by: SegmentBy::Dominant,
             segments: 1,
-            pyvcad_png: Some(5.4),
         },
         Case {
             name: "pyvcad_bcc_box",
@@ -232,7 +225,6 @@ fn cases() -> [Case; 6] {
             mesh_voxel: 0.05,
             by: SegmentBy::Dominant,
             segments: 1,
-            pyvcad_png: Some(2.5),
         },
     ]
 }
@@ -260,12 +252,8 @@ fn bench_png(tmp: &Path, c: &Case, model: &Arc<Model>) {
             .and_then(|s| s.parse().ok())
             .unwrap_or(0);
         let rate = voxels as f64 / secs / 1e6;
-        let versus = c
-            .pyvcad_png
-            .map(|r| format!("; {:.0}× pyvcad's {r} M/s", rate / r))
-            .unwrap_or_default();
         println!(
-            "png  {:<14} {:<9} {:>6} mm {:>12} voxels {:>8.3} s {:>8.1} M voxels/s  (sample {:.0} M/s, sample+choose {:.0} M/s; {} files, {:.1} MB{versus})",
+            "png  {:<14} {:<9} {:>6} mm {:>12} voxels {:>8.3} s {:>8.1} M voxels/s  (sample {:.0} M/s, sample+choose {:.0} M/s; {} files, {:.1} MB)",
             c.name,
             dither.name(),
             c.png_voxel,

@@ -3,7 +3,7 @@
 //!
 //! Encoding uses the `png` crate with its fastest setting (fdeflate, "Up"
 //! row filter): slice images are mostly long runs and repeated rows, which
-//! this pair compresses well at several hundred MB/s per core. The bytes
+//! this pair compresses well and fast. The bytes
 //! depend only on the pixels, so a layer encodes the same on any thread.
 
 use std::io::Cursor;

@@ -46,6 +46,8 @@ const PIO2_HI: f64 = 1.570_796_326_734_125_614_17e+00;
 /// π/2 − `PIO2_HI` (fdlibm's `pio2_1t`).
 const PIO2_LO: f64 = 6.077_100_506_506_192_249_32e-11;
 
+// fdlibm's __kernel_sin coefficients, then __kernel_cos's: two tables of
+// the same shape, not repeated logic.
 const S1: f64 = -1.666_666_666_666_663_243_48e-01;
 const S2: f64 = 8.333_333_333_322_489_461_24e-03;
 const S3: f64 = -1.984_126_982_985_794_931_34e-04;

@@ -400,51 +400,75 @@ macro_rules! scalar_ops {
 scalar_ops!(Add add, Sub sub, Mul mul, Div div);
 
 #[cfg(test)]
-mod tests {
-    use super::*;
+pub(crate) mod test_rng {
+    //! Random intervals for the interval arithmetic tests here and in
+    //! `expr::interval_eval`.
 
-    /// Deterministic xorshift generator, so failures reproduce.
-    struct Rng(crate::xorshift::XorShift);
-    impl Rng {
-        fn next(&mut self) -> f64 {
+    use super::Interval;
+
+    /// Random intervals (points, half-lines, everything, ranges of mixed
+    /// scale) and points in them, from a deterministic xorshift generator so
+    /// a failure reproduces: for the tests that check interval arithmetic
+    /// contains every value it bounds.
+    pub(crate) struct IntervalRng(crate::xorshift::XorShift);
+
+    impl IntervalRng {
+        /// The generator started from `seed`.
+        pub(crate) fn new(seed: u64) -> Self {
+            Self(crate::xorshift::XorShift::new(seed))
+        }
+        pub(crate) fn unit(&mut self) -> f64 {
             self.0.next_f64()
         }
-        fn interval(&mut self) -> Interval {
-            let scale = [0.5, 2.0, 10.0, 1000.0][(self.next() * 4.0) as usize];
-            let a = (self.next() - 0.5) * 2.0 * scale;
-            let b = (self.next() - 0.5) * 2.0 * scale;
-            match (self.next() * 12.0) as u32 {
-                0 => Interval::point(a),
-                10 => Interval::EVERYTHING,
-                1 => Interval::new(a.min(b), f64::INFINITY),
-                2 => Interval::new(f64::NEG_INFINITY, a.max(b)),
+        pub(crate) fn pick<T: Copy>(&mut self, xs: &[T]) -> T {
+            xs[((self.unit() * xs.len() as f64) as usize).min(xs.len() - 1)]
+        }
+        pub(crate) fn value(&mut self) -> f64 {
+            let scale = self.pick(&[0.01, 1.0, 1.5, 4.0, 20.0, 1e4]);
+            match (self.unit() * 8.0) as u32 {
+                0 => self.pick(&[0.0, -0.0, 1.0, -1.0, 2.0, 3.0, 0.5, -2.0]),
+                _ => (self.unit() - 0.5) * 2.0 * scale,
+            }
+        }
+        pub(crate) fn interval(&mut self) -> Interval {
+            let (a, b) = (self.value(), self.value());
+            match (self.unit() * 14.0) as u32 {
+                0 | 1 => Interval::point(a),
+                2 => Interval::new(a.min(b), f64::INFINITY),
+                3 => Interval::new(f64::NEG_INFINITY, a.max(b)),
+                4 => Interval::EVERYTHING,
+                5 => Interval::new(a.abs().min(b.abs()), a.abs().max(b.abs())),
                 _ => Interval::new(a.min(b), a.max(b)),
             }
         }
-        fn sample(&mut self, i: Interval) -> f64 {
-            if i.is_everything() && self.next() < 0.25 {
+        pub(crate) fn sample(&mut self, i: Interval) -> f64 {
+            if i.is_everything() && self.unit() < 0.2 {
                 return f64::NAN;
             }
-            match (self.next() * 8.0) as u32 {
+            match (self.unit() * 6.0) as u32 {
                 0 => i.lo,
                 1 => i.hi,
                 _ => {
-                    let t = self.next();
-                    let v = i.lo + (i.hi - i.lo) * t;
-                    let spread = 10f64.powf(self.next() * 8.0);
-                    if v.is_finite() {
-                        v.clamp(i.lo, i.hi)
+                    let spread = 10f64.powf(self.unit() * 6.0 - 2.0);
+                    if i.lo.is_finite() && i.hi.is_finite() {
+                        (i.lo + (i.hi - i.lo) * self.unit()).clamp(i.lo, i.hi)
                     } else if i.lo.is_finite() {
                         i.lo + spread
                     } else if i.hi.is_finite() {
                         i.hi - spread
                     } else {
-                        (self.next() - 0.5) * spread
+                        (self.unit() - 0.5) * spread
                     }
                 }
             }
         }
     }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::test_rng::IntervalRng;
+    use super::*;
 
     fn check(out: Interval, v: f64, what: &str) {
         if v.is_nan() {
@@ -517,7 +541,7 @@ mod tests {
             ("min", Interval::min, f64::min),
             ("max", Interval::max, f64::max),
         ];
-        let mut rng = Rng(crate::xorshift::XorShift::new(0x9E37_79B9_7F4A_7C15));
+        let mut rng = IntervalRng::new(0x9E37_79B9_7F4A_7C15);
         for _ in 0..3000 {
             let (a, b) = (rng.interval(), rng.interval());
             for (name, fi, fs) in unary {

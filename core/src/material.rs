@@ -352,6 +352,8 @@ mod tests {
     #[test]
     fn j750_is_pyvcads_table() {
         let t = MaterialTable::j750();
+        // As pyvcad 2.3.4 prints them; the first six are also
+        // compilers' `J750_COLOR_RESINS`, which this test must not read.
         let names = [
             "VeroCyan",
             "VeroMgnt",

@@ -293,21 +293,34 @@ fn refuse_tet_options(a: &ExportArgs, element: Element) -> anyhow::Result<()> {
     if element != Element::C3D8R {
         return Ok(());
     }
-    let given: Vec<&str> = [
-        ("--min-cell", a.min_cell.is_some()),
-        ("--max-cell", a.max_cell.is_some()),
-        ("--sizing", a.sizing.is_some()),
-    ]
-    .iter()
-    .filter(|(_, on)| *on)
-    .map(|(name, _)| *name)
-    .collect();
+    refuse_given(
+        &given_names(&[
+            ("--min-cell", a.min_cell.is_some()),
+            ("--max-cell", a.max_cell.is_some()),
+            ("--sizing", a.sizing.is_some()),
+        ]),
+        "bricks (c3d8r, the default element), which --voxel sizes",
+        "add --element c3d4 for adaptive tetrahedra, or give --voxel MM for bricks",
+    )
+}
+
+/// The names of the options given, from `(name, given)` pairs.
+pub(super) fn given_names(options: &[(&'static str, bool)]) -> Vec<&'static str> {
+    options
+        .iter()
+        .filter(|(_, on)| *on)
+        .map(|(name, _)| *name)
+        .collect()
+}
+
+/// Refuses the options `given` (when there are any), which do not apply to
+/// `what`, saying what to write `instead`.
+fn refuse_given(given: &[&str], what: &str, instead: &str) -> anyhow::Result<()> {
     if given.is_empty() {
         return Ok(());
     }
     bail!(
-        "{} {} not apply to bricks (c3d8r, the default element), which --voxel sizes; \
-         add --element c3d4 for adaptive tetrahedra, or give --voxel MM for bricks",
+        "{} {} not apply to {what}; {instead}",
         given.join(", "),
         if given.len() == 1 { "does" } else { "do" }
     )
@@ -317,20 +330,14 @@ fn refuse_tet_options(a: &ExportArgs, element: Element) -> anyhow::Result<()> {
 pub fn export(a: &ExportArgs) -> anyhow::Result<()> {
     // Options of another export kind would be ignored, and the files would
     // not be what the command line asked for: refuse them before any work.
-    let foreign = foreign_options(a);
-    if !foreign.is_empty() {
-        let kind = format!("{:?}", a.kind).to_lowercase();
-        bail!(
-            "{} {} not apply to `volcad export {kind}`; see `volcad export --help` for which \
-             export each option belongs to",
-            foreign.join(", "),
-            if foreign.len() == 1 { "does" } else { "do" }
-        );
-    }
+    let kind = format!("{:?}", a.kind).to_lowercase();
+    refuse_given(
+        &foreign_options(a),
+        &format!("`volcad export {kind}`"),
+        "see `volcad export --help` for which export each option belongs to",
+    )?;
     if a.shard.is_some() && !matches!(a.kind, Kind::Png | Kind::Vat) {
-        bail!(shard::not_shardable(
-            &format!("{:?}", a.kind).to_lowercase()
-        ));
+        bail!(shard::not_shardable(&kind));
     }
     if a.kind == Kind::Fea {
         refuse_tet_options(a, parse_element(a.element.as_deref())?)?;

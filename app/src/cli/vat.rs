@@ -46,7 +46,7 @@ pub struct VatArgs {
 impl VatArgs {
     /// The vat options given (for refusing them on other exports).
     pub fn given(&self) -> Vec<&'static str> {
-        [
+        super::export::given_names(&[
             ("--intensity", self.intensity.is_some()),
             ("--range", self.range.is_some()),
             ("--vats", self.vats.is_some()),
@@ -56,11 +56,7 @@ impl VatArgs {
             ("--layer", self.layer.is_some()),
             ("--offset", self.offset.is_some()),
             ("--bmp", self.bmp),
-        ]
-        .into_iter()
-        .filter(|(_, on)| *on)
-        .map(|(n, _)| n)
-        .collect()
+        ])
     }
 }
 

@@ -34,6 +34,9 @@ pub struct Resin {
 /// The J750's colour resins, named as in its material table (its
 /// `VeroPureWht` is Stratasys' VeroPureWhite): cyan, magenta, yellow,
 /// black, white and clear.
+// The first six names of `MaterialTable::j750`, whose test in
+// core/src/material.rs writes pyvcad's whole table out as measured: two
+// lists that look alike, this one what the colour export picks from.
 pub const J750_COLOR_RESINS: [&str; 6] = [
     "VeroCyan",
     "VeroMgnt",

@@ -233,9 +233,8 @@ impl FeaMesh {
 
     /// A low estimate of the size of the `.inp` file of this mesh, for
     /// refusing up front a disk that cannot hold it: 20 bytes a node line
-    /// and 4 + 3 a corner an element line (the files are larger: the
-    /// graded bar's at 0.5 mm by 1.5 times as bricks and 1.9 times as
-    /// tetrahedra, whose coordinates take more digits).
+    /// and 4 + 3 a corner an element line (the files are larger, most of
+    /// all for tetrahedra, whose coordinates take more digits).
     pub fn inp_bytes_at_least(&self) -> u64 {
         let corners = self.element.nodes_per_element() as u64;
         self.nodes.len() as u64 * 20 + self.len() as u64 * (4 + 3 * corners)
@@ -553,6 +552,23 @@ fn material_counts(used: &[MatOut], mesh: &FeaMesh) -> Vec<(String, u64)> {
         .collect()
 }
 
+/// [`build_mesh`] on `p.threads` worker threads (default: rayon's pool),
+/// reporting its progress as the first nine tenths of the job's.
+fn mesh_on_threads(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<FeaMesh, ExportError> {
+    let progress = |stage: &str, done: u64, total: u64, frac: f64| {
+        ctx.progress(stage, done, total, "elements", frac * 0.9)
+    };
+    match p.threads {
+        Some(0) => Err(ExportError::param("--threads", "must be at least 1")),
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map_err(|e| ExportError::Other(format!("thread pool: {e}")))?
+            .install(|| build_mesh(model, p, ctx.cancel_flag(), &progress)),
+        None => build_mesh(model, p, ctx.cancel_flag(), &progress),
+    }
+}
+
 /// Mesh `model` and write `<staging>/model.inp` (see the module doc).
 pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summary, ExportError> {
     let start = Instant::now();
@@ -571,18 +587,7 @@ pub fn export_fea(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Summ
     if let Some(s) = &p.step {
         check_step(s.top_displacement, model.bbox().size().z, &mut notes)?;
     }
-    let progress = |stage: &str, done: u64, total: u64, frac: f64| {
-        ctx.progress(stage, done, total, "elements", frac * 0.9)
-    };
-    let mut mesh = match p.threads {
-        Some(0) => return Err(ExportError::param("--threads", "must be at least 1")),
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .map_err(|e| ExportError::Other(format!("thread pool: {e}")))?
-            .install(|| build_mesh(model, p, ctx.cancel_flag(), &progress))?,
-        None => build_mesh(model, p, ctx.cancel_flag(), &progress)?,
-    };
+    let mut mesh = mesh_on_threads(model, p, ctx)?;
     ctx.check_cancel()?;
     let known = mesh.topology.take();
     if mesh.is_empty() {

@@ -299,8 +299,8 @@ fn oriented(
 /// Why: a planar face of a box or a slab is a rectangle whose sides carry
 /// a point at every voxel, exactly collinear and, four at a time, exactly
 /// cocircular, so many of the Delaunay triangulation's in-circle tests
-/// take `robust`'s exact path (whose zeroed scratch arrays take 26 KB a
-/// call; a quarter of the cube's triangulation was that `memset`). A
+/// take `robust`'s exact path (whose scratch arrays, 26 KB a call, are
+/// zeroed on every call: a `memset` that dominates a box's faces). A
 /// convex loop needs only orientation tests: every triangle of three of its
 /// points is inside it, so zig-zagging between its two ends from a
 /// strictly convex corner, taking the side whose triangle turns strictly

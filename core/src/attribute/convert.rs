@@ -15,14 +15,7 @@ impl Table {
     /// A table of `(input, output)` rows; `what` names it in errors.
     pub(crate) fn new(rows: &[(f64, f64)], what: &str) -> Result<Table, String> {
         check_pairs(rows, what, "a lookup table", "(input, output)")?;
-        if let Some(i) = rows.windows(2).position(|w| w[1].0 <= w[0].0) {
-            return Err(format!(
-                "{what}: the inputs must rise row by row, but row {} has {} after {}; sort the rows by input and merge repeated inputs",
-                i + 2,
-                rows[i + 1].0,
-                rows[i].0
-            ));
-        }
+        check_rising(rows, what, "input")?;
         Ok(Table {
             xs: rows.iter().map(|r| r.0).collect(),
             ys: rows.iter().map(|r| r.1).collect(),
@@ -124,6 +117,20 @@ pub(super) fn check_pairs(
         }
     }
     Ok(())
+}
+
+/// Refuse rows whose first column does not rise strictly (`key`: how the
+/// message names that column, singular).
+pub(super) fn check_rising(rows: &[(f64, f64)], what: &str, key: &str) -> Result<(), String> {
+    match rows.windows(2).position(|w| w[1].0 <= w[0].0) {
+        Some(i) => Err(format!(
+            "{what}: the {key}s must rise row by row, but row {} has {} after {}; sort the rows by {key} and merge repeated {key}s",
+            i + 2,
+            rows[i + 1].0,
+            rows[i].0
+        )),
+        None => Ok(()),
+    }
 }
 
 /// How a conversion maps its input.

@@ -63,19 +63,6 @@ impl ANode {
             self.own_value(pos as usize, q, pw, out)?;
             return Ok(true);
         }
-        self.eval_below(idx, q, pw, out, inside)
-    }
-
-    /// Attribute `idx` as the children below this node give it (`inside`:
-    /// q is known to be inside this node).
-    fn eval_below(
-        &self,
-        idx: usize,
-        q: DVec3,
-        pw: DVec3,
-        out: &mut [f64],
-        inside: bool,
-    ) -> Result<bool, AttributeError> {
         match &self.op {
             Op::Leaf => Ok(false),
             Op::Map(m, c) => c.eval(idx, m.apply(q), pw, out),
@@ -258,8 +245,10 @@ impl ANode {
                 let mut x = [f64::NAN];
                 match from_own {
                     Some(j) => x[0] = slots[COORD_SLOTS + j],
+                    // Not this node's own (else `from_own` names it): what
+                    // the children give.
                     None => {
-                        self.eval_below(*from, q, pw, &mut x, false)?;
+                        self.eval_at(*from, q, pw, &mut x, false)?;
                     }
                 }
                 out[0] = match map {

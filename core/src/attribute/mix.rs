@@ -19,7 +19,7 @@
 //! place on the path, found as for two materials (the inverse table maps
 //! the value to the position along the rows, row i at i).
 
-use super::convert::{Table, check_pairs, csv_cells, csv_rows};
+use super::convert::{Table, check_pairs, check_rising, csv_cells, csv_rows};
 use crate::interval::Interval;
 
 /// How far a row's fractions may add up away from 1 (rounding of typed
@@ -76,14 +76,7 @@ impl MixTable {
                 ));
             }
         }
-        if let Some(i) = rows.windows(2).position(|w| w[1].0 <= w[0].0) {
-            return Err(format!(
-                "{what}: the shares must rise row by row, but row {} has {} after {}; sort the rows by share and merge repeated shares",
-                i + 2,
-                rows[i + 1].0,
-                rows[i].0
-            ));
-        }
+        check_rising(rows, what, "share")?;
         let values: Vec<f64> = rows.iter().map(|r| r.1).collect();
         let rising = direction(&values, what)?;
         Ok(MixTable {

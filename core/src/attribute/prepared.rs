@@ -370,6 +370,9 @@ impl Builder<'_> {
     }
 
     /// How `n` passes points to the children that carry attributes.
+    // Its arms take the same node fields apart as the geometry's
+    // `Preparer::build` (core/src/model/prepare.rs) and look alike, but
+    // build a point move, not a distance node.
     fn op(&mut self, n: &Node) -> Result<Op, PrepareError> {
         let map = |m: Move, c: Option<Arc<ANode>>| c.map_or(Op::Leaf, |c| Op::Map(m, c));
         Ok(match n.kind() {

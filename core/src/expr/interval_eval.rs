@@ -393,63 +393,14 @@ impl Op {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Deterministic xorshift generator.
-    struct Rng(crate::xorshift::XorShift);
-    impl Rng {
-        fn unit(&mut self) -> f64 {
-            self.0.next_f64()
-        }
-        fn pick<T: Copy>(&mut self, xs: &[T]) -> T {
-            xs[((self.unit() * xs.len() as f64) as usize).min(xs.len() - 1)]
-        }
-        fn value(&mut self) -> f64 {
-            let scale = self.pick(&[0.01, 1.0, 1.5, 4.0, 20.0, 1e4]);
-            match (self.unit() * 8.0) as u32 {
-                0 => self.pick(&[0.0, -0.0, 1.0, -1.0, 2.0, 3.0, 0.5, -2.0]),
-                _ => (self.unit() - 0.5) * 2.0 * scale,
-            }
-        }
-        fn interval(&mut self) -> Interval {
-            let (a, b) = (self.value(), self.value());
-            match (self.unit() * 14.0) as u32 {
-                0 | 1 => Interval::point(a),
-                2 => Interval::new(a.min(b), f64::INFINITY),
-                3 => Interval::new(f64::NEG_INFINITY, a.max(b)),
-                4 => Interval::EVERYTHING,
-                5 => Interval::new(a.abs().min(b.abs()), a.abs().max(b.abs())),
-                _ => Interval::new(a.min(b), a.max(b)),
-            }
-        }
-        fn sample(&mut self, i: Interval) -> f64 {
-            if i.is_everything() && self.unit() < 0.2 {
-                return f64::NAN;
-            }
-            match (self.unit() * 6.0) as u32 {
-                0 => i.lo,
-                1 => i.hi,
-                _ => {
-                    let spread = 10f64.powf(self.unit() * 6.0 - 2.0);
-                    if i.lo.is_finite() && i.hi.is_finite() {
-                        (i.lo + (i.hi - i.lo) * self.unit()).clamp(i.lo, i.hi)
-                    } else if i.lo.is_finite() {
-                        i.lo + spread
-                    } else if i.hi.is_finite() {
-                        i.hi - spread
-                    } else {
-                        (self.unit() - 0.5) * spread
-                    }
-                }
-            }
-        }
-    }
+    use crate::interval::test_rng::IntervalRng;
 
     /// fidget-style exhaustive check: for every op, random operand intervals, random
     /// points inside them; the scalar result must lie in the interval result (or the
     /// interval must be `EVERYTHING` when the scalar is NaN).
     #[test]
     fn every_op_is_conservative() {
-        let mut rng = Rng(crate::xorshift::XorShift::new(0x2545_F491_4F6C_DD1D));
+        let mut rng = IntervalRng::new(0x2545_F491_4F6C_DD1D);
         for &op in Op::ALL {
             if op == Op::Var {
                 continue;

@@ -241,9 +241,10 @@ impl NAry {
             }
         };
         match &self.index {
-            // Speed copy of core/src/model/pnode.rs::NAry::indexed_min: through a shared closure-taking walk `best` and `first` leave registers.
-            // The same walk, also visiting every child that can contain p
-            // (docs/PERFORMANCE.md, "Large unions").
+            // Speed copy of core/src/model/pnode.rs::NAry::indexed_min, also
+            // visiting every child that can contain p: through one shared
+            // closure-taking walk `best` and `first` would leave registers
+            // (docs/PERFORMANCE.md, "Speed copies" and "Large unions").
             Some(index) => {
                 for &i in index.always() {
                     visit(i as usize, &mut best, &mut first);

@@ -498,7 +498,7 @@ impl NAry {
     /// the cell cannot prove the minimum (best ≥ margin, or `p` outside the
     /// grid). `union_eval` walks the same way.
     fn indexed_min(&self, index: &UnionIndex, p: DVec3) -> f64 {
-        // Speed copy of core/src/model/fractions.rs::NAry::union_eval: through a shared closure-taking walk `best` leaves registers.
+        // Speed copy of core/src/model/fractions.rs::NAry::union_eval: through a shared closure-taking walk `best` would leave registers (docs/PERFORMANCE.md, "Speed copies").
         let mut best = f64::INFINITY;
         for &i in index.always() {
             best = best.min(self.child_dist(i as usize, p));

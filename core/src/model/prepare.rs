@@ -6,10 +6,10 @@ use crate::expr::ExprSet;
 use std::collections::{BTreeSet, HashMap};
 use std::sync::Arc;
 
-use glam::{DMat3, DVec2, DVec3};
+use glam::DVec3;
 
 use super::flatten::{self, Shape, compose_moves, rotation};
-use super::pnode::{Grade, LineCapsule, NAry, PNode, Prism, SimGrade, Slot};
+use super::pnode::{Grade, LineCapsule, NAry, PNode, SimGrade, Slot};
 use super::shapes::Capsule;
 use super::strut_grid::{StrutGrid, octant_struts};
 use super::tpms::Tpms;
@@ -22,8 +22,12 @@ use crate::node::{Node, NodeKind};
 /// Unions with at least this many sharp children get a spatial index.
 const INDEX_MIN_CHILDREN: usize = 8;
 
+#[path = "prepare_prism.rs"]
+mod prism;
 #[path = "prepare_pyvcad3.rs"]
 mod pyvcad3;
+
+use prism::prism;
 
 pub(super) struct Preparer {
     slots: HashMap<MaterialId, Slot>,
@@ -213,6 +217,10 @@ impl Preparer {
         }
     }
 
+    /// `n` as a distance node over its prepared children, and its box.
+    // Its arms take the same node fields apart as the attributes'
+    // `Builder::op` (core/src/attribute/prepared.rs) and look alike, but
+    // build a distance node, not a point move.
     fn build(&mut self, n: &Node) -> Result<(PNode, Aabb), PrepareError> {
         Ok(match n.kind() {
             NodeKind::Translate { offset, child } => {
@@ -628,77 +636,4 @@ fn err(n: &Node, message: &str) -> PrepareError {
         node: n.describe(),
         message: message.to_owned(),
     }
-}
-
-/// A planar polygon (right-hand rule normal) extruded by `height` along the
-/// normal (negative flips; `symmetric` centres it on the plane).
-fn prism(vertices: &[DVec3], height: f64, symmetric: bool) -> Result<(Prism, Aabb), String> {
-    if vertices.len() < 3 {
-        return Err(format!("needs at least 3 vertices, got {}", vertices.len()));
-    }
-    // Newell's method: robust normal of a planar polygon, length = 2·area.
-    let mut normal = DVec3::ZERO;
-    for i in 0..vertices.len() {
-        let (a, b) = (vertices[i], vertices[(i + 1) % vertices.len()]);
-        normal += DVec3::new(
-            (a.y - b.y) * (a.z + b.z),
-            (a.z - b.z) * (a.x + b.x),
-            (a.x - b.x) * (a.y + b.y),
-        );
-    }
-    let scale = vertices
-        .iter()
-        .map(|v| (*v - vertices[0]).length())
-        .fold(0.0, f64::max);
-    if normal.length() <= 1e-12 * scale * scale || scale == 0.0 {
-        return Err("vertices are collinear or repeated: the polygon has no area".into());
-    }
-    let nrm = normal.normalize();
-    for (i, v) in vertices.iter().enumerate() {
-        let off = (*v - vertices[0]).dot(nrm);
-        if off.abs() > 1e-6 * scale.max(1.0) {
-            return Err(format!(
-                "vertex {i} is {off:.3e} mm off the polygon's plane: vertices must be coplanar"
-            ));
-        }
-    }
-    if height == 0.0 {
-        return Err("height is 0".into());
-    }
-    let u = (vertices[1] - vertices[0]).normalize();
-    let u = (u - nrm * u.dot(nrm)).normalize();
-    let v = nrm.cross(u);
-    let to_frame = DMat3::from_cols(u, v, nrm).transpose();
-    let origin = vertices[0];
-    let poly: Vec<DVec2> = vertices
-        .iter()
-        .map(|p| {
-            let q = to_frame * (*p - origin);
-            DVec2::new(q.x, q.y)
-        })
-        .collect();
-    let (lo, hi) = if symmetric {
-        (-height.abs() / 2.0, height.abs() / 2.0)
-    } else if height > 0.0 {
-        (0.0, height)
-    } else {
-        (height, 0.0)
-    };
-    let mut bbox = Aabb::EMPTY;
-    for p in vertices {
-        for w in [lo, hi] {
-            let q = *p + nrm * w;
-            bbox = bbox.union(&Aabb::new(q, q));
-        }
-    }
-    Ok((
-        Prism {
-            to_frame,
-            origin,
-            poly,
-            w_mid: (lo + hi) / 2.0,
-            w_half: (hi - lo) / 2.0,
-        },
-        bbox,
-    ))
 }

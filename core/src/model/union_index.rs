@@ -112,6 +112,34 @@ pub enum Candidates<'a> {
     Outside,
 }
 
+/// The per-child cell lists (`lists[k]`: child `finite[k]`'s cells and
+/// lower bounds) as one list per cell in CSR form (cell `c`'s entries are
+/// `entries[offsets[c]..offsets[c + 1]]`), each sorted by lower bound.
+fn cell_lists(finite: &[u32], lists: &[Vec<(u32, f32)>], ncells: usize) -> (Vec<u32>, Vec<Entry>) {
+    let mut offsets = vec![0u32; ncells + 1];
+    for l in lists {
+        for &(c, _) in l {
+            offsets[c as usize + 1] += 1;
+        }
+    }
+    for c in 0..ncells {
+        offsets[c + 1] += offsets[c];
+    }
+    let mut fill = offsets.clone();
+    let mut entries = vec![Entry { lo: 0.0, child: 0 }; offsets[ncells] as usize];
+    for (&i, l) in finite.iter().zip(lists) {
+        for &(c, lo) in l {
+            entries[fill[c as usize] as usize] = Entry { lo, child: i };
+            fill[c as usize] += 1;
+        }
+    }
+    for c in 0..ncells {
+        entries[offsets[c] as usize..offsets[c + 1] as usize]
+            .sort_unstable_by_key(|e| crate::spatial::order::f32_then_index(e.lo, e.child));
+    }
+    (offsets, entries)
+}
+
 impl UnionIndex {
     /// Build over `boxes` (one per child, in child order). `lower_bound(i,
     /// cell)` must return a lower bound of child `i`'s value over `cell` (its
@@ -227,27 +255,7 @@ impl UnionIndex {
                 cells
             })
             .collect();
-        let mut offsets = vec![0u32; ncells + 1];
-        for l in &lists {
-            for &(c, _) in l {
-                offsets[c as usize + 1] += 1;
-            }
-        }
-        for c in 0..ncells {
-            offsets[c + 1] += offsets[c];
-        }
-        let mut fill = offsets.clone();
-        let mut entries = vec![Entry { lo: 0.0, child: 0 }; offsets[ncells] as usize];
-        for (&i, l) in finite.iter().zip(&lists) {
-            for &(c, lo) in l {
-                entries[fill[c as usize] as usize] = Entry { lo, child: i };
-                fill[c as usize] += 1;
-            }
-        }
-        for c in 0..ncells {
-            entries[offsets[c] as usize..offsets[c + 1] as usize]
-                .sort_unstable_by_key(|e| crate::spatial::order::f32_then_index(e.lo, e.child));
-        }
+        let (offsets, entries) = cell_lists(&finite, &lists, ncells);
         let bvh = Bvh::build(boxes, &finite);
         Self {
             cells: lattice,
