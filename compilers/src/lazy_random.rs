@@ -42,8 +42,7 @@ struct Shares {
 
 impl Shares {
     /// No shares yet (filled by [`Shares::set`]; one per row, reused run
-    /// after run: built and moved per run, its 1 KB arrays were copied
-    /// each time).
+    /// after run, so its 1 KB arrays are not built and moved per run).
     const EMPTY: Shares = Shares {
         k: 0,
         lo: [0.0; MAX_MATERIALS],

@@ -93,8 +93,8 @@ const MAX_SLAB_LAYERS: usize = 16;
 /// The output size comes from a rule of thumb and from a few layers coded
 /// and encoded as the export does (`sampled_bytes`): what the CLI prints
 /// and checks the disk with, and the studio shows. The export job itself
-/// checks by the rule alone (the layers cost a few milliseconds, a sixth
-/// of the cube's 200³ stack).
+/// checks by the rule alone (coding the layers costs as much as a small
+/// stack's own export).
 pub fn estimate(model: &Model, p: &PngParams) -> Result<Estimate, ExportError> {
     estimate_with(model, p, Look::Layers)
 }
@@ -160,8 +160,10 @@ pub(crate) fn estimate_with(
     )?;
     let voxels = (layer * layers.len()) as u64;
     // Rough output: pure material compresses to almost nothing, a two-way
-    // mix to 0.7 (random) or 0.85 (diffusion) bytes per voxel (measured on
-    // the graded bar at 0.02 mm), plus a row's worth and a header per file.
+    // mix to 0.7 (random) or 0.85 (diffusion) bytes per voxel (the files'
+    // bytes over its voxels from `volcad export png
+    // assets/examples/graded_bar.rhai --voxel 0.02`, with `--dither random`
+    // and `--dither diffusion`), plus a row's worth and a header per file.
     let pr = coarse_estimate(model, p.voxel);
     let mixed_bytes = match p.dither {
         Dither::Random => 0.7,
@@ -557,10 +559,11 @@ const SAMPLED_LAYERS: usize = 3;
 /// of equal stretches of the range) coded and encoded as the export does,
 /// scaled to every layer; `None` when a layer's buffers would not fit the
 /// slab budget. Error diffusion is estimated from random picks scaled by
-/// 0.85/0.7 (measured on the graded bar), since its codes depend on every
-/// layer below. How well a layer compresses depends on its colours and its
-/// mix: bytes per voxel went from 0.7 (the graded bar at 0.02 mm) to 2.2
-/// (the seat at 0.3 mm), which a rule of thumb cannot see.
+/// 0.85/0.7 (the rule of thumb's two ratios, see [`estimate_with`]), since
+/// its codes depend on every layer below. How well a layer compresses
+/// depends on its colours and its mix, which a rule of thumb cannot see:
+/// compare the bytes per voxel of `volcad export png` on the graded bar at
+/// 0.02 mm and on the seat (`assets/examples/bicycle_seat.rhai`) at 0.3 mm.
 fn sampled_bytes(
     model: &Model,
     p: &PngParams,

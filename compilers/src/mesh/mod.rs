@@ -78,11 +78,11 @@ const SLAB_BUDGET: usize = 256 << 20;
 /// Most layers sampled per slab. Two slabs' planes are in flight (one
 /// contoured while the next is sampled), so thin slabs keep the working
 /// set small: fewer fresh pages to fault in, and planes still in cache
-/// when contoured. Alternating, 6 to 8 runs each, medians: the graded bar
-/// by dominant material at 0.0422 mm 86 M voxels/s with 16 layers, 89 to
-/// 97 M with 8, 98 to 104 M with 4, 101 M with 2; the cube at 0.05 mm
-/// 115 M with 16, 148 M with 4; the seat, gyroid, bunny lattice and
-/// tiled FCC within noise.
+/// when contoured. Compare values by alternating runs of two builds on the
+/// graded bar by dominant material and the cube (`volcad export mesh
+/// assets/examples/graded_bar.rhai --by dominant --voxel 0.0422`, and
+/// `hello_cube.rhai --voxel 0.05`): fewer layers were faster on both, down
+/// to four; the seat, gyroid, bunny lattice and tiled FCC did not move.
 const SLAB_LAYERS: usize = 4;
 /// Triangles per voxel face of surface (measured on spheres and lattices),
 /// by marching tetrahedra (two or more segments) and by marching cubes (one

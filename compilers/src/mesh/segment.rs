@@ -127,8 +127,8 @@ impl Classifier {
     /// How [`super::contour`] cuts edges between segments. With one
     /// segment no edge joins two segments (edges to void are cut by the
     /// distance), so no interface values are stored: a one-material
-    /// design's planes carry labels and distances only (the cube's 10 M
-    /// voxel mesh export wrote and copied 40 MB of values no edge read).
+    /// design's planes carry labels and distances only (values there would
+    /// be written and copied for every voxel and read by no edge).
     pub fn interface(&self) -> Interface {
         match *self {
             _ if self.segments() == 1 => Interface::Midpoint,
