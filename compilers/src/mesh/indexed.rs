@@ -99,13 +99,14 @@ impl IndexedMesh {
     pub fn shape(&self) -> (f64, f64) {
         // A triangle's smallest angle is opposite its shortest edge and is
         // at most 60°, where the sine rises with the angle: keep the
-        // smallest sine |u × v| / (|u| |v|) over triangles and take one
-        // asin at the end (exact for needles, where the acos of the
-        // normalised dot product rounds to 0).
+        // smallest squared sine |u × v|² / (|u|² |v|²) and the shortest
+        // squared edge over triangles, and take the square roots and one
+        // asin at the end (no root a triangle; exact for needles, where the
+        // acos of the normalised dot product rounds to 0).
         if self.triangles.is_empty() {
             return (180.0, f64::INFINITY);
         }
-        let (sine, edge) = (0..self.triangles.len())
+        let (sine2, edge2) = (0..self.triangles.len())
             .into_par_iter()
             .map(|t| {
                 let p = self.corners(t);
@@ -114,17 +115,17 @@ impl IndexedMesh {
                 let k = (0..3).fold(0, |m, k| if l[k] < l[m] { k } else { m });
                 // The two edges from the corner opposite the shortest, e[k].
                 let (u, v) = (e[(k + 1) % 3], e[(k + 2) % 3]);
-                let (lu, lv) = (l[(k + 1) % 3].sqrt(), l[(k + 2) % 3].sqrt());
                 let n = cross(u, v);
-                let sine = if lu > 0.0 && lv > 0.0 {
-                    (dot(n, n).sqrt() / (lu * lv)).min(1.0)
+                let uv = l[(k + 1) % 3] * l[(k + 2) % 3];
+                let sine2 = if uv > 0.0 {
+                    (dot(n, n) / uv).min(1.0)
                 } else {
                     0.0
                 };
-                (sine, l[k].sqrt())
+                (sine2, l[k])
             })
             .reduce(|| (1.0, f64::INFINITY), |a, b| (a.0.min(b.0), a.1.min(b.1)));
-        (sine.asin().to_degrees().min(60.0), edge)
+        (sine2.sqrt().asin().to_degrees().min(60.0), edge2.sqrt())
     }
 
     /// Unit normal of triangle `t` (zero for a degenerate one).
@@ -142,8 +143,9 @@ impl IndexedMesh {
     /// Count open, repeated and degenerate edges.
     ///
     /// Directed edges `a → b` are grouped by their start vertex (a counting
-    /// sort, linear in the edge count; each vertex has a handful), and the
-    /// groups are checked in parallel. `a → b` repeated is counted once per
+    /// sort, linear in the edge count; each vertex has a handful), in
+    /// parallel over ranges of vertices, and the groups are checked in
+    /// parallel. `a → b` repeated is counted once per
     /// extra copy; an edge is open when `a → b` occurs more often than `b → a` (each copy
     /// of `b → a` pairs with one copy of `a → b`).
     ///
@@ -151,49 +153,91 @@ impl IndexedMesh {
     /// equal, as a multiset, to its in-neighbours `I(a)` (every `a → b`
     /// then has exactly one `b → a`). The multisets are compared by their
     /// sums of a 64-bit mix of each neighbour, `Σ_{b ∈ O(a)} h(b) =
-    /// Σ_{b ∈ I(a)} h(b)` (mod 2⁶⁴), gathered in the same pass as the sort:
+    /// Σ_{b ∈ I(a)} h(b)` (mod 2⁶⁴), gathered while the edges are counted:
     /// one comparison a vertex instead of a search of every neighbour's
     /// list. Two different multisets with equal sums would take a collision
     /// of the mix (odds about 2⁻⁶⁴ a vertex); a vertex whose sums differ, or
     /// whose out-neighbours repeat, is counted exactly as described above.
     pub fn edge_report(&self) -> EdgeReport {
-        let mut r = EdgeReport::default();
-        let nv = self.vertices.len();
-        let mut start = vec![0u32; nv + 1];
-        for t in &self.triangles {
-            if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
-                r.degenerate += 1;
-            }
-            for a in t {
-                start[*a as usize + 1] += 1;
-            }
-        }
-        for v in 0..nv {
-            start[v + 1] += start[v];
-        }
-        let mut fill = start.clone();
-        let mut ends = vec![0u32; start[nv] as usize];
-        // Σ h(b) over the in-neighbours b of each vertex.
-        let mut into = vec![0u64; nv];
-        for t in &self.triangles {
-            let h = t.map(neighbour_mix);
-            for (i, j) in [(0, 1), (1, 2), (2, 0)] {
-                let (a, b) = (t[i], t[j]);
-                ends[fill[a as usize] as usize] = b;
-                fill[a as usize] += 1;
-                into[b as usize] = into[b as usize].wrapping_add(h[i]);
-            }
-        }
         // A vertex has a handful of edges: its list is scanned. Long lists
         // (a fan in an imported mesh) are sorted and searched, so a hub of
         // degree D costs D log D, not D².
         const SHORT: usize = 32;
-        for v in 0..nv {
-            let list = &mut ends[start[v] as usize..start[v + 1] as usize];
-            if list.len() > SHORT {
-                list.sort_unstable();
+        let mut r = EdgeReport::default();
+        let nv = self.vertices.len();
+        r.degenerate = self
+            .triangles
+            .par_iter()
+            .filter(|t| t[0] == t[1] || t[1] == t[2] || t[2] == t[0])
+            .count();
+        // The sort in parallel: each task owns a range of start vertices
+        // (so it writes only its own part of `ends`) and of end vertices
+        // (their fingerprints), and reads every triangle to find its edges.
+        let parts = rayon::current_num_threads().clamp(1, 16).min(nv.max(1));
+        let first = |p: usize| (nv * p / parts) as u32;
+        let edges = |t: &[u32; 3]| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])];
+        let counted: Vec<(Vec<u32>, Vec<u64>)> = (0..parts)
+            .into_par_iter()
+            .map(|p| {
+                let (lo, hi) = (first(p), first(p + 1));
+                let mut degree = vec![0u32; (hi - lo) as usize];
+                // Σ h(a) over the in-neighbours a of each vertex.
+                let mut into = vec![0u64; (hi - lo) as usize];
+                for t in &self.triangles {
+                    for (a, b) in edges(t) {
+                        if (lo..hi).contains(&a) {
+                            degree[(a - lo) as usize] += 1;
+                        }
+                        if (lo..hi).contains(&b) {
+                            let i = &mut into[(b - lo) as usize];
+                            *i = i.wrapping_add(neighbour_mix(a));
+                        }
+                    }
+                }
+                (degree, into)
+            })
+            .collect();
+        let mut start = Vec::with_capacity(nv + 1);
+        start.push(0u32);
+        let mut into = Vec::with_capacity(nv);
+        for (degree, part_into) in counted {
+            for d in degree {
+                start.push(start[start.len() - 1] + d);
             }
+            into.extend(part_into);
         }
+        let mut ends = vec![0u32; start[nv] as usize];
+        let mut pieces = Vec::with_capacity(parts);
+        let mut rest = &mut ends[..];
+        for p in 0..parts {
+            let len = (start[first(p + 1) as usize] - start[first(p) as usize]) as usize;
+            let (piece, tail) = rest.split_at_mut(len);
+            pieces.push((p, piece));
+            rest = tail;
+        }
+        pieces.into_par_iter().for_each(|(p, piece)| {
+            let (lo, hi) = (first(p), first(p + 1));
+            let base = start[lo as usize];
+            let mut fill: Vec<u32> = start[lo as usize..hi as usize]
+                .iter()
+                .map(|s| s - base)
+                .collect();
+            for t in &self.triangles {
+                for (a, b) in edges(t) {
+                    if (lo..hi).contains(&a) {
+                        let f = &mut fill[(a - lo) as usize];
+                        piece[*f as usize] = b;
+                        *f += 1;
+                    }
+                }
+            }
+            for v in lo as usize..hi as usize {
+                let list = &mut piece[(start[v] - base) as usize..(start[v + 1] - base) as usize];
+                if list.len() > SHORT {
+                    list.sort_unstable();
+                }
+            }
+        });
         let out = |v: u32| &ends[start[v as usize] as usize..start[v as usize + 1] as usize];
         let count = |list: &[u32], x: u32| {
             if list.len() > SHORT {
