@@ -98,31 +98,33 @@ impl IndexedMesh {
     /// program trips on them. `(180, inf)` without triangles.
     pub fn shape(&self) -> (f64, f64) {
         // A triangle's smallest angle is opposite its shortest edge and is
-        // at most 60°, where the sine rises with the angle: keep the
-        // smallest squared sine |u × v|² / (|u|² |v|²) and the shortest
-        // squared edge over triangles, and take the square roots and one
-        // asin at the end (no root a triangle; exact for needles, where the
-        // acos of the normalised dot product rounds to 0).
+        // at most 60°, where the sine rises with the angle. The sine at the
+        // corner between edges u and v is |u × v| / (|u| |v|), and |u × v|
+        // is twice the area for any two edges, so with squared lengths
+        // l₀, l₁, l₂ the smallest squared sine is |n|² · min l / (l₀ l₁ l₂):
+        // no square root, division or branch on the shortest edge a
+        // triangle. Keep the smallest over triangles, with the shortest
+        // squared edge, and take the roots and one asin at the end (exact
+        // for needles, where the acos of the normalised dot product rounds
+        // to 0).
         if self.triangles.is_empty() {
             return (180.0, f64::INFINITY);
         }
         let (sine2, edge2) = (0..self.triangles.len())
             .into_par_iter()
             .map(|t| {
-                let p = self.corners(t);
-                let e = [0, 1, 2].map(|k| sub(p[(k + 1) % 3], p[k]));
-                let l = e.map(|v| dot(v, v));
-                let k = (0..3).fold(0, |m, k| if l[k] < l[m] { k } else { m });
-                // The two edges from the corner opposite the shortest, e[k].
-                let (u, v) = (e[(k + 1) % 3], e[(k + 2) % 3]);
+                let [a, b, c] = self.corners(t);
+                let (u, v, w) = (sub(b, a), sub(c, b), sub(a, c));
+                let l = [dot(u, u), dot(v, v), dot(w, w)];
                 let n = cross(u, v);
-                let uv = l[(k + 1) % 3] * l[(k + 2) % 3];
-                let sine2 = if uv > 0.0 {
-                    (dot(n, n) / uv).min(1.0)
+                let shortest = l[0].min(l[1]).min(l[2]);
+                let all = l[0] * l[1] * l[2];
+                let sine2 = if all > 0.0 {
+                    (dot(n, n) * shortest / all).min(1.0)
                 } else {
                     0.0
                 };
-                (sine2, l[k])
+                (sine2, shortest)
             })
             .reduce(|| (1.0, f64::INFINITY), |a, b| (a.0.min(b.0), a.1.min(b.1)));
         (sine2.sqrt().asin().to_degrees().min(60.0), edge2.sqrt())
