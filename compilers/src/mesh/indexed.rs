@@ -161,10 +161,6 @@ impl IndexedMesh {
     /// of the mix (odds about 2⁻⁶⁴ a vertex); a vertex whose sums differ, or
     /// whose out-neighbours repeat, is counted exactly as described above.
     pub fn edge_report(&self) -> EdgeReport {
-        // A vertex has a handful of edges: its list is scanned. Long lists
-        // (a fan in an imported mesh) are sorted and searched, so a hub of
-        // degree D costs D log D, not D².
-        const SHORT: usize = 32;
         let mut r = EdgeReport::default();
         let nv = self.vertices.len();
         r.degenerate = self
@@ -172,9 +168,58 @@ impl IndexedMesh {
             .par_iter()
             .filter(|t| t[0] == t[1] || t[1] == t[2] || t[2] == t[0])
             .count();
-        // The sort in parallel: each task owns a range of start vertices
-        // (so it writes only its own part of `ends`) and of end vertices
-        // (their fingerprints), and reads every triangle to find its edges.
+        let EdgeLists { start, ends, into } = self.edge_lists();
+        let out = |v: u32| &ends[start[v as usize] as usize..start[v as usize + 1] as usize];
+        let count = |list: &[u32], x: u32| {
+            if list.len() > SHORT {
+                list.partition_point(|&e| e <= x) - list.partition_point(|&e| e < x)
+            } else {
+                list.iter().filter(|&&e| e == x).count()
+            }
+        };
+        let seen = |list: &[u32], i: usize| {
+            if list.len() > SHORT {
+                i > 0 && list[i - 1] == list[i]
+            } else {
+                list[..i].contains(&list[i])
+            }
+        };
+        let (repeated, open) = (0..nv as u32)
+            .into_par_iter()
+            .with_min_len(1 << 14)
+            .map(|a| {
+                let list = out(a);
+                let sum = list
+                    .iter()
+                    .fold(0u64, |s, &b| s.wrapping_add(neighbour_mix(b)));
+                if sum == into[a as usize] && (0..list.len()).all(|i| !seen(list, i)) {
+                    return (0, 0);
+                }
+                let (mut repeated, mut open) = (0, 0);
+                for (i, &b) in list.iter().enumerate() {
+                    if seen(list, i) {
+                        continue; // counted at its first copy
+                    }
+                    let m = count(list, b);
+                    repeated += m - 1;
+                    open += m.saturating_sub(count(out(b), a));
+                }
+                (repeated, open)
+            })
+            .reduce(|| (0, 0), |x, y| (x.0 + y.0, x.1 + y.1));
+        r.repeated = repeated;
+        r.open = open;
+        r
+    }
+
+    /// The directed edges grouped by start vertex (a counting sort; long
+    /// lists sorted), with each vertex's in-neighbour fingerprint (see
+    /// [`Self::edge_report`]). In parallel: each task owns a range of start
+    /// vertices (so it writes only its own part of `ends`) and of end
+    /// vertices (their fingerprints), and reads every triangle to find its
+    /// edges.
+    fn edge_lists(&self) -> EdgeLists {
+        let nv = self.vertices.len();
         let parts = rayon::current_num_threads().clamp(1, 16).min(nv.max(1));
         let first = |p: usize| (nv * p / parts) as u32;
         let edges = |t: &[u32; 3]| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])];
@@ -240,53 +285,27 @@ impl IndexedMesh {
                 }
             }
         });
-        let out = |v: u32| &ends[start[v as usize] as usize..start[v as usize + 1] as usize];
-        let count = |list: &[u32], x: u32| {
-            if list.len() > SHORT {
-                list.partition_point(|&e| e <= x) - list.partition_point(|&e| e < x)
-            } else {
-                list.iter().filter(|&&e| e == x).count()
-            }
-        };
-        let seen = |list: &[u32], i: usize| {
-            if list.len() > SHORT {
-                i > 0 && list[i - 1] == list[i]
-            } else {
-                list[..i].contains(&list[i])
-            }
-        };
-        let (repeated, open) = (0..nv as u32)
-            .into_par_iter()
-            .with_min_len(1 << 14)
-            .map(|a| {
-                let list = out(a);
-                let sum = list
-                    .iter()
-                    .fold(0u64, |s, &b| s.wrapping_add(neighbour_mix(b)));
-                if sum == into[a as usize] && (0..list.len()).all(|i| !seen(list, i)) {
-                    return (0, 0);
-                }
-                let (mut repeated, mut open) = (0, 0);
-                for (i, &b) in list.iter().enumerate() {
-                    if seen(list, i) {
-                        continue; // counted at its first copy
-                    }
-                    let m = count(list, b);
-                    repeated += m - 1;
-                    open += m.saturating_sub(count(out(b), a));
-                }
-                (repeated, open)
-            })
-            .reduce(|| (0, 0), |x, y| (x.0 + y.0, x.1 + y.1));
-        r.repeated = repeated;
-        r.open = open;
-        r
+        EdgeLists { start, ends, into }
     }
 
     /// Every edge shared by exactly two triangles, in opposite directions.
     pub fn is_watertight(&self) -> bool {
         !self.is_empty() && self.edge_report().is_clean()
     }
+}
+
+/// A vertex has a handful of edges: its list is scanned. Long lists (a fan
+/// in an imported mesh) are sorted and searched, so a hub of degree D costs
+/// D log D, not D².
+const SHORT: usize = 32;
+
+/// Directed edges by start vertex: vertex `v`'s end vertices are
+/// `ends[start[v]..start[v + 1]]`; `into[v]` sums the mix of its
+/// in-neighbours.
+struct EdgeLists {
+    start: Vec<u32>,
+    ends: Vec<u32>,
+    into: Vec<u64>,
 }
 
 /// The 64-bit mix of a vertex index whose sums fingerprint a vertex's

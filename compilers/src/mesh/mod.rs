@@ -528,6 +528,18 @@ fn build(
     // The slab sampled into, the one contoured and the one whose last
     // plane the contourer held: more means retired planes kept buffers.
     debug_assert!(pool.fresh() <= 3, "{} distance buffers", pool.fresh());
+    named_segments(model, p, pl, contourer, &tally)
+}
+
+/// The contourer's meshes as named segments with their infill (flat regions
+/// triangulated now, see [`Contourer::finish`]).
+fn named_segments(
+    model: &Model,
+    p: &MeshParams,
+    pl: &Plan,
+    contourer: Contourer,
+    tally: &Tally,
+) -> Result<Vec<SegmentMesh>, ExportError> {
     let names = segment_names(model, p, &pl.classifier);
     let n = pl.classifier.segments();
     contourer
