@@ -139,7 +139,16 @@ impl PNode {
             | PNode::Shape { .. } => true,
             // A sum of n distances changes up to n times as fast.
             PNode::Sum { children, .. } => children.len() == 1 && children[0].is_lipschitz(),
-            PNode::Function { .. } | PNode::Tpms { .. } | PNode::Tile { .. } => false,
+            PNode::Function { .. } | PNode::Tpms { .. } => false,
+            // A lattice folded into one octant (mirror symmetric in its mid
+            // planes) and clipped to the tiled cell takes the same value on
+            // both sides of every cell face, so the tiling is continuous
+            // and, 1-Lipschitz within each cell, 1-Lipschitz everywhere.
+            // Any other tiled child may jump at the faces.
+            PNode::Tile { cell, child } => matches!(
+                &**child,
+                PNode::Lattice { fold: true, clip_h: Some(h), .. } if *h * 2.0 == *cell
+            ),
             PNode::Translate { child, .. }
             | PNode::Rotate { child, .. }
             | PNode::Scale { child, .. }

@@ -631,3 +631,27 @@ fn batch_calls_match_single_points() {
         }
     }
 }
+
+/// A tiled lattice folded into one octant and clipped to its cell is
+/// 1-Lipschitz across the cell faces (`Model::distance_is_bound`): random
+/// pairs of nearby points, many across a face, never differ by more than
+/// their distance. A tiled `Function` is not claimed to be.
+#[test]
+fn a_tiled_symmetric_lattice_is_lipschitz_across_cell_faces() {
+    let m = model("Tile(GraphLattice(LatticeType::BodyCenteredCubic, Vec3(2, 2, 2), 0.3, 1))");
+    assert!(m.distance_is_bound());
+    let mut rng = crate::bench::XorShift::new(3);
+    let mut r = || rng.next_f64() * 2.0 - 1.0;
+    for _ in 0..50_000 {
+        // Near the cell faces at ±1 (and their corners).
+        let a = DVec3::new(1.0 + 0.2 * r(), 1.0 + 0.2 * r(), 3.0 * r());
+        let b = a + DVec3::new(r(), r(), r()) * 0.15;
+        let (da, db) = (m.distance(a), m.distance(b));
+        assert!(
+            (da - db).abs() <= a.distance(b) * (1.0 + 1e-12) + 1e-12,
+            "{a} {b}: {da} {db}"
+        );
+    }
+    let f = model(r#"Tile(2, 2, 2, Function("x*x + y*y + z*z - 0.5", 1))"#);
+    assert!(!f.distance_is_bound());
+}

@@ -85,6 +85,11 @@ pub(super) struct Needs<'a> {
     pub blocks: bool,
     /// Bounded varying fractions are left `NaN`.
     pub lazy: bool,
+    /// Voxels beyond the margin may hold a bound from a neighbour's value
+    /// (see `leaf`): consumers that read exact values only within the
+    /// margin. Not the viewport bake (the reference), the keep-out (which
+    /// reads how deep inside voxels lie) or GCVF's outline.
+    pub lipschitz_skip: bool,
 }
 
 impl<'a> Consumer<'a> {
@@ -97,9 +102,11 @@ impl<'a> Consumer<'a> {
             solid_rects: false,
             blocks: false,
             lazy: false,
+            lipschitz_skip: false,
         };
         let signs = Needs {
             signs_only: true,
+            lipschitz_skip: true,
             ..plain
         };
         match self {
@@ -112,6 +119,7 @@ impl<'a> Consumer<'a> {
                 uniform: Some(test),
                 solid_rects: true,
                 blocks: true,
+                lipschitz_skip: true,
                 ..plain
             },
             Consumer::PngStackSingle => Needs {

@@ -17,7 +17,8 @@
 //! a pick open; for blended designs also in tiles a surface crosses).
 //! Memory is proportional to the slab, never to the volume.
 //!
-//! Skipped voxels store the interval end (`lo` outside, `hi` inside): the
+//! Skipped voxels store the interval end (`lo` outside, `hi` inside), or in
+//! an open leaf a neighbour's value less their distance (see `leaf`): the
 //! sign is exact and the magnitude is a valid bound. For consumers that
 //! read distances, a skipped voxel is farther than one voxel diagonal from
 //! the surface, so no surface crossing lies on a grid edge that touches it,
@@ -33,6 +34,7 @@ use crate::model::{MAX_MATERIALS, Model};
 
 mod consumer;
 mod grid;
+mod leaf;
 mod slab;
 pub use consumer::{Consumer, UniformTest};
 pub use grid::{Grid, GridError};
@@ -145,6 +147,9 @@ pub struct Sampler<'a> {
     lazy_open: bool,
     /// The design's fractions when they are fixed (see [`Shared`]).
     fixed: Option<[f32; MAX_MATERIALS]>,
+    /// Evaluated voxels of a leaf bound the leaf's later ones (see `leaf`).
+    lipschitz_skip: bool,
+    leaf_gaps: leaf::LeafGaps,
     /// Open tiles asked whether their fractions are constant, and how many
     /// were (see `try_constant`).
     constant_asked: AtomicU64,
@@ -196,6 +201,8 @@ impl<'a> Sampler<'a> {
             blocks: needs.blocks,
             signs_only: needs.signs_only,
             lazy_open: lazy && model.averages_fractions(),
+            lipschitz_skip: needs.lipschitz_skip && model.distance_is_bound(),
+            leaf_gaps: leaf::leaf_gaps(grid.voxel.x, grid.voxel.y),
             stats: SampleStats::default(),
         }
     }
@@ -339,8 +346,6 @@ impl<'a> Sampler<'a> {
     fn tile(&self, r: Rect, out: &mut Rows, shared: &mut Shared) {
         let Rect { z, x0, y0, w, h } = r;
         let k = out.k;
-        let row0 = out.row0;
-        let nx = self.grid.dims[0];
         let b = self.grid.centres_box(x0, x0 + w - 1, y0, y0 + h - 1, z);
         match self.settle(&b, k) {
             Settled::Open => {}
@@ -388,73 +393,14 @@ impl<'a> Sampler<'a> {
             }
             return self.split(r, out, shared);
         }
-        let mut f = [0.0f64; MAX_MATERIALS];
-        // A lazy consumer bounds the fractions itself, run by run. Where
-        // fractions are averages (a `Blend`, 125 or 216 child samples a voxel) and
-        // their bounds over the tile are narrow, the inside voxels of tiles
-        // a surface crosses get `NaN` fractions too, and only their
-        // distance is evaluated (a large saving on the csg_tour slice
-        // stack). For other designs the bound costs about what it saves.
-        let lazy = k > 0 && self.lazy_open && self.bounded(&b, k);
-        // What an inside voxel gets without evaluating its fractions, once
-        // known: `NaN` for the lazy consumer, or the shared fractions.
-        let mut inside = match shared {
-            _ if k == 0 => None,
-            _ if lazy => Some([f32::NAN; MAX_MATERIALS]),
-            Shared::Constant(one) => *one,
-            Shared::Unknown => None,
-        };
-        let capture = matches!(shared, Shared::Constant(None));
-        let mut spared = 0;
-        for y in y0..y0 + h {
-            let row = (y - row0) * nx;
-            for x in x0..x0 + w {
-                let p = self.grid.center(x, y, z);
-                let v = row + x;
-                if let Some(one) = &inside {
-                    let d = self.model.distance(p);
-                    out.dist[v] = d as f32;
-                    let voxel = &mut out.fracs[v * k..(v + 1) * k];
-                    if d <= 0.0 {
-                        voxel.copy_from_slice(&one[..k]);
-                        spared += 1;
-                    } else {
-                        voxel.fill(0.0);
-                    }
-                } else if k > 0 {
-                    let d = self.model.eval_into(p, &mut f[..k]);
-                    out.dist[v] = d as f32;
-                    for (o, val) in out.fracs[v * k..(v + 1) * k].iter_mut().zip(&f[..k]) {
-                        *o = *val as f32;
-                    }
-                    if capture && d <= 0.0 {
-                        // The first inside voxel: the rest share its fractions.
-                        let mut one = [0.0; MAX_MATERIALS];
-                        for (o, val) in one.iter_mut().zip(&f[..k]) {
-                            *o = *val as f32;
-                        }
-                        inside = Some(one);
-                        *shared = Shared::Constant(inside);
-                    }
-                } else {
-                    out.dist[v] = self.model.distance(p) as f32;
-                }
-            }
-        }
-        out.counts.evaluated += (w * h) as u64;
-        if !lazy {
-            out.counts.shared += spared;
-        }
+        self.leaf(r, out, shared, &b);
     }
+
     /// What the bounds say about the voxel centres in `b` (`k` fractions).
     /// Beyond one voxel diagonal from the surface no grid edge that touches
     /// a voxel is crossed, so its distance need not be evaluated.
     fn settle(&self, b: &Aabb, k: usize) -> Settled {
-        let margin = if self.signs_only {
-            0.0
-        } else {
-            self.grid.voxel.length()
-        };
+        let margin = self.margin();
         let iv = self.model.interval(b);
         if iv.lo > margin {
             return Settled::Outside(iv.lo as f32);
@@ -492,6 +438,17 @@ impl<'a> Sampler<'a> {
             value: iv.hi as f32,
             constant,
             mixed,
+        }
+    }
+
+    /// How far from the surface a voxel's value may be a bound: one voxel
+    /// diagonal for consumers that read distances, 0 for those that read
+    /// signs only.
+    fn margin(&self) -> f64 {
+        if self.signs_only {
+            0.0
+        } else {
+            self.grid.voxel.length()
         }
     }
 

@@ -163,3 +163,68 @@ fn tiles_of_one_exact_distance_store_what_evaluating_gives() {
         }
     }
 }
+
+/// The leaves' Lipschitz bounds (see `leaf`): on a tiled BCC lattice in a
+/// sphere (a `Tile` known to be Lipschitz) and a grading, a mesh contour's
+/// and a slice stack's samples keep every sign and every inside voxel's
+/// fractions; the mesh contour's distances within one voxel diagonal of the
+/// surface are the evaluated ones bit for bit, and beyond it every stored
+/// value is a bound (`|stored| ≤ |d|`, beyond the margin); and fewer voxels
+/// are evaluated than without the bounds.
+#[test]
+fn leaf_bounds_keep_what_consumers_read() {
+    let m = model(
+        r#"let m = default_materials();
+        let cell = GraphLattice(LatticeType::BodyCenteredCubic, Vec3(2, 2, 2), 0.25, m.id("gray"));
+        FGrade(["clamp(0, x/8 + 0.5, 1)", "1 - clamp(0, x/8 + 0.5, 1)"],
+               [m.id("cyan"), m.id("white")], true,
+               Intersection(false, [Tile(cell), Sphere(Vec3(0, 0, 0), 3.5, m.id("gray"))]))"#,
+    );
+    assert!(
+        m.distance_is_bound(),
+        "a tiled symmetric lattice is Lipschitz"
+    );
+    let grid = Grid::covering(&m.bbox(), DVec3::new(0.07, 0.05, 0.06), 1 << 30).unwrap();
+    let margin = grid.voxel.length() as f32;
+    let (plain, _) = sample_all(&Sampler::new(&m, grid, Consumer::ViewportBake));
+    let any = |_: &[Interval]| false;
+    let mesh = Sampler::new(&m, grid, Consumer::MeshContour(&any));
+    let (mine, _) = sample_all(&mesh);
+    let signs = Sampler::new(&m, grid, Consumer::PngStackDiffusion);
+    let (stack, _) = sample_all(&signs);
+    let k = plain.k;
+    let mut bounded = 0;
+    for v in 0..plain.dist.len() {
+        let (a, b, c) = (plain.dist[v], mine.dist[v], stack.dist[v]);
+        assert_eq!(a <= 0.0, b <= 0.0, "mesh sign of voxel {v}: {a} vs {b}");
+        assert_eq!(a <= 0.0, c <= 0.0, "stack sign of voxel {v}: {a} vs {c}");
+        if a <= 0.0 {
+            let fa = &plain.fracs[v * k..(v + 1) * k];
+            assert_eq!(fa, &stack.fracs[v * k..(v + 1) * k], "voxel {v}");
+        }
+        if a.abs() <= margin {
+            assert_eq!(a.to_bits(), b.to_bits(), "voxel {v} near the surface");
+        } else if a != b {
+            assert!(
+                b.abs() <= a.abs() && b.abs() > margin * 0.999,
+                "{v}: {b} for {a}"
+            );
+            bounded += 1;
+        }
+    }
+    assert!(bounded > 0, "no voxel took a bound");
+    let evaluated = |s: &Sampler<'_>| s.stats.evaluated.load(Ordering::Relaxed);
+    let mut off = Sampler::new(&m, grid, Consumer::PngStackDiffusion);
+    off.lipschitz_skip = false;
+    let (again, _) = sample_all(&off);
+    assert_eq!(
+        again.dist.iter().filter(|d| **d <= 0.0).count(),
+        stack.dist.iter().filter(|d| **d <= 0.0).count()
+    );
+    assert!(
+        evaluated(&signs) < evaluated(&off),
+        "{} vs {}",
+        evaluated(&signs),
+        evaluated(&off)
+    );
+}
