@@ -54,6 +54,7 @@ pub use sizing::{SizeRule, heterogeneity};
 use tets::STUFF;
 
 use crate::job::{ExportError, JobContext, Summary};
+use crate::resources::run_with_threads;
 use inp_writer::{Deck, MatOut};
 
 /// Element kind.
@@ -558,15 +559,9 @@ fn mesh_on_threads(model: &Model, p: &FeaParams, ctx: &JobContext) -> Result<Fea
     let progress = |stage: &str, done: u64, total: u64, frac: f64| {
         ctx.progress(stage, done, total, "elements", frac * 0.9)
     };
-    match p.threads {
-        Some(0) => Err(ExportError::param("--threads", "must be at least 1")),
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .map_err(|e| ExportError::Other(format!("thread pool: {e}")))?
-            .install(|| build_mesh(model, p, ctx.cancel_flag(), &progress)),
-        None => build_mesh(model, p, ctx.cancel_flag(), &progress),
-    }
+    run_with_threads(p.threads, || {
+        build_mesh(model, p, ctx.cancel_flag(), &progress)
+    })
 }
 
 /// Mesh `model` and write `<staging>/model.inp` (see the module doc).

@@ -130,8 +130,9 @@ pub(super) fn body_notes(b: &bodies::Bodies, voxel: f64, design: &StatedGaps) ->
 /// every segment. The contouring guarantees watertightness; checked anyway
 /// (a linear pass over the edges), every segment on its own thread.
 pub(super) fn checks(segs: &[SegmentMesh]) -> Vec<Check> {
-    // The three at once: the edge check's sort and the volume's sum run
-    // on one thread each, beside the writers and the body count.
+    // The three at once, beside the writers and the body count: the
+    // volume's sum runs on one thread (in a fixed order, so the same bits
+    // on any thread count) while the other two split their work.
     segs.par_iter()
         .map(|s| {
             let (watertight, (volume, shape)) = rayon::join(

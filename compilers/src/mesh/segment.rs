@@ -218,28 +218,25 @@ impl Classifier {
             // Outside voxels (labels stay 0) are most of what is left
             // between solid runs: skipped eight at a time, with one
             // vector comparison and no branch per voxel.
-            if let Some(eight) = dist.get(x..x + 8)
-                && x + 8 <= xs.end
-                && eight.iter().fold(true, |all, d| all & (*d > 0.0))
-            {
+            if x + 8 <= xs.end && dist[x..x + 8].iter().fold(true, |all, d| all & (*d > 0.0)) {
                 x += 8;
                 continue;
             }
+            let v = x;
             x += 1;
-            let x = x - 1;
-            if dist[x] > 0.0 {
+            if dist[v] > 0.0 {
                 continue;
             }
-            let fv = &fracs[x * k..(x + 1) * k];
+            let fv = &fracs[v * k..(v + 1) * k];
             let (lab, f) = match last {
                 Some((u, lab, f)) if same_bits(&fracs[u * k..][..k], fv) => {
-                    copy_value(values, u, x, stride);
+                    copy_value(values, u, v, stride);
                     (lab, f)
                 }
-                _ => self.classify(fv, &mut values[x * stride..(x + 1) * stride]),
+                _ => self.classify(fv, &mut values[v * stride..(v + 1) * stride]),
             };
-            last = Some((x, lab, f));
-            labels[x] = lab;
+            last = Some((v, lab, f));
+            labels[v] = lab;
             if lab > 0 {
                 t.voxels[lab as usize - 1] += 1;
                 t.sum_f[lab as usize - 1] += f64::from(f);

@@ -314,7 +314,8 @@ impl Model {
 
     /// True when [`Model::distance`] is 1-Lipschitz, so a sphere tracer may
     /// step by it; false when a node's value is not a distance (a math
-    /// string `Function`, a TPMS sheet, a `Tile`), where a renderer must
+    /// string `Function`, a TPMS sheet, a `Tile` of anything but a
+    /// mirror-symmetric lattice clipped to its cell), where a renderer must
     /// find the surface by the sign of the value instead.
     pub fn distance_is_bound(&self) -> bool {
         self.root.is_lipschitz()

@@ -52,6 +52,7 @@ impl Sampler<'_> {
         let (mut spared, mut settled) = (0, 0);
         // Lower bounds of later voxels' |d| (with their sign), or NaN.
         let mut bounds = [f32::NAN; LEAF * LEAF];
+        let margin = self.margin();
         for y in y0..y0 + h {
             let row = (y - row0) * nx;
             for x in x0..x0 + w {
@@ -99,7 +100,7 @@ impl Sampler<'_> {
                 };
                 out.dist[v] = d as f32;
                 if self.lipschitz_skip {
-                    self.bound_later(d, at, [w, h], &mut bounds);
+                    self.bound_later(d, margin, at, [w, h], &mut bounds);
                 }
             }
         }
@@ -111,11 +112,11 @@ impl Sampler<'_> {
     }
 
     /// Bound the leaf's voxels after `at` (of `w × h`) by the value `d`
-    /// at `at`, where that proves them beyond the margin.
-    fn bound_later(&self, d: f64, at: usize, [w, h]: [usize; 2], bounds: &mut [f32]) {
+    /// at `at`, where that proves them beyond `margin`.
+    fn bound_later(&self, d: f64, margin: f64, at: usize, [w, h]: [usize; 2], bounds: &mut [f32]) {
         let a = d.abs();
-        let margin = self.margin();
-        // (A NaN value bounds nothing.)
+        // Nothing is proved when not even the nearest neighbour is reached
+        // (nor by a NaN value).
         if a.is_nan() || a <= margin + self.leaf_gaps[1].min(self.leaf_gaps[LEAF]) {
             return;
         }
