@@ -54,7 +54,9 @@ use super::kuhn::{
 };
 use super::layer_dist::LayerDist;
 use super::mixed::mixed_cubes;
-use super::one_label::{EdgeSlots, OneLabelBand, SlotPool};
+use super::one_label::{EdgeSlots, OneLabelBand};
+pub use super::unevaluated::ExactAt;
+use super::unevaluated::{CornerMemo, Layer, Pool};
 use super::vertex_keys::{BandMesh, KeyMap};
 use super::vertex_keys::{Tri, VRef};
 
@@ -110,8 +112,8 @@ const NOT_FLAT: u32 = u32::MAX;
 
 /// Builds label meshes plane by plane.
 pub struct Contourer {
-    grid: Grid,
-    iface: Interface,
+    pub(super) grid: Grid,
+    pub(super) iface: Interface,
     meshes: Vec<IndexedMesh>,
     /// Per label: key → vertex index, for keys based in the lower and the
     /// upper plane of the current cube layer.
@@ -138,9 +140,12 @@ pub struct Contourer {
     /// since growing them by doubling copies and faults in their memory
     /// again and again.
     band_sizes: Vec<(usize, usize)>,
-    /// Edge slots of the one-label path, lent to contouring tasks and
-    /// given back, so a plane does not allocate and zero fresh ones.
-    slot_pool: SlotPool,
+    /// Edge slots of the one-label path and corner memos, lent to
+    /// contouring tasks and given back.
+    slot_pool: Pool<(EdgeSlots, CornerMemo)>,
+    /// Corners evaluated by [`Self::flat_layer`], which reads cubes of the
+    /// whole layer.
+    layer_memo: CornerMemo,
 }
 
 impl Contourer {
@@ -162,7 +167,8 @@ impl Contourer {
             spare_flat: Vec::new(),
             spare_list: Vec::new(),
             band_sizes: Vec::new(),
-            slot_pool: SlotPool::default(),
+            slot_pool: Pool::default(),
+            layer_memo: CornerMemo::default(),
         }
     }
 
@@ -180,11 +186,12 @@ impl Contourer {
 
     /// Add plane `z` (planes come in order from 0); contours the cube layer
     /// between it and the previous plane, and hands that previous plane
-    /// back for its buffers to be reused.
+    /// back for its buffers to be reused. `exact` evaluates the corners of
+    /// cut cubes that the sampler left unevaluated.
     ///
     /// # Panics
     /// If a plane is skipped or has the wrong size.
-    pub fn push_plane(&mut self, z: usize, plane: Plane) -> Option<Plane> {
+    pub fn push_plane(&mut self, z: usize, plane: Plane, exact: ExactAt) -> Option<Plane> {
         let layer = self.grid.dims[0] * self.grid.dims[1];
         assert!(
             plane.label.len() == layer && plane.dist.len() == layer,
@@ -212,12 +219,19 @@ impl Contourer {
             .into_par_iter()
             .map_init(
                 || self.slot_pool.lend(),
-                |slots, b| {
+                |scratch, b| {
                     let js = b * BAND..((b + 1) * BAND).min(rows);
                     let hint = sizes
                         .get(b)
                         .map_or((0, 0), |&(t, f)| (t + t / 8, f + f / 8));
-                    let (mesh, flats) = self.band(pz, js, &lo, &plane, hint, slots);
+                    let layer = Layer {
+                        lo: &lo,
+                        hi: &plane,
+                        exact,
+                    };
+                    let (slots, memo) = &mut **scratch;
+                    memo.begin(pz, js.start, BAND + 1, self.grid.dims[0]);
+                    let (mesh, flats) = self.band(pz, js, layer, hint, slots, memo);
                     let made = (mesh.tris.len(), flats.at.len());
                     (mesh, flats, made)
                 },
@@ -238,7 +252,12 @@ impl Contourer {
         }
         if self.merge {
             let flats: Vec<BandFlats> = bands.into_iter().map(|r| r.1).collect();
-            self.flat_layer(pz, &lo, &plane, flats);
+            let layer = Layer {
+                lo: &lo,
+                hi: &plane,
+                exact,
+            };
+            self.flat_layer(pz, layer, flats);
         }
         for m in &mut self.maps {
             m.swap(0, 1);
@@ -280,26 +299,6 @@ impl Contourer {
         meshes
     }
 
-    /// The cube with lowest corner `(i, j, z)`, from planes `z` and `z + 1`.
-    fn cube<'a>(&self, [i, j, z]: [usize; 3], lo: &'a Plane, hi: &'a Plane) -> Cube<'a> {
-        let nx = self.grid.dims[0];
-        let s = self.iface.stride();
-        let idx: [usize; 8] = std::array::from_fn(|c| (j + (c >> 1 & 1)) * nx + i + (c & 1));
-        let plane = |c: usize| if c & 4 == 0 { lo } else { hi };
-        let dist = [&*lo.dist, &*hi.dist];
-        Cube {
-            base: [i, j, z],
-            label: std::array::from_fn(|c| plane(c).label[idx[c]]),
-            dist: std::array::from_fn(|c| dist[c >> 2][idx[c]]),
-            // (One segment stores no values: nothing to slice.)
-            value: if s == 0 {
-                [&[]; 8]
-            } else {
-                std::array::from_fn(|c| &plane(c).value[idx[c] * s..(idx[c] + 1) * s])
-            },
-        }
-    }
-
     /// Triangles of the cubes in rows `js` between planes `z` and `z + 1`,
     /// over the band's own vertices, and the band's flat cubes (left for
     /// [`Self::flat_layer`]).
@@ -307,10 +306,10 @@ impl Contourer {
         &self,
         z: usize,
         js: std::ops::Range<usize>,
-        lo: &Plane,
-        hi: &Plane,
+        layer: Layer,
         (tris, flat): (usize, usize),
         slots: &mut EdgeSlots,
+        corners: &mut CornerMemo,
     ) -> (BandMesh, BandFlats) {
         let nx = self.grid.dims[0];
         let mut out = Vec::with_capacity(if self.one_label { 0 } else { tris });
@@ -320,6 +319,7 @@ impl Contourer {
         let mut flats = BandFlats::with_capacity(flat, self.grid.dims);
         let mut scratch = Scratch::default();
         let mut memo = FlatMemo::default();
+        let (lo, hi) = (layer.lo, layer.hi);
         for j in js {
             let rows = [
                 &lo.label[j * nx..(j + 1) * nx],
@@ -328,7 +328,7 @@ impl Contourer {
                 &hi.label[(j + 1) * nx..(j + 2) * nx],
             ];
             for i in mixed_cubes(rows) {
-                let cube = self.cube([i, j, z], lo, hi);
+                let cube = self.cube([i, j, z], layer, corners);
                 if self.merge
                     && let Some(key) = memo.key(self.grid.voxel, self.iface, &cube)
                 {
@@ -354,8 +354,10 @@ impl Contourer {
     /// the same key (left, front, below) and give each region the cut
     /// segments of its faces shared with anything else. Faces towards the
     /// next layer are settled when that layer comes.
-    fn flat_layer(&mut self, pz: usize, lo: &Plane, hi: &Plane, flats: Vec<BandFlats>) {
+    fn flat_layer(&mut self, pz: usize, layer: Layer, flats: Vec<BandFlats>) {
         let [nx, ny, _] = self.grid.dims;
+        let mut memo = std::mem::take(&mut self.layer_memo);
+        memo.begin(pz, 0, ny, nx);
         let (cw, ch) = (nx - 1, ny - 1);
         let mut cur = std::mem::take(&mut self.spare_flat);
         if cur.len() != cw * ch {
@@ -401,7 +403,7 @@ impl Contourer {
                     }
                     continue;
                 }
-                let cube = cube.get_or_insert_with(|| self.cube([i, j, pz], lo, hi));
+                let cube = cube.get_or_insert_with(|| self.cube([i, j, pz], layer, &mut memo));
                 self.outline(pz, id, cube, axis, side, false);
             }
         }
@@ -414,7 +416,7 @@ impl Contourer {
             {
                 continue;
             }
-            let cube = self.cube([c % cw, c / cw, pz], lo, hi);
+            let cube = self.cube([c % cw, c / cw, pz], layer, &mut memo);
             self.outline(pz, id, &cube, 2, 0, true);
         }
         let mut old = std::mem::replace(&mut self.prev_flat, cur);
@@ -425,6 +427,7 @@ impl Contourer {
         self.spare_list = below;
         self.spare_list.clear();
         self.prev_list = list;
+        self.layer_memo = memo;
     }
 
     /// Add the cut of `cube`'s face (`axis`, `side`) to region `id`'s
@@ -472,16 +475,6 @@ impl Contourer {
                 self.regions.add_edge(id, [ra.key, rb.key], xi, yi);
             }
         }
-    }
-
-    /// Grid index (i, j, k) of corner `m` of the cube.
-    pub(super) fn corner(cube: &Cube, m: u8) -> [usize; 3] {
-        let [i, j, k] = cube.base;
-        [
-            i + (m & 1) as usize,
-            j + (m >> 1 & 1) as usize,
-            k + (m >> 2 & 1) as usize,
-        ]
     }
 
     pub(super) fn global(&self, c: [usize; 3]) -> u64 {

@@ -24,6 +24,7 @@ pub(super) fn contour_field(mut c: Contourer, grid: &Grid, values: &[f32]) -> In
     for z in 0..nz {
         let dist = values[z * nx * ny..(z + 1) * nx * ny].to_vec();
         let label = border_void(&dist, [nx, ny, nz], z, |d| u16::from(d <= 0.0));
+        // (Every sample is given: none is left to evaluate.)
         c.push_plane(
             z,
             Plane {
@@ -31,6 +32,7 @@ pub(super) fn contour_field(mut c: Contourer, grid: &Grid, values: &[f32]) -> In
                 dist: dist.into(),
                 value: Vec::new(),
             },
+            &|[i, j, k]| values[(k * ny + j) * nx + i],
         );
     }
     c.finish(&|[i, j, k], _| values[(k * ny + j) * nx + i])

@@ -46,6 +46,7 @@ pub mod segment;
 pub mod stl;
 mod text_blocks;
 pub mod threemf;
+mod unevaluated;
 mod vertex_keys;
 
 use std::sync::atomic::AtomicBool;
@@ -425,12 +426,13 @@ fn sampled_triangles(model: &Model, grid: Grid, classifier: &Classifier) -> u64 
         {
             return 0;
         }
+        let exact = |[i, j, k]: [usize; 3]| model.distance(grid.center(i, j, k)) as f32;
         let mut contourer = Contourer::new(grid, classifier.segments(), classifier.interface());
         // Both planes share the slab's distances, as in the export.
         let dist = std::sync::Arc::new(std::mem::take(&mut slab.dist));
         for (l, z) in [(0, z), (1, z + 1)] {
             let plane = classifier.plane_into(&slab, &dist, l, dims, z, Plane::default());
-            contourer.push_plane(l, plane.0);
+            contourer.push_plane(l, plane.0, &|[i, j, k]| exact([i, j, z + k]));
         }
         made += contourer.triangles();
     }
@@ -455,6 +457,8 @@ fn build(
         Flat::Off => contourer.with_flat_merge(false),
         Flat::FallbackOnly => contourer.with_fallback_only(),
     };
+    // What the sampler would have written at a voxel it left unevaluated.
+    let exact = |[i, j, k]: [usize; 3]| model.distance(pl.grid.center(i, j, k)) as f32;
     let mut tally = Tally::new(pl.classifier.segments());
     let mut slab = Slab::default();
     let mut pool = DistPool::default();
@@ -508,7 +512,7 @@ fn build(
                     // once (it is kept for its other buffers), so the
                     // buffer can come back to the sampler (kept until
                     // reuse, a fourth buffer was needed).
-                    retired.extend(contourer.push_plane(z, plane).map(|mut p| {
+                    retired.extend(contourer.push_plane(z, plane, &exact).map(|mut p| {
                         p.dist = LayerDist::default();
                         p
                     }));

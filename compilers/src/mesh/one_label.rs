@@ -3,8 +3,6 @@
 //! each grid edge's point is placed once and found again by its edge's
 //! slot, not by hashing its key: four cubes share each grid edge.
 
-use std::sync::Mutex;
-
 use glam::DVec3;
 
 use super::contour::{BAND, Contourer, KEY_TYPES, LOOP_KEY, Scratch, corner_mask};
@@ -103,53 +101,6 @@ pub(super) struct EdgeSlots {
     /// `band << 32 | vertex`.
     slot: Vec<u64>,
     band: u64,
-}
-
-/// Edge slots not in use: a contouring task borrows one ([`SlotPool::lend`])
-/// and gives it back when done.
-#[derive(Default)]
-pub(super) struct SlotPool(Mutex<Vec<EdgeSlots>>);
-
-impl SlotPool {
-    /// Slots for one task (fresh when none is free), back in the pool when
-    /// the loan is dropped.
-    pub fn lend(&self) -> SlotLoan<'_> {
-        let slots = self
-            .0
-            .lock()
-            .ok()
-            .and_then(|mut free| free.pop())
-            .unwrap_or_default();
-        SlotLoan { slots, pool: self }
-    }
-}
-
-/// Slots lent by a [`SlotPool`].
-pub(super) struct SlotLoan<'a> {
-    slots: EdgeSlots,
-    pool: &'a SlotPool,
-}
-
-impl std::ops::Deref for SlotLoan<'_> {
-    type Target = EdgeSlots;
-    fn deref(&self) -> &EdgeSlots {
-        &self.slots
-    }
-}
-
-impl std::ops::DerefMut for SlotLoan<'_> {
-    fn deref_mut(&mut self) -> &mut EdgeSlots {
-        &mut self.slots
-    }
-}
-
-impl Drop for SlotLoan<'_> {
-    fn drop(&mut self) {
-        // (A poisoned pool only means the next task allocates afresh.)
-        if let Ok(mut free) = self.pool.0.lock() {
-            free.push(std::mem::take(&mut self.slots));
-        }
-    }
 }
 
 /// One band's mesh as the one-label path builds it: an edge point is found

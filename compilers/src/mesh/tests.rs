@@ -99,7 +99,16 @@ fn uniform_tiles_give_the_same_meshes() {
     )
     .expect("seat");
     let cyan = seat.table().id("VeroCyan").expect("VeroCyan");
+    // One label through a lattice: the contourer evaluates the corners the
+    // sampler left unevaluated (see `Consumer::MeshContour`).
+    let bcc = model_of_file(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../assets/examples/bcc_sphere.rhai"),
+    )
+    .expect("bcc sphere");
+    let gray = bcc.table().id("gray").expect("gray");
     let cases = [
+        (&bcc, SegmentBy::Material(gray), 1, 0.12),
         (&seat, SegmentBy::Material(cyan), 4, 2.0),
         (&bar, SegmentBy::Material(red), 4, 0.1),
         (&bar, SegmentBy::Dominant, 1, 0.1),

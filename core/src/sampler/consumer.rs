@@ -15,7 +15,11 @@ pub type UniformTest<'a> = &'a (dyn Fn(&[Interval]) -> bool + Sync);
 ///   (meshers, the viewport's shading) get the exact distance of every
 ///   voxel within one voxel diagonal of the surface; consumers that read
 ///   signs only let a tile settle as soon as its bound excludes zero,
-///   which leaves fewer voxels to evaluate and changes no sign.
+///   which leaves fewer voxels to evaluate and changes no sign. A mesh
+///   export's contouring does too, and gets `±∞` (the sign kept) in the
+///   voxels it left within one voxel diagonal: the contourer evaluates
+///   those where a cube it cuts has one as a corner (see
+///   [`Consumer::MeshContour`]).
 /// - **fractions**: filled per voxel (`k` values, zero outside), or not at
 ///   all (`Slab::k` is 0).
 #[derive(Clone, Copy)]
@@ -32,7 +36,16 @@ pub enum Consumer<'a> {
     /// fractions.
     SurfaceContour,
     /// A mesh export's contouring, whose `test` says where a segment label
-    /// is constant. A solid tile whose fraction bounds, over the tile grown
+    /// is constant. Tiles settle as soon as their bound excludes zero, as
+    /// for signs-only consumers; a value not evaluated that may lie within
+    /// one voxel diagonal of the surface is written as `±∞` with its sign
+    /// (an *unevaluated* voxel). The contourer reads distances only at the
+    /// corners of cubes whose signs differ, and every such corner lies
+    /// within one voxel diagonal of the surface: it evaluates the corners
+    /// that hold `±∞` there, and gets what sampling them would have given.
+    /// Most voxels that a margin of one diagonal evaluates are corners of
+    /// no such cube. Inside, where the design's fractions vary, tiles keep
+    /// the margin of one diagonal (see `Sampler::settle`). A solid tile whose fraction bounds, over the tile grown
     /// by one voxel on every side, pass `test` gets its centre's fractions
     /// in every voxel (one evaluation instead of one per voxel); growing
     /// the box makes every neighbour of such a voxel agree too, so the mesh
@@ -90,6 +103,9 @@ pub(super) struct Needs<'a> {
     /// margin. Not the viewport bake (the reference), the keep-out (which
     /// reads how deep inside voxels lie) or GCVF's outline.
     pub lipschitz_skip: bool,
+    /// Values written without evaluation within one voxel diagonal of zero
+    /// are `±∞` (see [`Consumer::MeshContour`]).
+    pub unevaluated_near: bool,
 }
 
 impl<'a> Consumer<'a> {
@@ -103,6 +119,7 @@ impl<'a> Consumer<'a> {
             blocks: false,
             lazy: false,
             lipschitz_skip: false,
+            unevaluated_near: false,
         };
         let signs = Needs {
             signs_only: true,
@@ -119,7 +136,9 @@ impl<'a> Consumer<'a> {
                 uniform: Some(test),
                 solid_rects: true,
                 blocks: true,
+                signs_only: true,
                 lipschitz_skip: true,
+                unevaluated_near: true,
                 ..plain
             },
             Consumer::PngStackSingle => Needs {

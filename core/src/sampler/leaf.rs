@@ -4,7 +4,8 @@
 //! Where the model's value is 1-Lipschitz (`Model::distance_is_bound`) and
 //! the consumer allows it ([`super::consumer::Needs`]), each evaluated
 //! voxel `v` settles the later voxels `u` of the leaf that it proves beyond
-//! the margin: `|d(u)| ≥ |d(v)| − |u − v| > margin`, so `d(u)` has `d(v)`'s
+//! the margin (for a mesh export, one voxel diagonal; see `leaf`):
+//! `|d(u)| ≥ |d(v)| − |u − v| > margin`, so `d(u)` has `d(v)`'s
 //! sign and that lower bound is stored, as a tile beyond the margin stores
 //! its interval's end (see the module docs of [`super`]). Their fractions
 //! are written as an evaluation would write them (zero outside; inside,
@@ -52,7 +53,11 @@ impl Sampler<'_> {
         let (mut spared, mut settled) = (0, 0);
         // Lower bounds of later voxels' |d| (with their sign), or NaN.
         let mut bounds = [f32::NAN; LEAF * LEAF];
-        let margin = self.margin();
+        // A mesh export's leaf settles only voxels it proves beyond one voxel
+        // diagonal, though its tiles settle beyond zero: most voxels of an
+        // open leaf nearer than that are corners of cut cubes, which the
+        // contourer would evaluate one by one, without the leaf's order.
+        let margin = self.unevaluated_near.unwrap_or_else(|| self.margin());
         for y in y0..y0 + h {
             let row = (y - row0) * nx;
             for x in x0..x0 + w {
@@ -129,7 +134,7 @@ impl Sampler<'_> {
                 }
                 let m = a - self.leaf_gaps[ix.abs_diff(jx) + LEAF * (jy - iy)];
                 if m > margin {
-                    bounds[j] = (d.signum() * m) as f32;
+                    bounds[j] = self.written(d.signum() * m, false);
                 }
             }
         }

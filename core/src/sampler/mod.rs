@@ -22,7 +22,10 @@
 //! sign is exact and the magnitude is a valid bound. For consumers that
 //! read distances, a skipped voxel is farther than one voxel diagonal from
 //! the surface, so no surface crossing lies on a grid edge that touches it,
-//! and meshers never interpolate it.
+//! and meshers never interpolate it. A mesh export's contouring settles
+//! tiles as signs-only consumers do and gets `±∞` where a skipped voxel may
+//! lie within that diagonal: it evaluates those it reads (see
+//! [`Consumer::MeshContour`]).
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
@@ -149,6 +152,9 @@ pub struct Sampler<'a> {
     fixed: Option<[f32; MAX_MATERIALS]>,
     /// Evaluated voxels of a leaf bound the leaf's later ones (see `leaf`).
     lipschitz_skip: bool,
+    /// For [`Consumer::MeshContour`]: one voxel diagonal, within which a
+    /// value not evaluated is written as `±∞` (see [`Self::written`]).
+    unevaluated_near: Option<f64>,
     leaf_gaps: leaf::LeafGaps,
     /// Open tiles asked whether their fractions are constant, and how many
     /// were (see `try_constant`).
@@ -202,6 +208,7 @@ impl<'a> Sampler<'a> {
             signs_only: needs.signs_only,
             lazy_open: lazy && model.averages_fractions(),
             lipschitz_skip: needs.lipschitz_skip && model.distance_is_bound(),
+            unevaluated_near: needs.unevaluated_near.then(|| grid.voxel.length()),
             leaf_gaps: leaf::leaf_gaps(grid.voxel.x, grid.voxel.y),
             stats: SampleStats::default(),
         }
@@ -402,10 +409,19 @@ impl<'a> Sampler<'a> {
     fn settle(&self, b: &Aabb, k: usize) -> Settled {
         let margin = self.margin();
         let iv = self.model.interval(b);
+        let one_number = iv.lo == iv.hi && iv.lo.is_finite() && b.min != b.max;
         if iv.lo > margin {
-            return Settled::Outside(iv.lo as f32);
+            return Settled::Outside(self.written(iv.lo, one_number));
         }
-        if iv.hi.is_nan() || iv.hi >= -margin {
+        // Inside, a mesh export of varying fractions keeps the margin of
+        // one voxel diagonal: inside voxels settled nearer would take their
+        // tile's fractions where the labels allow (`uniformity`), and the
+        // segments' mean fractions in the summary would move.
+        let inside_margin = match self.unevaluated_near {
+            Some(diagonal) if k > 0 && self.fixed.is_none() => diagonal,
+            _ => margin,
+        };
+        if iv.hi.is_nan() || iv.hi >= -inside_margin {
             // A bound that is one number over a box of voxel centres is
             // every voxel's distance: the exact intervals (a box's, a
             // cylinder's, and their translates and unions) evaluate the
@@ -418,7 +434,7 @@ impl<'a> Sampler<'a> {
             // parallel to it (the cube's top and bottom) is such a tile
             // away from the other faces: without this, a cube's layers
             // within a voxel diagonal of them are evaluated voxel by voxel.
-            if iv.lo == iv.hi && iv.lo.is_finite() && b.min != b.max {
+            if one_number {
                 return Settled::Exact(iv.lo);
             }
             return Settled::Open;
@@ -435,9 +451,20 @@ impl<'a> Sampler<'a> {
                     Uniformity::Unknown => false,
                 });
         Settled::Solid {
-            value: iv.hi as f32,
+            value: self.written(iv.hi, one_number),
             constant,
             mixed,
+        }
+    }
+
+    /// What a voxel whose distance was not evaluated stores, given a bound
+    /// `v` (exact when `exact`): `v`, except for [`Consumer::MeshContour`]
+    /// where a bound within one voxel diagonal of zero is written `±∞`
+    /// with its sign, for the contourer to evaluate where it reads it.
+    fn written(&self, v: f64, exact: bool) -> f32 {
+        match self.unevaluated_near {
+            Some(diagonal) if !exact && v.abs() <= diagonal => f32::INFINITY.copysign(v as f32),
+            _ => v as f32,
         }
     }
 

@@ -150,6 +150,7 @@ fn two_segments(iface: Interface) -> [Vec<IndexedMesh>; 3] {
                     dist: d.into(),
                     value,
                 },
+                &|[i, j, k]| dist[(k * ny + j) * nx + i],
             );
         }
         // Samples again, as the planes had them.
