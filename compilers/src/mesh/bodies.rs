@@ -6,7 +6,7 @@
 use rayon::prelude::*;
 
 use super::SegmentMesh;
-use crate::union_find::{find, join};
+use crate::union_find::join;
 
 /// Bodies of a part.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -56,18 +56,30 @@ pub fn bodies(segs: &[SegmentMesh]) -> Bodies {
             }
         }
     }
-    let mut volume = vec![0.0f64; n as usize];
-    for (s, &b) in segs.iter().zip(&base) {
+    // Every id's root in one pass: a parent is never above its child (the
+    // smaller root wins, and halving only shortens), so the parent's root
+    // is known when the child is reached.
+    for i in 0..parent.len() {
+        parent[i] = parent[parent[i] as usize];
+    }
+    measured(segs, &base, &parent)
+}
+
+/// Each body's volume (`root`: every vertex's body, the least index in
+/// it, segments numbered on from `base`), summed triangle by triangle.
+fn measured(segs: &[SegmentMesh], base: &[u32], root: &[u32]) -> Bodies {
+    let mut volume = vec![0.0f64; root.len()];
+    for (s, &b) in segs.iter().zip(base) {
         for t in &s.mesh.triangles {
             let [p, q, r] = t.map(|i| s.mesh.vertices[i as usize].map(f64::from));
             let det = p[0] * (q[1] * r[2] - q[2] * r[1]) - p[1] * (q[0] * r[2] - q[2] * r[0])
                 + p[2] * (q[0] * r[1] - q[1] * r[0]);
-            volume[find(&mut parent, b + t[0]) as usize] += det / 6.0;
+            volume[root[(b + t[0]) as usize] as usize] += det / 6.0;
         }
     }
-    let mut volumes: Vec<f64> = (0..n)
-        .filter(|&i| find(&mut parent, i) == i)
-        .map(|i| volume[i as usize])
+    let mut volumes: Vec<f64> = (0..root.len())
+        .filter(|&i| root[i] as usize == i)
+        .map(|i| volume[i])
         .collect();
     volumes.sort_unstable_by(|a, b| b.total_cmp(a));
     Bodies { volumes }
