@@ -83,20 +83,6 @@ pub(super) fn flat_key(voxel: DVec3, iface: Interface, cube: &Cube) -> Option<Fl
         }
         g
     };
-    // Which side holds `g = 0` exactly, as the labels put it: inside for
-    // distances (d ≤ 0), the upper range for ranges (⌊f·n⌋), the lower slot
-    // for dominant ties.
-    let zero_is_x = !matches!((y, iface), (1.., Interface::Ranges { .. }));
-    for (l, v) in cube.label.iter().zip(&g) {
-        let ok = if *l == x {
-            *v < 0.0 || (*v == 0.0 && zero_is_x)
-        } else {
-            *v > 0.0 || (*v == 0.0 && !zero_is_x)
-        };
-        if !ok || !v.is_finite() {
-            return None;
-        }
-    }
     // Per axis, the four corners with that axis' bit clear (ascending, so
     // the sums are those of a loop over 0..8).
     const LOW: [[usize; 4]; 3] = [[0, 2, 4, 6], [0, 1, 4, 5], [0, 1, 2, 3]];
@@ -117,9 +103,25 @@ pub(super) fn flat_key(voxel: DVec3, iface: Interface, cube: &Cube) -> Option<Fl
         .iter()
         .zip(&diffs)
         .all(|(m, d)| d.iter().all(|v| (v - m).abs() <= tol));
-    // (`scale` is finite: every g is.)
+    // (`scale` is finite when the test holds: a non-finite sample makes an
+    // axis' mean infinite or NaN, and its own difference then fails.)
     if !affine || scale <= 0.0 {
         return None;
+    }
+    // Which side holds `g = 0` exactly, as the labels put it: inside for
+    // distances (d ≤ 0), the upper range for ranges (⌊f·n⌋), the lower slot
+    // for dominant ties. Tested after the plane: most cubes of a curved
+    // surface fail the test above, which has no branch per corner.
+    let zero_is_x = !matches!((y, iface), (1.., Interface::Ranges { .. }));
+    for (l, v) in cube.label.iter().zip(&g) {
+        let ok = if *l == x {
+            *v < 0.0 || (*v == 0.0 && zero_is_x)
+        } else {
+            *v > 0.0 || (*v == 0.0 && !zero_is_x)
+        };
+        if !ok || !v.is_finite() {
+            return None;
+        }
     }
     let n = DVec3::new(mean[0] / voxel.x, mean[1] / voxel.y, mean[2] / voxel.z).normalize();
     let q = n * NORMAL_BINS;
