@@ -44,6 +44,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use volcad_core::sampler::Grid;
 
+use super::band_scratch::{Pool, Stamped};
 use super::cube_loops;
 use super::flat::{FlatKey, FlatMemo, KeptCubes, Regions, SampleAt};
 use super::indexed::IndexedMesh;
@@ -54,9 +55,9 @@ use super::kuhn::{
 };
 use super::layer_dist::LayerDist;
 use super::mixed::mixed_cubes;
-use super::one_label::{EdgeSlots, OneLabelBand};
+use super::one_label::OneLabelBand;
 pub use super::unevaluated::ExactAt;
-use super::unevaluated::{CornerMemo, Layer, Pool};
+use super::unevaluated::{CornerMemo, Layer};
 use super::vertex_keys::{BandMesh, KeyMap};
 use super::vertex_keys::{Tri, VRef};
 
@@ -142,7 +143,7 @@ pub struct Contourer {
     band_sizes: Vec<(usize, usize)>,
     /// Edge slots of the one-label path and corner memos, lent to
     /// contouring tasks and given back.
-    slot_pool: Pool<(EdgeSlots, CornerMemo)>,
+    scratch_pool: Pool<(Stamped, CornerMemo)>,
     /// Corners evaluated by [`Self::flat_layer`], which reads cubes of the
     /// whole layer.
     layer_memo: CornerMemo,
@@ -167,7 +168,7 @@ impl Contourer {
             spare_flat: Vec::new(),
             spare_list: Vec::new(),
             band_sizes: Vec::new(),
-            slot_pool: Pool::default(),
+            scratch_pool: Pool::default(),
             layer_memo: CornerMemo::default(),
         }
     }
@@ -215,20 +216,20 @@ impl Contourer {
         // triangle corner: the sequential part was a third of contouring).
         let rows = ny.saturating_sub(1);
         let sizes = &self.band_sizes;
+        let layer = Layer {
+            lo: &lo,
+            hi: &plane,
+            exact,
+        };
         let bands: Vec<(BandMesh, BandFlats, (usize, usize))> = (0..rows.div_ceil(BAND))
             .into_par_iter()
             .map_init(
-                || self.slot_pool.lend(),
+                || self.scratch_pool.lend(),
                 |scratch, b| {
                     let js = b * BAND..((b + 1) * BAND).min(rows);
                     let hint = sizes
                         .get(b)
                         .map_or((0, 0), |&(t, f)| (t + t / 8, f + f / 8));
-                    let layer = Layer {
-                        lo: &lo,
-                        hi: &plane,
-                        exact,
-                    };
                     let (slots, memo) = &mut **scratch;
                     memo.begin(pz, js.start, BAND + 1, self.grid.dims[0]);
                     let (mesh, flats) = self.band(pz, js, layer, hint, slots, memo);
@@ -252,11 +253,6 @@ impl Contourer {
         }
         if self.merge {
             let flats: Vec<BandFlats> = bands.into_iter().map(|r| r.1).collect();
-            let layer = Layer {
-                lo: &lo,
-                hi: &plane,
-                exact,
-            };
             self.flat_layer(pz, layer, flats);
         }
         for m in &mut self.maps {
@@ -308,7 +304,7 @@ impl Contourer {
         js: std::ops::Range<usize>,
         layer: Layer,
         (tris, flat): (usize, usize),
-        slots: &mut EdgeSlots,
+        slots: &mut Stamped,
         corners: &mut CornerMemo,
     ) -> (BandMesh, BandFlats) {
         let nx = self.grid.dims[0];

@@ -28,6 +28,7 @@
 //! share their interfaces exactly instead of being contoured one by one
 //! (which leaves gaps and overlaps); fractions are normalised by their sum.
 
+mod band_scratch;
 pub mod bodies;
 pub mod contour;
 mod cube_loops;
@@ -426,13 +427,12 @@ fn sampled_triangles(model: &Model, grid: Grid, classifier: &Classifier) -> u64 
         {
             return 0;
         }
-        let exact = |[i, j, k]: [usize; 3]| model.distance(grid.center(i, j, k)) as f32;
         let mut contourer = Contourer::new(grid, classifier.segments(), classifier.interface());
         // Both planes share the slab's distances, as in the export.
         let dist = std::sync::Arc::new(std::mem::take(&mut slab.dist));
         for (l, z) in [(0, z), (1, z + 1)] {
             let plane = classifier.plane_into(&slab, &dist, l, dims, z, Plane::default());
-            contourer.push_plane(l, plane.0, &|[i, j, k]| exact([i, j, z + k]));
+            contourer.push_plane(l, plane.0, &|[i, j, k]| sampler.evaluate([i, j, z + k]));
         }
         made += contourer.triangles();
     }
@@ -457,8 +457,7 @@ fn build(
         Flat::Off => contourer.with_flat_merge(false),
         Flat::FallbackOnly => contourer.with_fallback_only(),
     };
-    // What the sampler would have written at a voxel it left unevaluated.
-    let exact = |[i, j, k]: [usize; 3]| model.distance(pl.grid.center(i, j, k)) as f32;
+    let exact = |at: [usize; 3]| sampler.evaluate(at);
     let mut tally = Tally::new(pl.classifier.segments());
     let mut slab = Slab::default();
     let mut pool = DistPool::default();

@@ -5,6 +5,7 @@
 
 use glam::DVec3;
 
+use super::band_scratch::Stamped;
 use super::contour::{BAND, Contourer, KEY_TYPES, LOOP_KEY, Scratch, corner_mask};
 use super::cube_loops;
 use super::interface::Cube;
@@ -93,16 +94,6 @@ fn fan(k: usize, apex: usize) -> impl Iterator<Item = [usize; 3]> {
     (0..steps).map(move |d| [apex, (first + d) % k, (first + d + 1) % k])
 }
 
-/// Vertex index per grid edge of a band (two planes of `BAND + 1` rows,
-/// three directions), stamped with the band it was set in: reused band
-/// after band by one thread, with nothing to clear between bands.
-#[derive(Default)]
-pub(super) struct EdgeSlots {
-    /// `band << 32 | vertex`.
-    slot: Vec<u64>,
-    band: u64,
-}
-
 /// One band's mesh as the one-label path builds it: an edge point is found
 /// by its edge's slot, not by hashing its key.
 pub(super) struct OneLabelBand<'a> {
@@ -110,19 +101,14 @@ pub(super) struct OneLabelBand<'a> {
     /// First row of cubes.
     j0: usize,
     nx: usize,
-    slots: &'a mut EdgeSlots,
+    /// Vertex index per grid edge of the band: two planes of `BAND + 1`
+    /// rows, three directions.
+    slots: &'a mut Stamped,
 }
 
 impl<'a> OneLabelBand<'a> {
-    pub fn new(j0: usize, nx: usize, tris: usize, slots: &'a mut EdgeSlots) -> Self {
-        let len = 2 * (BAND + 1) * nx * 3;
-        if slots.slot.len() != len {
-            *slots = EdgeSlots {
-                slot: vec![0; len],
-                band: 0,
-            };
-        }
-        slots.band += 1;
+    pub fn new(j0: usize, nx: usize, tris: usize, slots: &'a mut Stamped) -> Self {
+        slots.begin(2 * (BAND + 1) * nx * 3);
         OneLabelBand {
             mesh: BandMesh {
                 verts: Vec::with_capacity(tris / 2),
@@ -149,14 +135,12 @@ impl<'a> OneLabelBand<'a> {
         );
         let dir = (b & !a).trailing_zeros() as usize;
         let s = ((ck * (BAND + 1) + cj) * self.nx + ci) * 3 + dir;
-        let band = self.slots.band;
-        let set = self.slots.slot[s];
-        if set >> 32 == band {
-            return set as u32;
+        if let Some(v) = self.slots.get(s) {
+            return v;
         }
         let r = placed.unwrap_or_else(|| c.resolve(cube, 0, &[0; 4], p));
         let v = self.push(r);
-        self.slots.slot[s] = band << 32 | u64::from(v);
+        self.slots.set(s, v);
         v
     }
 
@@ -188,7 +172,7 @@ mod tests {
         };
         let c = Contourer::new(grid, 1, Interface::Midpoint);
         let mut rng = XorShift::new(11);
-        let mut slots = EdgeSlots::default();
+        let mut slots = Stamped::default();
         let mut centres = 0;
         for j0 in [0, BAND] {
             // Corner samples of this band: labels and distances whose

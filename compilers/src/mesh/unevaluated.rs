@@ -8,8 +8,7 @@
 //! layer share a corner). A cube's samples are read here
 //! ([`Contourer::cube`]).
 
-use std::sync::Mutex;
-
+use super::band_scratch::Stamped;
 use super::contour::{Contourer, Plane};
 use super::interface::Cube;
 
@@ -28,13 +27,11 @@ pub(super) struct Layer<'p> {
 
 /// Corner distances evaluated in one band of rows of a cube layer (or in a
 /// whole layer): one slot per sample of the band's rows in the layer's two
-/// planes, stamped with the band it was set in, so nothing is cleared
-/// between bands.
+/// planes.
 #[derive(Default)]
 pub(super) struct CornerMemo {
-    /// `band << 32 | distance bits`.
-    slot: Vec<u64>,
-    band: u64,
+    /// Distance bits by sample.
+    slots: Stamped,
     /// The band's lower plane, first row and rows, and the row length.
     z: usize,
     j0: usize,
@@ -46,12 +43,7 @@ impl CornerMemo {
     /// Start a band: rows `j0..j0 + rows` of planes `z` and `z + 1`
     /// (`nx` samples a row).
     pub fn begin(&mut self, z: usize, j0: usize, rows: usize, nx: usize) {
-        let len = 2 * rows * nx;
-        if self.slot.len() != len {
-            self.slot = vec![0; len];
-            self.band = 0;
-        }
-        self.band += 1;
+        self.slots.begin(2 * rows * nx);
         (self.z, self.j0, self.rows, self.nx) = (z, j0, rows, nx);
     }
 
@@ -68,12 +60,11 @@ impl CornerMemo {
             return exact(at);
         }
         let s = (dk * self.rows + dj) * self.nx + i;
-        let set = self.slot[s];
-        if set >> 32 == self.band {
-            return f32::from_bits(set as u32);
+        if let Some(bits) = self.slots.get(s) {
+            return f32::from_bits(bits);
         }
         let v = exact(at);
-        self.slot[s] = self.band << 32 | u64::from(v.to_bits());
+        self.slots.set(s, v.to_bits());
         v
     }
 }
@@ -126,58 +117,5 @@ impl Contourer {
             j + (m >> 1 & 1) as usize,
             k + (m >> 2 & 1) as usize,
         ]
-    }
-}
-
-/// Band scratch not in use (edge slots, corner memos): a contouring task
-/// borrows one ([`Pool::lend`]) and gives it back when done, so a plane
-/// does not allocate and zero fresh ones.
-pub(super) struct Pool<T: Default>(Mutex<Vec<T>>);
-
-impl<T: Default> Default for Pool<T> {
-    fn default() -> Self {
-        Self(Mutex::new(Vec::new()))
-    }
-}
-
-impl<T: Default> Pool<T> {
-    /// One for a task (fresh when none is free), back in the pool when the
-    /// loan is dropped.
-    pub fn lend(&self) -> Loan<'_, T> {
-        let item = self
-            .0
-            .lock()
-            .ok()
-            .and_then(|mut free| free.pop())
-            .unwrap_or_default();
-        Loan { item, pool: self }
-    }
-}
-
-/// What a [`Pool`] lent.
-pub(super) struct Loan<'a, T: Default> {
-    item: T,
-    pool: &'a Pool<T>,
-}
-
-impl<T: Default> std::ops::Deref for Loan<'_, T> {
-    type Target = T;
-    fn deref(&self) -> &T {
-        &self.item
-    }
-}
-
-impl<T: Default> std::ops::DerefMut for Loan<'_, T> {
-    fn deref_mut(&mut self) -> &mut T {
-        &mut self.item
-    }
-}
-
-impl<T: Default> Drop for Loan<'_, T> {
-    fn drop(&mut self) {
-        // (A poisoned pool only means the next task allocates afresh.)
-        if let Ok(mut free) = self.pool.0.lock() {
-            free.push(std::mem::take(&mut self.item));
-        }
     }
 }

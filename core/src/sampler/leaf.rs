@@ -133,8 +133,9 @@ impl Sampler<'_> {
                     continue;
                 }
                 let m = a - self.leaf_gaps[ix.abs_diff(jx) + LEAF * (jy - iy)];
+                // (Beyond one voxel diagonal for a mesh export: never `±∞`.)
                 if m > margin {
-                    bounds[j] = self.written(d.signum() * m, false);
+                    bounds[j] = (d.signum() * m) as f32;
                 }
             }
         }

@@ -219,6 +219,13 @@ impl<'a> Sampler<'a> {
         &self.grid
     }
 
+    /// The distance at voxel `[x, y, z]`, as an evaluating tile stores it:
+    /// what a consumer evaluates where this sampler left a voxel
+    /// unevaluated (see [`Consumer::MeshContour`]).
+    pub fn evaluate(&self, [x, y, z]: [usize; 3]) -> f32 {
+        self.model.distance(self.grid.center(x, y, z)) as f32
+    }
+
     /// Fill `slab` with layers `z0..z1` (in parallel on the current rayon
     /// pool). Checks `cancel` between rows of tiles.
     pub fn sample_layers(

@@ -278,7 +278,7 @@ fn read(path: &Path, mesh: &TriangleMesh) -> Option<(Option<CoarseGrid>, Option<
     grids.filter(|_| intact)
 }
 
-/// Parses and checks a file's body (checksum already verified).
+/// Parses and checks a file's body (its checksum is checked beside this).
 fn decode(body: &[u8], mesh: &TriangleMesh) -> Option<(Option<CoarseGrid>, Option<CandidateGrid>)> {
     let mut r = Reader { b: body, at: 0 };
     if r.take(8)? != MAGIC || r.u32()? != FORMAT || r.u64()? != key(mesh) {

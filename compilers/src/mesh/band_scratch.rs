@@ -1,0 +1,92 @@
+//! Scratch a contouring task reuses band after band: slot arrays stamped
+//! with the band that set them (so nothing is cleared between bands), and
+//! the pool tasks borrow them from (so a plane does not allocate and zero
+//! fresh ones).
+
+use std::sync::Mutex;
+
+/// One `u32` per slot, stamped with the band it was set in: a slot set in
+/// an earlier band reads as unset.
+#[derive(Default)]
+pub(super) struct Stamped {
+    /// `band << 32 | value`.
+    slot: Vec<u64>,
+    band: u64,
+}
+
+impl Stamped {
+    /// Start a band of `len` slots, none set.
+    pub fn begin(&mut self, len: usize) {
+        if self.slot.len() != len {
+            self.slot = vec![0; len];
+            self.band = 0;
+        }
+        self.band += 1;
+    }
+
+    /// Slot `s`'s value, when set in this band.
+    #[inline]
+    pub fn get(&self, s: usize) -> Option<u32> {
+        let set = self.slot[s];
+        (set >> 32 == self.band).then_some(set as u32)
+    }
+
+    /// Set slot `s` for this band.
+    #[inline]
+    pub fn set(&mut self, s: usize, value: u32) {
+        self.slot[s] = self.band << 32 | u64::from(value);
+    }
+}
+
+/// Band scratch not in use: a contouring task
+/// borrows one ([`Pool::lend`]) and gives it back when done, so a plane
+/// does not allocate and zero fresh ones.
+pub(super) struct Pool<T: Default>(Mutex<Vec<T>>);
+
+impl<T: Default> Default for Pool<T> {
+    fn default() -> Self {
+        Self(Mutex::new(Vec::new()))
+    }
+}
+
+impl<T: Default> Pool<T> {
+    /// One for a task (fresh when none is free), back in the pool when the
+    /// loan is dropped.
+    pub fn lend(&self) -> Loan<'_, T> {
+        let item = self
+            .0
+            .lock()
+            .ok()
+            .and_then(|mut free| free.pop())
+            .unwrap_or_default();
+        Loan { item, pool: self }
+    }
+}
+
+/// What a [`Pool`] lent.
+pub(super) struct Loan<'a, T: Default> {
+    item: T,
+    pool: &'a Pool<T>,
+}
+
+impl<T: Default> std::ops::Deref for Loan<'_, T> {
+    type Target = T;
+    fn deref(&self) -> &T {
+        &self.item
+    }
+}
+
+impl<T: Default> std::ops::DerefMut for Loan<'_, T> {
+    fn deref_mut(&mut self) -> &mut T {
+        &mut self.item
+    }
+}
+
+impl<T: Default> Drop for Loan<'_, T> {
+    fn drop(&mut self) {
+        // (A poisoned pool only means the next task allocates afresh.)
+        if let Ok(mut free) = self.pool.0.lock() {
+            free.push(std::mem::take(&mut self.item));
+        }
+    }
+}
