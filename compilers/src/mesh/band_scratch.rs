@@ -24,6 +24,11 @@ impl Stamped {
         self.band += 1;
     }
 
+    /// Slots (set or not).
+    pub fn slots(&self) -> usize {
+        self.slot.len()
+    }
+
     /// Slot `s`'s value, when set in this band.
     #[inline]
     pub fn get(&self, s: usize) -> Option<u32> {

@@ -6,20 +6,17 @@
 use rayon::prelude::*;
 
 use super::SegmentMesh;
-use crate::union_find::join;
+use crate::union_find::{find, join};
 
 /// Bodies of a part.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Bodies {
-    /// Enclosed volume (mm³) of each body, largest first.
-    pub volumes: Vec<f64>,
-}
-
-impl Bodies {
     /// Number of bodies.
-    pub fn count(&self) -> usize {
-        self.volumes.len()
-    }
+    pub count: usize,
+    /// Enclosed volume (mm³) of each body, largest first, when there are
+    /// two or more (what a warning about a part that fell apart says; one
+    /// body's volume is the part's, which the checks sum).
+    pub volumes: Vec<f64>,
 }
 
 /// The bodies of the part made of `segs`.
@@ -33,8 +30,12 @@ pub fn bodies(segs: &[SegmentMesh]) -> Bodies {
     let mut parent: Vec<u32> = (0..n).collect();
     for (s, &b) in segs.iter().zip(&base) {
         for t in &s.mesh.triangles {
-            join(&mut parent, b + t[0], b + t[1]);
-            join(&mut parent, b + t[0], b + t[2]);
+            // (`join` twice, with the first corner's root found once.)
+            let r = find(&mut parent, b + t[0]);
+            let r1 = find(&mut parent, b + t[1]);
+            let r = link(&mut parent, r, r1);
+            let r2 = find(&mut parent, b + t[2]);
+            link(&mut parent, r, r2);
         }
     }
     if segs.iter().filter(|s| !s.mesh.is_empty()).count() > 1 {
@@ -59,15 +60,31 @@ pub fn bodies(segs: &[SegmentMesh]) -> Bodies {
     // Every id's root in one pass: a parent is never above its child (the
     // smaller root wins, and halving only shortens), so the parent's root
     // is known when the child is reached.
+    let mut count = 0;
     for i in 0..parent.len() {
         parent[i] = parent[parent[i] as usize];
+        count += usize::from(parent[i] as usize == i);
     }
-    measured(segs, &base, &parent)
+    Bodies {
+        count,
+        volumes: if count > 1 {
+            measured(segs, &base, &parent)
+        } else {
+            Vec::new()
+        },
+    }
+}
+
+/// Join the sets of roots `a` and `b` (the smaller root wins); the root.
+fn link(parent: &mut [u32], a: u32, b: u32) -> u32 {
+    let (lo, hi) = (a.min(b), a.max(b));
+    parent[hi as usize] = lo;
+    lo
 }
 
 /// Each body's volume (`root`: every vertex's body, the least index in
 /// it, segments numbered on from `base`), summed triangle by triangle.
-fn measured(segs: &[SegmentMesh], base: &[u32], root: &[u32]) -> Bodies {
+fn measured(segs: &[SegmentMesh], base: &[u32], root: &[u32]) -> Vec<f64> {
     let mut volume = vec![0.0f64; root.len()];
     for (s, &b) in segs.iter().zip(base) {
         for t in &s.mesh.triangles {
@@ -82,7 +99,7 @@ fn measured(segs: &[SegmentMesh], base: &[u32], root: &[u32]) -> Bodies {
         .map(|i| volume[i])
         .collect();
     volumes.sort_unstable_by(|a, b| b.total_cmp(a));
-    Bodies { volumes }
+    volumes
 }
 
 #[cfg(test)]
@@ -122,12 +139,13 @@ mod tests {
             .extend(far.triangles.iter().map(|t| t.map(|i| i + 4)));
         two.vertices.extend(far.vertices);
         let b = bodies(&[seg(two)]);
-        assert_eq!(b.count(), 2);
+        assert_eq!(b.count, 2);
         assert!((b.volumes[0] - 1.0 / 6.0).abs() < 1e-9, "{b:?}");
         // Two segments sharing the vertex (1, 0, 0): one body.
         let b = bodies(&[seg(tet([0., 0., 0.])), seg(tet([1., 0., 0.]))]);
-        assert_eq!(b.count(), 1);
+        assert_eq!(b.count, 1);
+        assert!(b.volumes.is_empty());
         let b = bodies(&[seg(tet([0., 0., 0.])), seg(tet([3., 0., 0.]))]);
-        assert_eq!(b.count(), 2);
+        assert_eq!(b.count, 2);
     }
 }

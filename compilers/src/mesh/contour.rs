@@ -56,6 +56,7 @@ use super::kuhn::{
 use super::layer_dist::LayerDist;
 use super::mixed::mixed_cubes;
 use super::one_label::OneLabelBand;
+use super::one_label::PlaneEdges;
 pub use super::unevaluated::ExactAt;
 use super::unevaluated::{CornerMemo, Layer};
 use super::vertex_keys::{BandMesh, KeyMap};
@@ -147,6 +148,9 @@ pub struct Contourer {
     /// Corners evaluated by [`Self::flat_layer`], which reads cubes of the
     /// whole layer.
     layer_memo: CornerMemo,
+    /// One label: the mesh's points on the x and y edges of the layer's
+    /// lower plane and of its upper plane (see `one_label::PlaneEdges`).
+    edges: [PlaneEdges; 2],
 }
 
 impl Contourer {
@@ -170,6 +174,7 @@ impl Contourer {
             band_sizes: Vec::new(),
             scratch_pool: Pool::default(),
             layer_memo: CornerMemo::default(),
+            edges: Default::default(),
         }
     }
 
@@ -221,6 +226,10 @@ impl Contourer {
             hi: &plane,
             exact,
         };
+        if self.one_label {
+            self.edges[0].fit(self.grid.dims);
+        }
+        let below = &self.edges[0];
         let bands: Vec<(BandMesh, BandFlats, (usize, usize))> = (0..rows.div_ceil(BAND))
             .into_par_iter()
             .map_init(
@@ -232,7 +241,7 @@ impl Contourer {
                         .map_or((0, 0), |&(t, f)| (t + t / 8, f + f / 8));
                     let (slots, memo) = &mut **scratch;
                     memo.begin(pz, js.start, BAND + 1, self.grid.dims[0]);
-                    let (mesh, flats) = self.band(pz, js, layer, hint, slots, memo);
+                    let (mesh, flats) = self.band(pz, js, layer, hint, (slots, below), memo);
                     let made = (mesh.tris.len(), flats.at.len());
                     (mesh, flats, made)
                 },
@@ -240,6 +249,7 @@ impl Contourer {
             .collect();
         self.band_sizes = bands.iter().map(|b| b.2).collect();
         let mut global = Vec::new();
+        self.edges[1].begin(self.grid.dims);
         for (row, _, _) in &bands {
             global.clear();
             for &(label, key, pos) in &row.verts {
@@ -248,7 +258,7 @@ impl Contourer {
             for &(label, t) in &row.tris {
                 self.meshes[label as usize - 1]
                     .triangles
-                    .push(t.map(|i| global[i as usize]));
+                    .push(t.map(|i| PlaneEdges::index(i, &global)));
             }
         }
         if self.merge {
@@ -259,6 +269,7 @@ impl Contourer {
             m.swap(0, 1);
             m[1].clear();
         }
+        self.edges.swap(0, 1);
         self.prev = Some((z, plane));
         Some(lo)
     }
@@ -275,10 +286,14 @@ impl Contourer {
         let plane_len = (self.grid.dims[0] * self.grid.dims[1]) as u64;
         let (mesh, maps) = (&mut self.meshes[l], &mut self.maps[l]);
         let slot = ((v.key / KEY_TYPES) / plane_len - pz as u64) as usize;
-        *maps[slot].entry(v.key).or_insert_with(|| {
+        let at = *maps[slot].entry(v.key).or_insert_with(|| {
             mesh.vertices.push(v.pos);
             (mesh.vertices.len() - 1) as u32
-        })
+        });
+        if self.one_label && slot == 1 {
+            self.edges[1].remember(self.grid.dims, v.key, at);
+        }
+        at
     }
 
     /// The meshes, label 1 first (flat regions triangulated now; a region
@@ -304,14 +319,14 @@ impl Contourer {
         js: std::ops::Range<usize>,
         layer: Layer,
         (tris, flat): (usize, usize),
-        slots: &mut Stamped,
+        (slots, below): (&mut Stamped, &PlaneEdges),
         corners: &mut CornerMemo,
     ) -> (BandMesh, BandFlats) {
         let nx = self.grid.dims[0];
         let mut out = Vec::with_capacity(if self.one_label { 0 } else { tris });
         let mut one = self
             .one_label
-            .then(|| OneLabelBand::new(js.start, nx, tris, slots));
+            .then(|| OneLabelBand::new(js.start, nx, tris, slots, below));
         let mut flats = BandFlats::with_capacity(flat, self.grid.dims);
         let mut scratch = Scratch::default();
         let mut memo = FlatMemo::default();

@@ -1,7 +1,9 @@
 //! The contourer's one-label path: each cube's marching-cubes loops (see
 //! [`super::cube_loops`]) fanned into triangles. Within a band of rows,
 //! each grid edge's point is placed once and found again by its edge's
-//! slot, not by hashing its key: four cubes share each grid edge.
+//! slot, not by hashing its key: four cubes share each grid edge. A point
+//! on an x or y edge of the layer's lower plane, placed by the layer
+//! below, is taken from it as a vertex of the mesh ([`PlaneEdges`]).
 
 use glam::DVec3;
 
@@ -104,10 +106,18 @@ pub(super) struct OneLabelBand<'a> {
     /// Vertex index per grid edge of the band: two planes of `BAND + 1`
     /// rows, three directions.
     slots: &'a mut Stamped,
+    /// The mesh's vertices on the lower plane's x and y edges.
+    below: &'a PlaneEdges,
 }
 
 impl<'a> OneLabelBand<'a> {
-    pub fn new(j0: usize, nx: usize, tris: usize, slots: &'a mut Stamped) -> Self {
+    pub fn new(
+        j0: usize,
+        nx: usize,
+        tris: usize,
+        slots: &'a mut Stamped,
+        below: &'a PlaneEdges,
+    ) -> Self {
         slots.begin(2 * (BAND + 1) * nx * 3);
         OneLabelBand {
             mesh: BandMesh {
@@ -117,6 +127,7 @@ impl<'a> OneLabelBand<'a> {
             j0,
             nx,
             slots,
+            below,
         }
     }
 
@@ -138,6 +149,13 @@ impl<'a> OneLabelBand<'a> {
         if let Some(v) = self.slots.get(s) {
             return v;
         }
+        if ck == 0
+            && dir < 2
+            && let Some(v) = self.below.get(ci, cj + self.j0, self.nx, dir)
+        {
+            self.slots.set(s, v);
+            return v;
+        }
         let r = placed.unwrap_or_else(|| c.resolve(cube, 0, &[0; 4], p));
         let v = self.push(r);
         self.slots.set(s, v);
@@ -147,6 +165,60 @@ impl<'a> OneLabelBand<'a> {
     fn push(&mut self, r: VRef) -> u32 {
         self.mesh.verts.push((1, r.key, r.pos));
         (self.mesh.verts.len() - 1) as u32
+    }
+}
+
+/// Marks a triangle corner that is a vertex of the mesh already (its index
+/// in the mesh), not one of the band's new vertices.
+const KNOWN: u32 = 1 << 31;
+
+/// The one-label mesh's vertices on the x and y grid edges of one plane, by
+/// edge. Each such edge is shared by the cube layers below and above the
+/// plane: the layer below places its point, and the layer above takes that
+/// vertex from here rather than placing the point again and finding its
+/// key in the contourer's map. (What is found is what the map holds for
+/// the key: the vertices, their order and the triangles do not change.)
+#[derive(Default)]
+pub(super) struct PlaneEdges(Stamped);
+
+impl PlaneEdges {
+    /// Sized for planes of `dims`, keeping what is set.
+    pub fn fit(&mut self, [nx, ny, _]: [usize; 3]) {
+        if self.0.slots() != 2 * nx * ny {
+            self.0.begin(2 * nx * ny);
+        }
+    }
+
+    /// A new plane of `dims`, nothing set.
+    pub fn begin(&mut self, [nx, ny, _]: [usize; 3]) {
+        self.0.begin(2 * nx * ny);
+    }
+
+    /// Remember mesh vertex `at` under `key` (see [`Contourer::resolve`]),
+    /// when the key names an x or y edge of this plane.
+    pub fn remember(&mut self, [nx, ny, _]: [usize; 3], key: u64, at: u32) {
+        let kind = key % KEY_TYPES;
+        if kind == 1 || kind == 2 {
+            let sample = (key / KEY_TYPES) as usize % (nx * ny);
+            debug_assert!(at < KNOWN, "vertex index {at}");
+            self.0.set(sample * 2 + kind as usize - 1, at);
+        }
+    }
+
+    /// The vertex on the edge from sample `(i, j)` along x (`dir` 0) or y
+    /// (1), marked as known.
+    pub fn get(&self, i: usize, j: usize, nx: usize, dir: usize) -> Option<u32> {
+        self.0.get((j * nx + i) * 2 + dir).map(|v| v | KNOWN)
+    }
+
+    /// A band triangle's corner `i` as a mesh index: a known vertex's own,
+    /// or the index `band` gives the band's new vertex `i`.
+    pub fn index(i: u32, band: &[u32]) -> u32 {
+        if i & KNOWN != 0 {
+            i & !KNOWN
+        } else {
+            band[i as usize]
+        }
     }
 }
 
@@ -187,7 +259,9 @@ mod tests {
                 }
                 (label, dist)
             };
-            let mut band = OneLabelBand::new(j0, nx, 0, &mut slots);
+            let mut below = PlaneEdges::default();
+            below.fit(grid.dims);
+            let mut band = OneLabelBand::new(j0, nx, 0, &mut slots, &below);
             let mut tris = Vec::new();
             let mut scratch = Scratch::default();
             for j in j0..j0 + BAND {

@@ -94,7 +94,7 @@ pub(super) fn write_files(
 /// ([`volcad_core::Model::stated_gaps`]).
 pub(super) fn body_notes(b: &bodies::Bodies, voxel: f64, design: &StatedGaps) -> Vec<String> {
     let total: f64 = b.volumes.iter().sum();
-    let n = b.count();
+    let n = b.count;
     let mut out = vec![match design.parts {
         Some(parts) if parts > 1 => format!("bodies: {n} (the design has {parts} separate parts)"),
         _ => format!("bodies: {n}"),

@@ -12,7 +12,7 @@
 //! the tile's shared fractions), and an inside voxel whose fractions are
 //! not known without evaluating is evaluated.
 
-use super::slab::{Rect, Rows};
+use super::slab::{Rect, Rows, fill_pattern, fill_short};
 use super::{LEAF, Sampler, Shared};
 use crate::aabb::Aabb;
 use crate::model::MAX_MATERIALS;
@@ -33,7 +33,8 @@ impl Sampler<'_> {
     pub(super) fn leaf(&self, r: Rect, out: &mut Rows, shared: &mut Shared, b: &Aabb) {
         let Rect { z, x0, y0, w, h } = r;
         let (k, row0, nx) = (out.k, out.row0, self.grid.dims[0]);
-        let mut f = [0.0f64; MAX_MATERIALS];
+        // (Zeroed only where fractions are evaluated.)
+        let mut f = None;
         // A lazy consumer bounds the fractions itself, run by run. Where
         // fractions are averages (a `Blend`, 125 or 216 child samples a voxel) and
         // their bounds over the tile are narrow, the inside voxels of tiles
@@ -68,8 +69,8 @@ impl Sampler<'_> {
                     out.dist[v] = bound;
                     let voxel = &mut out.fracs[v * k..(v + 1) * k];
                     match &inside {
-                        Some(one) if bound <= 0.0 => voxel.copy_from_slice(&one[..k]),
-                        _ => voxel.fill(0.0),
+                        Some(one) if bound <= 0.0 => fill_pattern(voxel, &one[..k]),
+                        _ => fill_short(voxel, 0.0),
                     }
                     settled += 1;
                     continue;
@@ -79,13 +80,16 @@ impl Sampler<'_> {
                     let d = self.model.distance(p);
                     let voxel = &mut out.fracs[v * k..(v + 1) * k];
                     if d <= 0.0 {
-                        voxel.copy_from_slice(&one[..k]);
+                        fill_pattern(voxel, &one[..k]);
                         spared += 1;
                     } else {
-                        voxel.fill(0.0);
+                        fill_short(voxel, 0.0);
                     }
                     d
                 } else if k > 0 {
+                    // (Lazily: the array's zeroing stays out of the loop.)
+                    #[allow(clippy::unnecessary_lazy_evaluations)]
+                    let f = f.get_or_insert_with(|| [0.0f64; MAX_MATERIALS]);
                     let d = self.model.eval_into(p, &mut f[..k]);
                     for (o, val) in out.fracs[v * k..(v + 1) * k].iter_mut().zip(&f[..k]) {
                         *o = *val as f32;

@@ -41,7 +41,7 @@ mod leaf;
 mod slab;
 pub use consumer::{Consumer, UniformTest};
 pub use grid::{Grid, GridError};
-use slab::{Counts, Rect, Rows, merge_rects, row_blocks, x_tiles};
+use slab::{Counts, Rect, Rows, fill_short, merge_rects, row_blocks, x_tiles};
 pub use slab::{Slab, SolidRect, fill_pattern};
 
 /// Counts of how voxels were obtained (for reports and benchmarks).
@@ -561,7 +561,8 @@ impl<'a> Sampler<'a> {
             });
             out.rect_fracs.extend_from_slice(one);
         }
-        let mut f = [0.0f64; MAX_MATERIALS];
+        // (Zeroed only when voxels are evaluated: most fills are small.)
+        let mut f = None;
         for y in y0..y0 + h {
             let row = (y - row0) * nx;
             out.dist[row + x0..row + x0 + w].fill(value);
@@ -572,10 +573,13 @@ impl<'a> Sampler<'a> {
             // fractions (a per-voxel `fill` was a library call each).
             let run = &mut out.fracs[(row + x0) * k..(row + x0 + w) * k];
             match how {
-                Fill::Outside => run.fill(0.0),
+                Fill::Outside => fill_short(run, 0.0),
                 Fill::Lazy => run.fill(f32::NAN),
                 Fill::Constant(one) => fill_pattern(run, one),
                 Fill::Evaluate => {
+                    // (Lazily: the array's zeroing stays out of the loop.)
+                    #[allow(clippy::unnecessary_lazy_evaluations)]
+                    let f = f.get_or_insert_with(|| [0.0f64; MAX_MATERIALS]);
                     for (x, voxel) in (x0..).zip(run.chunks_exact_mut(k)) {
                         let p = self.grid.center(x, y, z);
                         self.model.fractions_inside(p, &mut f[..k]);

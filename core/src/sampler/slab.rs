@@ -82,6 +82,20 @@ pub fn fill_pattern(run: &mut [f32], one: &[f32]) {
     }
 }
 
+/// `run.fill(v)` as plain stores: for zeros `fill` calls the library's
+/// `memset`, which costs more than the stores themselves on the few voxels
+/// of a leaf's row or a small settled tile's (millions of calls on a
+/// lattice).
+#[inline]
+pub(super) fn fill_short(run: &mut [f32], v: f32) {
+    // (Hidden from the optimiser, the value cannot be seen to be zero and
+    // the loop is not turned back into that call.)
+    let v = std::hint::black_box(v);
+    for x in run {
+        *x = v;
+    }
+}
+
 /// Voxels `[x0, x0 + w) × [y0, y0 + h)` of layer `z`.
 #[derive(Clone, Copy)]
 pub(super) struct Rect {
