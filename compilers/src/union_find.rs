@@ -14,7 +14,13 @@ pub fn find(parent: &mut [u32], mut i: u32) -> u32 {
 /// Join the sets of `a` and `b`.
 pub fn join(parent: &mut [u32], a: u32, b: u32) {
     let (a, b) = (find(parent, a), find(parent, b));
-    if a != b {
-        parent[a.max(b) as usize] = a.min(b);
-    }
+    link(parent, a, b);
+}
+
+/// Join the sets whose roots are `a` and `b` (the smaller root wins); the
+/// joined set's root.
+pub fn link(parent: &mut [u32], a: u32, b: u32) -> u32 {
+    let (lo, hi) = (a.min(b), a.max(b));
+    parent[hi as usize] = lo;
+    lo
 }

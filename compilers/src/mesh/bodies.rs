@@ -6,7 +6,7 @@
 use rayon::prelude::*;
 
 use super::SegmentMesh;
-use crate::union_find::{find, join};
+use crate::union_find::{find, join, link};
 
 /// Bodies of a part.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -73,13 +73,6 @@ pub fn bodies(segs: &[SegmentMesh]) -> Bodies {
             Vec::new()
         },
     }
-}
-
-/// Join the sets of roots `a` and `b` (the smaller root wins); the root.
-fn link(parent: &mut [u32], a: u32, b: u32) -> u32 {
-    let (lo, hi) = (a.min(b), a.max(b));
-    parent[hi as usize] = lo;
-    lo
 }
 
 /// Each body's volume (`root`: every vertex's body, the least index in

@@ -249,7 +249,9 @@ impl Contourer {
             .collect();
         self.band_sizes = bands.iter().map(|b| b.2).collect();
         let mut global = Vec::new();
-        self.edges[1].begin(self.grid.dims);
+        if self.one_label {
+            self.edges[1].begin(self.grid.dims);
+        }
         for (row, _, _) in &bands {
             global.clear();
             for &(label, key, pos) in &row.verts {

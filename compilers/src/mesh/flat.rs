@@ -360,11 +360,7 @@ impl Regions {
         if self.parent[a as usize] == self.parent[b as usize] {
             return;
         }
-        let (ra, rb) = (
-            crate::union_find::find(&mut self.parent, a),
-            crate::union_find::find(&mut self.parent, b),
-        );
-        self.parent[ra.max(rb) as usize] = ra.min(rb);
+        crate::union_find::join(&mut self.parent, a, b);
     }
 
     /// Add an outline edge to the region of cube `id`: vertex keys and

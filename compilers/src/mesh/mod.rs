@@ -321,8 +321,13 @@ fn plan(model: &Model, p: &MeshParams, look: Look) -> Result<Plan, ExportError> 
     // Planes: one slab being contoured, the next being labelled, and the
     // contourer's previous plane; their distances are the slabs' buffers
     // (three circulate: the one sampled into is in `per_layer`).
-    let planes =
-        ((2 * slab_layers + 1) * layer * (2 + 4 * stride) + 2 * slab_layers * layer * 4) as u64;
+    // With one segment the contourer also keeps the vertices on two
+    // planes' x and y edges (`one_label::PlaneEdges`: 8 bytes a slot, two
+    // slots a sample).
+    let plane_edges = if segments == 1 { 2 * layer * 2 * 8 } else { 0 };
+    let planes = ((2 * slab_layers + 1) * layer * (2 + 4 * stride)
+        + 2 * slab_layers * layer * 4
+        + plane_edges) as u64;
     let memory_bytes = (slab_layers * per_layer) as u64 + planes + mesh_bytes + flat_bytes;
     check_memory(
         memory_bytes,

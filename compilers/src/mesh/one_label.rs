@@ -293,4 +293,66 @@ mod tests {
         }
         assert!(centres > 0, "no loop without an apex was drawn");
     }
+
+    /// A random field over several layers and bands, contoured plane by
+    /// plane: the vertices a layer takes from the one below
+    /// ([`PlaneEdges`]) leave the mesh exactly what deduplicating every
+    /// cube's triangles by key gives, the same vertices in the same order
+    /// and the same triangles.
+    #[test]
+    fn layers_take_their_lower_plane_vertices_from_below() {
+        let [nx, ny, nz] = [12, 2 * BAND + 4, 6];
+        let grid = Grid {
+            origin: DVec3::new(0.5, -1.0, 2.0),
+            voxel: DVec3::new(0.3, 0.5, 0.4),
+            dims: [nx, ny, nz],
+        };
+        let mut rng = XorShift::new(5);
+        let border = |i: usize, j: usize, k: usize| {
+            i == 0 || j == 0 || k == 0 || i + 1 == nx || j + 1 == ny || k + 1 == nz
+        };
+        // Inside or outside at random, never exactly zero; the grid's
+        // outer layer outside, as `contour_field` labels it.
+        let mut values = vec![0.0f32; nx * ny * nz];
+        for (v, d) in values.iter_mut().enumerate() {
+            let (i, j, k) = (v % nx, v / nx % ny, v / (nx * ny));
+            let mag = (rng.next_f64() * 0.4 + 0.01) as f32;
+            *d = if !border(i, j, k) && rng.next_f64() < 0.5 {
+                -mag
+            } else {
+                mag
+            };
+        }
+        let c = Contourer::new(grid, 1, Interface::Midpoint).with_flat_merge(false);
+        let mesh = crate::mesh::field::contour_field(c, &grid, &values);
+        let c = Contourer::new(grid, 1, Interface::Midpoint);
+        let mut tris = Vec::new();
+        let mut scratch = Scratch::default();
+        for k in 0..nz - 1 {
+            for j in 0..ny - 1 {
+                for i in 0..nx - 1 {
+                    let at = |m: usize| {
+                        let (a, b, e) = (i + (m & 1), j + (m >> 1 & 1), k + (m >> 2 & 1));
+                        values[(e * ny + b) * nx + a]
+                    };
+                    let dist: [f32; 8] = std::array::from_fn(at);
+                    let cube = Cube {
+                        base: [i, j, k],
+                        label: dist.map(|d| u16::from(d <= 0.0)),
+                        dist,
+                        value: [&[]; 8],
+                    };
+                    c.loops_to_tris(&cube, &mut scratch, &mut tris);
+                }
+            }
+        }
+        let want = BandMesh::new(tris);
+        let bits = |p: [f32; 3]| p.map(f32::to_bits);
+        let got: Vec<_> = mesh.vertices.iter().map(|p| bits(*p)).collect();
+        let expected: Vec<_> = want.verts.iter().map(|v| bits(v.2)).collect();
+        assert_eq!(got, expected, "vertices");
+        let expected: Vec<[u32; 3]> = want.tris.iter().map(|t| t.1).collect();
+        assert_eq!(mesh.triangles, expected, "triangles");
+        assert!(mesh.is_watertight(), "{:?}", mesh.edge_report());
+    }
 }

@@ -86,10 +86,9 @@ impl Contourer {
         let plane = |c: usize| if c & 4 == 0 { lo } else { hi };
         let planes = [&*lo.dist, &*hi.dist];
         let mut dist: [f32; 8] = std::array::from_fn(|c| planes[c >> 2][idx[c]]);
-        if dist.iter().any(|d| d.is_infinite()) {
-            for (c, d) in (0..).zip(&mut dist) {
-                let at = Self::corner_at([i, j, z], c);
-                *d = memo.value(*d, at, exact);
+        for (c, d) in (0..).zip(&mut dist) {
+            if d.is_infinite() {
+                *d = memo.value(*d, Self::corner_at([i, j, z], c), exact);
             }
         }
         Cube {
