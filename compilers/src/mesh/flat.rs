@@ -239,6 +239,10 @@ struct Region {
     /// (ids) when it falls back.
     cubes: Vec<u32>,
     edges: Vec<u32>,
+    /// The outline edges' vertices in label `x`'s mesh, gathered while the
+    /// edges are read in order: triangulating read them by index, one
+    /// cache miss an edge.
+    outline: Vec<[u32; 2]>,
 }
 
 /// A [`FlatKey`] interned by [`Regions`]: equal ids, equal keys.
@@ -392,29 +396,24 @@ impl Regions {
                 key: self.key(r),
                 cubes: Vec::new(),
                 edges: Vec::new(),
+                outline: Vec::new(),
             })
             .collect();
         for e in 0..self.edges.len() {
             let r = crate::union_find::find(&mut self.parent, self.edges[e].cube);
             if let Ok(s) = roots.binary_search(&r) {
                 regions[s].edges.push(e as u32);
+                regions[s].outline.push(self.edges[e].xi);
             }
         }
         let tris: Vec<Option<Triangulated>> = {
             let meshes = &*meshes;
-            let edges = &self.edges;
             regions
                 .par_iter()
                 .map(|r| {
                     let verts = &meshes[r.key.x as usize - 1].vertices;
                     self.triangulate
-                        .then(|| {
-                            triangulate(
-                                r.key.normal,
-                                r.edges.iter().map(|e| edges[*e as usize].xi),
-                                verts,
-                            )
-                        })
+                        .then(|| triangulate(r.key.normal, r.outline.iter().copied(), verts))
                         .flatten()
                 })
                 .collect()

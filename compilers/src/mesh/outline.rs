@@ -90,15 +90,15 @@ pub(super) fn triangulate(
         };
         added = inner_points(&mut pts, &mut global, &edges, area2, verts, &plane);
     }
-    let count = pts.len();
+    let (count, constraints) = (pts.len(), edges.len());
     let mut conflict = false;
     let cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::try_bulk_load_cdt(
         pts.clone(),
-        edges.clone(),
+        edges,
         |_| conflict = true,
     )
     .ok()?;
-    if conflict || cdt.num_vertices() != count || cdt.num_constraints() != edges.len() {
+    if conflict || cdt.num_vertices() != count || cdt.num_constraints() != constraints {
         return None;
     }
     // Parity of outline crossings from the hull: 1 = inside.

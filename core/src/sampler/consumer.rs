@@ -21,7 +21,8 @@ pub type UniformTest<'a> = &'a (dyn Fn(&[Interval]) -> bool + Sync);
 ///   those where a cube it cuts has one as a corner (see
 ///   [`Consumer::MeshContour`]).
 /// - **fractions**: filled per voxel (`k` values, zero outside), or not at
-///   all (`Slab::k` is 0).
+///   all (`Slab::k` is 0). A mesh export reads no outside voxel's
+///   fractions: its slab keeps whatever they held before.
 #[derive(Clone, Copy)]
 pub enum Consumer<'a> {
     /// The studio's viewport bake: distances and fractions of every voxel,
@@ -52,7 +53,8 @@ pub enum Consumer<'a> {
     /// is the same as with every voxel sampled. Such tiles (and those of a
     /// fixed mix) are reported as [`SolidRect`](super::SolidRect)s in
     /// `Slab::rects`, with their voxels' entries in `Slab::fracs` left
-    /// unwritten. Tiles are first tried as blocks through every layer of
+    /// unwritten; so are the entries of outside voxels (the labels read
+    /// fractions inside only). Tiles are first tried as blocks through every layer of
     /// the slab: a block that is empty, or solid with one fraction vector,
     /// is filled in every layer from one analysis, its skipped voxels
     /// holding the block's (looser) interval end, whose sign is all a
@@ -106,6 +108,10 @@ pub(super) struct Needs<'a> {
     /// Values written without evaluation within one voxel diagonal of zero
     /// are `±∞` (see [`Consumer::MeshContour`]).
     pub unevaluated_near: bool,
+    /// Outside voxels' fractions are written (zero); false where the
+    /// consumer never reads them (most of an imported mesh's box is
+    /// outside, and zeroing is a store per voxel and material).
+    pub outside_fracs: bool,
 }
 
 impl<'a> Consumer<'a> {
@@ -120,6 +126,7 @@ impl<'a> Consumer<'a> {
             lazy: false,
             lipschitz_skip: false,
             unevaluated_near: false,
+            outside_fracs: true,
         };
         let signs = Needs {
             signs_only: true,
@@ -139,6 +146,7 @@ impl<'a> Consumer<'a> {
                 signs_only: true,
                 lipschitz_skip: true,
                 unevaluated_near: true,
+                outside_fracs: false,
                 ..plain
             },
             Consumer::PngStackSingle => Needs {

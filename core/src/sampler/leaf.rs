@@ -8,8 +8,9 @@
 //! `|d(u)| ≥ |d(v)| − |u − v| > margin`, so `d(u)` has `d(v)`'s
 //! sign and that lower bound is stored, as a tile beyond the margin stores
 //! its interval's end (see the module docs of [`super`]). Their fractions
-//! are written as an evaluation would write them (zero outside; inside,
-//! the tile's shared fractions), and an inside voxel whose fractions are
+//! are written as an evaluation would write them (zero outside, where the
+//! consumer reads them; inside, the tile's shared fractions), and an
+//! inside voxel whose fractions are
 //! not known without evaluating is evaluated.
 
 use super::slab::{Rect, Rows, fill_pattern, fill_short};
@@ -70,7 +71,8 @@ impl Sampler<'_> {
                     let voxel = &mut out.fracs[v * k..(v + 1) * k];
                     match &inside {
                         Some(one) if bound <= 0.0 => fill_pattern(voxel, &one[..k]),
-                        _ => fill_short(voxel, 0.0),
+                        _ if self.outside_fracs => fill_short(voxel, 0.0),
+                        _ => {}
                     }
                     settled += 1;
                     continue;
@@ -82,7 +84,7 @@ impl Sampler<'_> {
                     if d <= 0.0 {
                         fill_pattern(voxel, &one[..k]);
                         spared += 1;
-                    } else {
+                    } else if self.outside_fracs {
                         fill_short(voxel, 0.0);
                     }
                     d

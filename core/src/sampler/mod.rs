@@ -152,6 +152,8 @@ pub struct Sampler<'a> {
     fixed: Option<[f32; MAX_MATERIALS]>,
     /// Evaluated voxels of a leaf bound the leaf's later ones (see `leaf`).
     lipschitz_skip: bool,
+    /// Outside voxels get zero fractions (see `Needs::outside_fracs`).
+    outside_fracs: bool,
     /// For [`Consumer::MeshContour`]: one voxel diagonal, within which a
     /// value not evaluated is written as `±∞` (see [`Self::written`]).
     unevaluated_near: Option<f64>,
@@ -209,6 +211,7 @@ impl<'a> Sampler<'a> {
             lazy_open: lazy && model.averages_fractions(),
             lipschitz_skip: needs.lipschitz_skip && model.distance_is_bound(),
             unevaluated_near: needs.unevaluated_near.then(|| grid.voxel.length()),
+            outside_fracs: needs.outside_fracs,
             leaf_gaps: leaf::leaf_gaps(grid.voxel.x, grid.voxel.y),
             stats: SampleStats::default(),
         }
@@ -566,7 +569,7 @@ impl<'a> Sampler<'a> {
         for y in y0..y0 + h {
             let row = (y - row0) * nx;
             out.dist[row + x0..row + x0 + w].fill(value);
-            if k == 0 || as_rect {
+            if k == 0 || as_rect || (matches!(how, Fill::Outside) && !self.outside_fracs) {
                 continue;
             }
             // Whole runs at once where every voxel gets the same

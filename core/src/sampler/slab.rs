@@ -14,7 +14,8 @@ pub struct Slab {
     /// Signed distance per voxel, index `(z − z0)·nx·ny + y·nx + x`.
     pub dist: Vec<f32>,
     /// Fractions per voxel, `k` consecutive values in model material order
-    /// (empty when fractions were not asked for). Zero outside. `NaN` in a
+    /// (empty when fractions were not asked for). Zero outside, except for
+    /// [`super::Consumer::MeshContour`] (left as they were). `NaN` in a
     /// solid tile whose fractions vary, for
     /// [`super::Consumer::PngStackRandom`]: the consumer evaluates them.
     pub fracs: Vec<f32>,
