@@ -32,7 +32,7 @@ pub(super) fn leaf_gaps(hx: f64, hy: f64) -> LeafGaps {
 impl Sampler<'_> {
     /// Evaluate the open leaf `r` (voxel centres `b`) into `out`.
     pub(super) fn leaf(&self, r: Rect, out: &mut Rows, shared: &mut Shared, b: &Aabb) {
-        let Rect { z, x0, y0, w, h } = r;
+        let (z, x0, y0, w, h) = r.parts();
         let (k, row0, nx) = (out.k, out.row0, self.grid.dims[0]);
         // (Zeroed only where fractions are evaluated.)
         let mut f = None;

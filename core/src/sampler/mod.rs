@@ -293,7 +293,7 @@ impl<'a> Sampler<'a> {
                 for (x0, w) in x_tiles(nx) {
                     if !self.block(z0, x0, y0, w, h, &mut outs) {
                         for (z, out) in (z0..).zip(outs.iter_mut()) {
-                            self.tile(Rect { z, x0, y0, w, h }, out, &mut self.shared());
+                            self.tile(Rect::new(z, x0, y0, w, h), out, &mut self.shared());
                         }
                     }
                 }
@@ -345,7 +345,7 @@ impl<'a> Sampler<'a> {
                 None => Fill::Outside,
                 Some(one) => Fill::Constant(&one[..k]),
             };
-            self.fill(Rect { z, x0, y0, w, h }, out, value, how);
+            self.fill(Rect::new(z, x0, y0, w, h), out, value, how);
         }
         true
     }
@@ -355,13 +355,13 @@ impl<'a> Sampler<'a> {
         let nx = self.grid.dims[0];
         let (y0, h) = (out.row0, out.dist.len() / nx);
         for (x0, w) in x_tiles(nx) {
-            self.tile(Rect { z, x0, y0, w, h }, out, &mut self.shared());
+            self.tile(Rect::new(z, x0, y0, w, h), out, &mut self.shared());
         }
     }
 
     /// Refine tile `r` into `out`.
     fn tile(&self, r: Rect, out: &mut Rows, shared: &mut Shared) {
-        let Rect { z, x0, y0, w, h } = r;
+        let (z, x0, y0, w, h) = r.parts();
         let k = out.k;
         let b = self.grid.centres_box(x0, x0 + w - 1, y0, y0 + h - 1, z);
         match self.settle(&b, k) {
@@ -550,7 +550,7 @@ impl<'a> Sampler<'a> {
     /// Write tile `r` without evaluating distances: `value` everywhere,
     /// fractions as `how` says.
     fn fill(&self, r: Rect, out: &mut Rows, value: f32, how: Fill<'_>) {
-        let Rect { z, x0, y0, w, h } = r;
+        let (z, x0, y0, w, h) = r.parts();
         let (k, row0, nx) = (out.k, out.row0, self.grid.dims[0]);
         let as_rect = k > 0 && self.solid_rects && matches!(how, Fill::Constant(_));
         if let (true, Fill::Constant(one)) = (as_rect, how) {
@@ -598,11 +598,12 @@ impl<'a> Sampler<'a> {
 
     /// Refine a tile as four quarters.
     fn split(&self, r: Rect, out: &mut Rows, shared: &mut Shared) {
-        let (hw, hh) = (r.w.div_ceil(2), r.h.div_ceil(2));
-        for (x0, w) in [(r.x0, hw), (r.x0 + hw, r.w - hw)] {
-            for (y0, h) in [(r.y0, hh), (r.y0 + hh, r.h - hh)] {
+        let (z, rx, ry, rw, rh) = r.parts();
+        let (hw, hh) = (rw.div_ceil(2), rh.div_ceil(2));
+        for (x0, w) in [(rx, hw), (rx + hw, rw - hw)] {
+            for (y0, h) in [(ry, hh), (ry + hh, rh - hh)] {
                 if w > 0 && h > 0 {
-                    self.tile(Rect { x0, y0, w, h, ..r }, out, shared);
+                    self.tile(Rect::new(z, x0, y0, w, h), out, shared);
                 }
             }
         }

@@ -98,13 +98,41 @@ pub(super) fn fill_short(run: &mut [f32], v: f32) {
 }
 
 /// Voxels `[x0, x0 + w) × [y0, y0 + h)` of layer `z`.
+///
+/// Packed into two integers (a grid has at most `u32::MAX` voxels along
+/// an axis, a tile at most `TILE` along a side): a pair of scalars is
+/// passed in registers, where five fields went through memory, written by
+/// the caller and read back at the top of every call of the quadtree.
 #[derive(Clone, Copy)]
 pub(super) struct Rect {
-    pub z: usize,
-    pub x0: usize,
-    pub y0: usize,
-    pub w: usize,
-    pub h: usize,
+    /// `z` in the high half, `x0` in the low.
+    zx: u64,
+    /// `y0` in the high half, then `w` and `h` (16 bits each).
+    ywh: u64,
+}
+
+impl Rect {
+    /// The rectangle `[x0, x0 + w) × [y0, y0 + h)` of layer `z`.
+    #[inline(always)]
+    pub fn new(z: usize, x0: usize, y0: usize, w: usize, h: usize) -> Self {
+        debug_assert!(w <= TILE && h <= TILE && x0.max(y0).max(z) <= u32::MAX as usize);
+        Self {
+            zx: (z as u64) << 32 | x0 as u64,
+            ywh: (y0 as u64) << 32 | (w as u64) << 16 | h as u64,
+        }
+    }
+
+    /// `(z, x0, y0, w, h)`.
+    #[inline(always)]
+    pub fn parts(self) -> (usize, usize, usize, usize, usize) {
+        (
+            (self.zx >> 32) as usize,
+            (self.zx & 0xffff_ffff) as usize,
+            (self.ywh >> 32) as usize,
+            ((self.ywh >> 16) & 0xffff) as usize,
+            (self.ywh & 0xffff) as usize,
+        )
+    }
 }
 
 /// Column ranges `(x0, w)` of the tiles across a row of `nx` voxels.
