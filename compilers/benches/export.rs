@@ -86,6 +86,7 @@ fn stage_times(model: &Model, voxel: f64, dither: Dither) -> (u64, f64, f64) {
             match dither {
                 Dither::Random => {
                     use rayon::prelude::*;
+                    let lazy = slab.rect_rows(z + l, nx, ny);
                     codes.par_chunks_mut(nx).enumerate().for_each(|(y, c)| {
                         let v = y * nx;
                         choose_random_row(
@@ -96,6 +97,7 @@ fn stage_times(model: &Model, voxel: f64, dither: Dither) -> (u64, f64, f64) {
                             &d[v..v + nx],
                             &f[v * k..(v + nx) * k],
                             k,
+                            lazy.row(y),
                             c,
                         );
                     });

@@ -8,8 +8,9 @@
 //! narrow band; every voxel whose `r` falls outside the bands gets its pick
 //! from the bounds alone, and only the others are evaluated (on the graded
 //! bar, runs of 32 voxels at 0.05 mm: about a tenth, tested).
-//! The sampler marks such regions with `NaN` fractions
-//! (`Sampler::with_lazy_fractions`).
+//! The sampler lists such solid tiles as rectangles (`Slab::rects`, with
+//! `NaN` fractions; `Consumer::PngStackRandom`) and marks such voxels of
+//! tiles a surface crosses with `NaN` fractions.
 //!
 //! Exactness: the bounds are widened by `crate::dither::BOUND_MARGIN`,
 //! which covers rounding the `f64` fractions to `f32` and the `f32` running
@@ -20,7 +21,7 @@
 use volcad_core::Model;
 use volcad_core::interval::Interval;
 use volcad_core::model::MAX_MATERIALS;
-use volcad_core::sampler::Grid;
+use volcad_core::sampler::{Grid, RowSpan};
 
 use crate::dither::{BOUND_MARGIN as EPS, MIN_TOTAL, pick_random, splitmix64, unit_f32};
 /// Longest run of voxels bounded together (a sampler tile's width).
@@ -111,9 +112,11 @@ impl Shares {
 
 /// Random picks for row `y` of layer `z` (`out` and `dist` one per voxel of
 /// the row, `fracs` `k` per voxel): as [`crate::dither::choose_random`],
-/// with `NaN`-marked fractions bounded per run and evaluated only where
-/// the bounds leave the pick open. Returns how many marked voxels were
-/// evaluated.
+/// with lazy voxels' fractions bounded per run and evaluated only where
+/// the bounds leave the pick open. Lazy: the voxels of `lazy_spans` (the
+/// row's runs of the sampler's lazy rectangles, whose entries in `fracs`
+/// are not written) and inside voxels whose fractions are `NaN`. Returns
+/// how many lazy voxels were evaluated.
 #[allow(clippy::too_many_arguments)]
 pub fn choose_random_row(
     model: &Model,
@@ -123,57 +126,105 @@ pub fn choose_random_row(
     dist: &[f32],
     fracs: &[f32],
     k: usize,
+    lazy_spans: &[RowSpan],
     out: &mut [u8],
 ) -> usize {
-    let [nx, ny, _] = grid.dims;
-    let mut evaluated = 0;
-    let first = ((z * ny + y) * nx) as u64;
-    let lazy = |x: usize| dist[x] <= 0.0 && fracs[x * k].is_nan();
-    let mut iv = [Interval::point(0.0); MAX_MATERIALS];
-    let mut f = [0.0f64; MAX_MATERIALS];
-    let mut f32s = [0.0f32; MAX_MATERIALS];
-    let mut shares = Shares::EMPTY;
+    let nx = grid.dims[0];
+    let mut row = Row {
+        model,
+        grid,
+        seed,
+        yz: [y, z],
+        dist,
+        fracs,
+        k,
+        iv: [Interval::point(0.0); MAX_MATERIALS],
+        f: [0.0; MAX_MATERIALS],
+        f32s: [0.0; MAX_MATERIALS],
+        shares: Shares::EMPTY,
+        evaluated: 0,
+    };
     let mut x = 0;
-    while x < nx {
-        if !lazy(x) {
-            let end = (x + 1..nx).find(|&e| lazy(e)).unwrap_or(nx);
-            crate::dither::choose_random(
-                seed,
-                first + x as u64,
-                &dist[x..end],
-                &fracs[x * k..end * k],
-                k,
-                &mut out[x..end],
-            );
-            x = end;
-            continue;
-        }
-        let end = (x + 1..(x + RUN).min(nx))
-            .find(|&e| !lazy(e))
-            .unwrap_or((x + RUN).min(nx));
-        let b = volcad_core::Aabb::new(grid.center(x, y, z), grid.center(end - 1, y, z));
-        let sums =
-            (model.fraction_bounds(&b, &mut iv[..k]) && shares.set(&iv[..k])).then_some(&shares);
-        let x0 = x;
-        let mut open = |i: usize, r: f32| {
-            let v = x0 + i;
-            evaluated += 1;
-            model.fractions_inside(grid.center(v, y, z), &mut f[..k]);
-            for (a, b) in f32s.iter_mut().zip(&f[..k]) {
-                *a = *b as f32;
-            }
-            pick_random(&f32s[..k], r)
-        };
-        let out = &mut out[x..end];
-        match (sums, k) {
-            (Some(s), 2) => run_k::<2>(s, seed, first + x as u64, out, &mut open),
-            (Some(s), 3) => run_k::<3>(s, seed, first + x as u64, out, &mut open),
-            (Some(s), _) => run(seed, first + x as u64, out, |r| s.pick(r), &mut open),
-            (None, _) => run(seed, first + x as u64, out, |_| None, &mut open),
-        }
-        x = end;
+    for s in lazy_spans {
+        let (a, b) = (s.x0.clamp(x, nx), s.x1.clamp(x, nx));
+        row.picks(x..a, out, |v| dist[v] <= 0.0 && fracs[v * k].is_nan());
+        // (A rectangle's voxels are solid.)
+        row.picks(a..b, out, |_| true);
+        x = x.max(b);
     }
-    evaluated
+    row.picks(x..nx, out, |v| dist[v] <= 0.0 && fracs[v * k].is_nan());
+    row.evaluated
+}
+
+/// One row's inputs and scratch for [`choose_random_row`].
+struct Row<'a> {
+    model: &'a Model,
+    grid: &'a Grid,
+    seed: u64,
+    yz: [usize; 2],
+    dist: &'a [f32],
+    fracs: &'a [f32],
+    k: usize,
+    iv: [Interval; MAX_MATERIALS],
+    f: [f64; MAX_MATERIALS],
+    f32s: [f32; MAX_MATERIALS],
+    shares: Shares,
+    evaluated: usize,
+}
+
+impl Row<'_> {
+    /// The picks of voxels `xs` into `out` (the whole row's), `lazy(v)`
+    /// telling which are lazy.
+    #[inline(always)]
+    fn picks(&mut self, xs: std::ops::Range<usize>, out: &mut [u8], lazy: impl Fn(usize) -> bool) {
+        let (k, [y, z]) = (self.k, self.yz);
+        let [nx, ny, _] = self.grid.dims;
+        let first = ((z * ny + y) * nx) as u64;
+        let mut x = xs.start;
+        while x < xs.end {
+            if !lazy(x) {
+                let end = (x + 1..xs.end).find(|&e| lazy(e)).unwrap_or(xs.end);
+                crate::dither::choose_random(
+                    self.seed,
+                    first + x as u64,
+                    &self.dist[x..end],
+                    &self.fracs[x * k..end * k],
+                    k,
+                    &mut out[x..end],
+                );
+                x = end;
+                continue;
+            }
+            let end = (x + 1..(x + RUN).min(xs.end))
+                .find(|&e| !lazy(e))
+                .unwrap_or((x + RUN).min(xs.end));
+            let b =
+                volcad_core::Aabb::new(self.grid.center(x, y, z), self.grid.center(end - 1, y, z));
+            let sums = (self.model.fraction_bounds(&b, &mut self.iv[..k])
+                && self.shares.set(&self.iv[..k]))
+            .then_some(&self.shares);
+            let (model, grid, evaluated) = (self.model, self.grid, &mut self.evaluated);
+            let (f, f32s) = (&mut self.f, &mut self.f32s);
+            let x0 = x;
+            let mut open = |i: usize, r: f32| {
+                let v = x0 + i;
+                *evaluated += 1;
+                model.fractions_inside(grid.center(v, y, z), &mut f[..k]);
+                for (a, b) in f32s.iter_mut().zip(&f[..k]) {
+                    *a = *b as f32;
+                }
+                pick_random(&f32s[..k], r)
+            };
+            let (seed, out) = (self.seed, &mut out[x..end]);
+            match (sums, k) {
+                (Some(s), 2) => run_k::<2>(s, seed, first + x as u64, out, &mut open),
+                (Some(s), 3) => run_k::<3>(s, seed, first + x as u64, out, &mut open),
+                (Some(s), _) => run(seed, first + x as u64, out, |r| s.pick(r), &mut open),
+                (None, _) => run(seed, first + x as u64, out, |_| None, &mut open),
+            }
+            x = end;
+        }
+    }
 }
 
 /// Picks for one run of voxels, the first with global index `first`: from
@@ -234,19 +285,28 @@ mod tests {
         let (mut a, mut b) = (Slab::default(), Slab::default());
         let (mut ca, mut cb) = (vec![0u8; nx], vec![0u8; nx]);
         let (mut marked, mut evaluated, mut inside) = (0, 0, 0);
+        // Stale fractions in the reused buffer must not matter where the
+        // lazy sampler lists rectangles.
+        b.fracs = vec![0.25; nx * ny * k];
         for z in 0..nz {
             eager
                 .sample_layers(z, z + 1, &mut a, &cancel)
                 .expect("sample");
             lazy.sample_layers(z, z + 1, &mut b, &cancel)
                 .expect("sample");
+            let rows = b.rect_rows(z, nx, ny);
             for y in 0..ny {
                 let (d, f) = (&a.dist[y * nx..][..nx], &a.fracs[y * nx * k..][..nx * k]);
                 crate::dither::choose_random(seed, ((z * ny + y) * nx) as u64, d, f, k, &mut ca);
                 let (d, f) = (&b.dist[y * nx..][..nx], &b.fracs[y * nx * k..][..nx * k]);
-                evaluated += choose_random_row(m, &grid, seed, [y, z], d, f, k, &mut cb);
+                let spans = rows.row(y);
+                evaluated += choose_random_row(m, &grid, seed, [y, z], d, f, k, spans, &mut cb);
                 assert_eq!(ca, cb, "row {y} of layer {z}");
-                marked += (0..nx).filter(|&x| f[x * k].is_nan()).count();
+                marked += (0..nx)
+                    .filter(|&x| {
+                        f[x * k].is_nan() || spans.iter().any(|s| (s.x0..s.x1).contains(&x))
+                    })
+                    .count();
                 inside += ca.iter().filter(|&&c| c > 0).count();
             }
         }

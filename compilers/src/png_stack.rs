@@ -535,19 +535,26 @@ fn pick_codes(
                     *o = code - code * u8::from(*d > 0.0);
                 }
             }),
-        None => codes.par_chunks_mut(nx).enumerate().for_each(|(row, c)| {
-            let v = row * nx;
-            lazy_random::choose_random_row(
-                model,
-                &grid,
-                seed,
-                [row % ny, z0 + row / ny],
-                &slab.dist[v..v + nx],
-                &slab.fracs[v * k..(v + nx) * k],
-                k,
-                c,
-            );
-        }),
+        None => {
+            // The sampler's lazy rectangles, row by row, per layer.
+            let lazy: Vec<_> = (0..slab.layers)
+                .map(|l| slab.rect_rows(z0 + l, nx, ny))
+                .collect();
+            codes.par_chunks_mut(nx).enumerate().for_each(|(row, c)| {
+                let v = row * nx;
+                lazy_random::choose_random_row(
+                    model,
+                    &grid,
+                    seed,
+                    [row % ny, z0 + row / ny],
+                    &slab.dist[v..v + nx],
+                    &slab.fracs[v * k..(v + nx) * k],
+                    k,
+                    lazy[row / ny].row(row % ny),
+                    c,
+                );
+            })
+        }
     }
 }
 

@@ -20,7 +20,7 @@ use rayon::prelude::*;
 use volcad_core::Model;
 use volcad_core::interval::Interval;
 use volcad_core::model::MAX_MATERIALS;
-use volcad_core::sampler::{Slab, SolidRect, fill_pattern};
+use volcad_core::sampler::{RectRows, Slab, fill_pattern};
 
 use super::contour::Plane;
 use super::interface::Interface;
@@ -311,7 +311,7 @@ impl Classifier {
                 let row = &rows_dist[y * nx..(y + 1) * nx];
                 let fracs = &fracs[y * nx * k..(y + 1) * nx * k];
                 let mut x = 1;
-                for sp in runs.row(y) {
+                for sp in runs.rows.row(y) {
                     let (a, b) = (sp.x0.max(x), sp.x1.min(nx - 1));
                     if a >= b {
                         continue;
@@ -349,38 +349,20 @@ impl Classifier {
     }
 }
 
-/// One row's run of a [`SolidRect`]: columns `x0..x1`, rectangle `rect`.
-#[derive(Clone, Copy, Debug, Default)]
-struct Span {
-    x0: usize,
-    x1: usize,
-    rect: usize,
-}
-
-/// The runs of one layer's solid rectangles, row by row, and each
+/// One layer's solid rectangles as runs, row by row, and each
 /// rectangle's classification (label, classifying fraction, values).
 struct SolidRuns {
-    /// Row `y`'s runs are `spans[first[y]..first[y + 1]]`, by column.
-    first: Vec<usize>,
-    spans: Vec<Span>,
+    rows: RectRows,
     classes: Vec<(u16, f32)>,
     values: Vec<f32>,
-}
-
-impl SolidRuns {
-    fn row(&self, y: usize) -> &[Span] {
-        &self.spans[self.first[y]..self.first[y + 1]]
-    }
 }
 
 impl Classifier {
     /// [`SolidRuns`] of layer `z` of `slab` (`nx × ny`).
     fn solid_runs(&self, slab: &Slab, z: usize, nx: usize, ny: usize) -> SolidRuns {
         let (k, stride) = (slab.k, self.interface().stride());
-        // The sampler lists rectangles by layer.
-        let lo = slab.rects.partition_point(|r| r.z < z);
-        let hi = slab.rects.partition_point(|r| r.z <= z);
-        let rects = &slab.rects[lo..hi];
+        let rows = slab.rect_rows(z, nx, ny);
+        let rects = &slab.rects[rows.rects.clone()];
         let mut values = vec![0.0; rects.len() * stride];
         let classes = (rects.iter().enumerate())
             .map(|(i, r)| {
@@ -388,40 +370,8 @@ impl Classifier {
                 self.classify(f, &mut values[i * stride..(i + 1) * stride])
             })
             .collect();
-        // Counting sort by row. Within a row the sampler's order (tiles left
-        // to right, quadrants left before right) is already by column; the
-        // check below keeps that an optimisation, not an assumption.
-        let rows = |r: &SolidRect| r.y0.min(ny)..(r.y0 + r.h).min(ny);
-        let mut first = vec![0usize; ny + 1];
-        for r in rects {
-            for y in rows(r) {
-                first[y + 1] += 1;
-            }
-        }
-        for y in 0..ny {
-            first[y + 1] += first[y];
-        }
-        let mut fill = first.clone();
-        let mut spans = vec![Span::default(); first[ny]];
-        for (i, r) in rects.iter().enumerate() {
-            for y in rows(r) {
-                spans[fill[y]] = Span {
-                    x0: r.x0,
-                    x1: (r.x0 + r.w).min(nx),
-                    rect: i,
-                };
-                fill[y] += 1;
-            }
-        }
-        for y in 0..ny {
-            let row = &mut spans[first[y]..first[y + 1]];
-            if !row.is_sorted_by_key(|s| s.x0) {
-                row.sort_unstable_by_key(|s| s.x0);
-            }
-        }
         SolidRuns {
-            first,
-            spans,
+            rows,
             classes,
             values,
         }

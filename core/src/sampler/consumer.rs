@@ -66,9 +66,10 @@ pub enum Consumer<'a> {
     PngStackDiffusion,
     /// A randomly dithered slice stack: signs, and fractions only where
     /// the picks need them. A solid tile whose fractions vary, and which
-    /// `Model::fraction_bounds` can bound, gets `NaN` fractions instead of
-    /// one evaluation per voxel; the consumer evaluates them where its
-    /// bounds leave a pick open. Where fractions are averages (`Blend`),
+    /// `Model::fraction_bounds` can bound, is listed in `Slab::rects`
+    /// (with `NaN` fractions, its voxels' entries in `Slab::fracs` not
+    /// written) instead of one evaluation per voxel; the consumer
+    /// evaluates them where its bounds leave a pick open. Where fractions are averages (`Blend`),
     /// so are the inside voxels of bounded tiles that a surface crosses.
     /// For a design whose fractions never vary
     /// (`Model::varying_fractions`) this is [`Consumer::PngStackDiffusion`].
@@ -108,6 +109,9 @@ pub(super) struct Needs<'a> {
     /// Values written without evaluation within one voxel diagonal of zero
     /// are `±∞` (see [`Consumer::MeshContour`]).
     pub unevaluated_near: bool,
+    /// Solid tiles left lazy go to `Slab::rects` (`NaN` fractions) instead
+    /// of `NaN` in each voxel's fractions.
+    pub lazy_rects: bool,
     /// Outside voxels' fractions are written (zero); false where the
     /// consumer never reads them (most of an imported mesh's box is
     /// outside, and zeroing is a store per voxel and material).
@@ -126,6 +130,7 @@ impl<'a> Consumer<'a> {
             lazy: false,
             lipschitz_skip: false,
             unevaluated_near: false,
+            lazy_rects: false,
             outside_fracs: true,
         };
         let signs = Needs {
@@ -159,6 +164,7 @@ impl<'a> Consumer<'a> {
             | Consumer::Estimate => signs,
             Consumer::PngStackRandom => Needs {
                 lazy: true,
+                lazy_rects: true,
                 ..signs
             },
         }

@@ -42,7 +42,7 @@ mod slab;
 pub use consumer::{Consumer, UniformTest};
 pub use grid::{Grid, GridError};
 use slab::{Counts, Rect, Rows, fill_short, merge_rects, row_blocks, x_tiles};
-pub use slab::{Slab, SolidRect, fill_pattern};
+pub use slab::{RectRows, RowSpan, Slab, SolidRect, fill_pattern};
 
 /// Counts of how voxels were obtained (for reports and benchmarks).
 #[derive(Debug, Default)]
@@ -144,6 +144,8 @@ pub struct Sampler<'a> {
     uniform: Option<UniformTest<'a>>,
     lazy: bool,
     solid_rects: bool,
+    /// Lazy solid tiles go to `Slab::rects` (see `Needs::lazy_rects`).
+    lazy_rects: bool,
     blocks: bool,
     signs_only: bool,
     /// Lazy fractions in tiles a surface crosses too (see `tile`).
@@ -206,6 +208,7 @@ impl<'a> Sampler<'a> {
             uniform: needs.uniform,
             lazy,
             solid_rects: needs.solid_rects,
+            lazy_rects: needs.lazy_rects,
             blocks: needs.blocks,
             signs_only: needs.signs_only,
             lazy_open: lazy && model.averages_fractions(),
@@ -552,8 +555,13 @@ impl<'a> Sampler<'a> {
     fn fill(&self, r: Rect, out: &mut Rows, value: f32, how: Fill<'_>) {
         let (z, x0, y0, w, h) = r.parts();
         let (k, row0, nx) = (out.k, out.row0, self.grid.dims[0]);
-        let as_rect = k > 0 && self.solid_rects && matches!(how, Fill::Constant(_));
-        if let (true, Fill::Constant(one)) = (as_rect, how) {
+        let as_rect = k > 0
+            && match how {
+                Fill::Constant(_) => self.solid_rects,
+                Fill::Lazy => self.lazy_rects,
+                _ => false,
+            };
+        if as_rect {
             out.rects.push(SolidRect {
                 z,
                 x0,
@@ -562,7 +570,10 @@ impl<'a> Sampler<'a> {
                 h,
                 at: out.rect_fracs.len(),
             });
-            out.rect_fracs.extend_from_slice(one);
+            match how {
+                Fill::Constant(one) => out.rect_fracs.extend_from_slice(one),
+                _ => out.rect_fracs.resize(out.rect_fracs.len() + k, f32::NAN),
+            }
         }
         // (Zeroed only when voxels are evaluated: most fills are small.)
         let mut f = None;

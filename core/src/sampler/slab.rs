@@ -16,15 +16,18 @@ pub struct Slab {
     /// Fractions per voxel, `k` consecutive values in model material order
     /// (empty when fractions were not asked for). Zero outside, except for
     /// [`super::Consumer::MeshContour`] (left as they were). `NaN` in a
-    /// solid tile whose fractions vary, for
+    /// voxel of a solid tile a surface crosses whose fractions vary, for
     /// [`super::Consumer::PngStackRandom`]: the consumer evaluates them.
     pub fracs: Vec<f32>,
     /// Fractions per voxel (`Model::materials().len()`).
     pub k: usize,
-    /// For [`super::Consumer::MeshContour`]: rectangles of solid voxels that
-    /// share one fraction vector, by layer then row block. Their voxels'
-    /// entries in `fracs` are not written (they hold whatever the buffer
-    /// held); their fractions are `rect_fracs[at..at + k]`.
+    /// Rectangles of solid voxels, by layer then row block: for
+    /// [`super::Consumer::MeshContour`], those that share one fraction
+    /// vector, `rect_fracs[at..at + k]`; for
+    /// [`super::Consumer::PngStackRandom`], solid tiles whose fractions the
+    /// consumer evaluates (`rect_fracs` all `NaN`). Their voxels' entries
+    /// in `fracs` are not written (they hold whatever the buffer held).
+    /// [`Slab::rect_rows`] lists them row by row.
     pub rects: Vec<SolidRect>,
     /// Fraction vectors of `rects`, `k` values each.
     pub rect_fracs: Vec<f32>,
@@ -54,6 +57,84 @@ impl Slab {
     pub fn fracs_of(&self, v: usize) -> &[f32] {
         &self.fracs[v * self.k..(v + 1) * self.k]
     }
+
+    /// The rectangles of layer `z` (`nx × ny` voxels), as runs row by row:
+    /// `rects` is their range in [`Slab::rects`].
+    pub fn rect_rows(&self, z: usize, nx: usize, ny: usize) -> RectRows {
+        // The sampler lists rectangles by layer.
+        let lo = self.rects.partition_point(|r| r.z < z);
+        let hi = self.rects.partition_point(|r| r.z <= z);
+        let rects = &self.rects[lo..hi];
+        // Counting sort by row. Within a row the sampler's order (tiles left
+        // to right, quadrants left before right) is already by column; the
+        // check below keeps that an optimisation, not an assumption.
+        let rows = |r: &SolidRect| r.y0.min(ny)..(r.y0 + r.h).min(ny);
+        let mut first = vec![0usize; ny + 1];
+        for r in rects {
+            for y in rows(r) {
+                first[y + 1] += 1;
+            }
+        }
+        for y in 0..ny {
+            first[y + 1] += first[y];
+        }
+        let mut fill = first.clone();
+        let mut spans = vec![RowSpan::default(); first[ny]];
+        for (i, r) in rects.iter().enumerate() {
+            for y in rows(r) {
+                spans[fill[y]] = RowSpan {
+                    x0: r.x0,
+                    x1: (r.x0 + r.w).min(nx),
+                    rect: i,
+                };
+                fill[y] += 1;
+            }
+        }
+        for y in 0..ny {
+            let row = &mut spans[first[y]..first[y + 1]];
+            if !row.is_sorted_by_key(|s| s.x0) {
+                row.sort_unstable_by_key(|s| s.x0);
+            }
+        }
+        RectRows {
+            rects: lo..hi,
+            first,
+            spans,
+        }
+    }
+}
+
+/// One layer's [`SolidRect`]s as runs, row by row ([`Slab::rect_rows`]).
+#[derive(Clone, Debug, Default)]
+pub struct RectRows {
+    /// The layer's rectangles: their range in [`Slab::rects`].
+    pub rects: std::ops::Range<usize>,
+    /// Row `y`'s runs are `spans[first[y]..first[y + 1]]`.
+    first: Vec<usize>,
+    spans: Vec<RowSpan>,
+}
+
+impl RectRows {
+    /// Row `y`'s runs, by column (none when the layer has no rectangle).
+    #[inline]
+    pub fn row(&self, y: usize) -> &[RowSpan] {
+        match self.first.get(y + 1) {
+            Some(&end) => &self.spans[self.first[y]..end],
+            None => &[],
+        }
+    }
+}
+
+/// Columns `x0..x1` of one row inside rectangle `rect` (counted from the
+/// layer's first, see [`RectRows::rects`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RowSpan {
+    /// First column.
+    pub x0: usize,
+    /// Past the last column.
+    pub x1: usize,
+    /// The rectangle, among the layer's.
+    pub rect: usize,
 }
 
 /// Repeat `one` (a voxel's fractions, or a mesh label's interface values)
