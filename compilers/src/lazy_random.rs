@@ -144,15 +144,17 @@ pub fn choose_random_row(
         shares: Shares::EMPTY,
         evaluated: 0,
     };
+    // Outside the rectangles, an inside voxel marked `NaN` is lazy.
+    let marked = |v: usize| dist[v] <= 0.0 && fracs[v * k].is_nan();
     let mut x = 0;
     for s in lazy_spans {
         let (a, b) = (s.x0.clamp(x, nx), s.x1.clamp(x, nx));
-        row.picks(x..a, out, |v| dist[v] <= 0.0 && fracs[v * k].is_nan());
+        row.picks(x..a, out, marked);
         // (A rectangle's voxels are solid.)
         row.picks(a..b, out, |_| true);
         x = x.max(b);
     }
-    row.picks(x..nx, out, |v| dist[v] <= 0.0 && fracs[v * k].is_nan());
+    row.picks(x..nx, out, marked);
     row.evaluated
 }
 

@@ -109,9 +109,6 @@ pub(super) struct Needs<'a> {
     /// Values written without evaluation within one voxel diagonal of zero
     /// are `±∞` (see [`Consumer::MeshContour`]).
     pub unevaluated_near: bool,
-    /// Solid tiles left lazy go to `Slab::rects` (`NaN` fractions) instead
-    /// of `NaN` in each voxel's fractions.
-    pub lazy_rects: bool,
     /// Outside voxels' fractions are written (zero); false where the
     /// consumer never reads them (most of an imported mesh's box is
     /// outside, and zeroing is a store per voxel and material).
@@ -130,7 +127,6 @@ impl<'a> Consumer<'a> {
             lazy: false,
             lipschitz_skip: false,
             unevaluated_near: false,
-            lazy_rects: false,
             outside_fracs: true,
         };
         let signs = Needs {
@@ -164,7 +160,6 @@ impl<'a> Consumer<'a> {
             | Consumer::Estimate => signs,
             Consumer::PngStackRandom => Needs {
                 lazy: true,
-                lazy_rects: true,
                 ..signs
             },
         }

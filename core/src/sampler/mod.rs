@@ -105,7 +105,8 @@ enum Fill<'f> {
     Outside,
     /// Inside, one vector for every voxel.
     Constant(&'f [f32]),
-    /// Inside, left `NaN` for a lazy consumer.
+    /// Inside, listed in `Slab::rects` with `NaN` fractions for a lazy
+    /// consumer, which evaluates them.
     Lazy,
     /// Inside, evaluated voxel by voxel.
     Evaluate,
@@ -144,8 +145,6 @@ pub struct Sampler<'a> {
     uniform: Option<UniformTest<'a>>,
     lazy: bool,
     solid_rects: bool,
-    /// Lazy solid tiles go to `Slab::rects` (see `Needs::lazy_rects`).
-    lazy_rects: bool,
     blocks: bool,
     signs_only: bool,
     /// Lazy fractions in tiles a surface crosses too (see `tile`).
@@ -208,7 +207,6 @@ impl<'a> Sampler<'a> {
             uniform: needs.uniform,
             lazy,
             solid_rects: needs.solid_rects,
-            lazy_rects: needs.lazy_rects,
             blocks: needs.blocks,
             signs_only: needs.signs_only,
             lazy_open: lazy && model.averages_fractions(),
@@ -555,10 +553,11 @@ impl<'a> Sampler<'a> {
     fn fill(&self, r: Rect, out: &mut Rows, value: f32, how: Fill<'_>) {
         let (z, x0, y0, w, h) = r.parts();
         let (k, row0, nx) = (out.k, out.row0, self.grid.dims[0]);
+        // A lazy tile is always listed (its fractions are the consumer's).
         let as_rect = k > 0
             && match how {
                 Fill::Constant(_) => self.solid_rects,
-                Fill::Lazy => self.lazy_rects,
+                Fill::Lazy => true,
                 _ => false,
             };
         if as_rect {
@@ -588,7 +587,8 @@ impl<'a> Sampler<'a> {
             let run = &mut out.fracs[(row + x0) * k..(row + x0 + w) * k];
             match how {
                 Fill::Outside => fill_short(run, 0.0),
-                Fill::Lazy => run.fill(f32::NAN),
+                // (Listed as a rectangle above.)
+                Fill::Lazy => {}
                 Fill::Constant(one) => fill_pattern(run, one),
                 Fill::Evaluate => {
                     // (Lazily: the array's zeroing stays out of the loop.)
