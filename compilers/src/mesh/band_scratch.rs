@@ -41,6 +41,16 @@ impl Stamped {
     pub fn set(&mut self, s: usize, value: u32) {
         self.slot[s] = self.band << 32 | u64::from(value);
     }
+
+    /// Slot `s`'s value, or `add()`'s, set in this band.
+    #[inline]
+    pub fn find_or(&mut self, s: usize, add: impl FnOnce() -> u32) -> u32 {
+        self.get(s).unwrap_or_else(|| {
+            let v = add();
+            self.set(s, v);
+            v
+        })
+    }
 }
 
 /// Band scratch not in use: a contouring task

@@ -56,7 +56,7 @@ use super::kuhn::{
 use super::layer_dist::LayerDist;
 use super::mixed::mixed_cubes;
 use super::one_label::OneLabelBand;
-use super::one_label::PlaneEdges;
+use super::one_label::{LayerEdges, PlaneEdges};
 pub use super::unevaluated::ExactAt;
 use super::unevaluated::{CornerMemo, Layer};
 use super::vertex_keys::{BandMesh, KeyMap};
@@ -118,7 +118,8 @@ pub struct Contourer {
     pub(super) iface: Interface,
     meshes: Vec<IndexedMesh>,
     /// Per label: key → vertex index, for keys based in the lower and the
-    /// upper plane of the current cube layer.
+    /// upper plane of the current cube layer (two or more labels; one
+    /// label uses `edges`).
     maps: Vec<[KeyMap; 2]>,
     prev: Option<(usize, Plane)>,
     /// Merge flat regions (see [`super::flat`]); off: plain marching
@@ -148,9 +149,9 @@ pub struct Contourer {
     /// Corners evaluated by [`Self::flat_layer`], which reads cubes of the
     /// whole layer.
     layer_memo: CornerMemo,
-    /// One label: the mesh's points on the x and y edges of the layer's
-    /// lower plane and of its upper plane (see `one_label::PlaneEdges`).
-    edges: [PlaneEdges; 2],
+    /// One label: the mesh's points on the layer's grid edges (see
+    /// `one_label::LayerEdges`).
+    edges: LayerEdges,
 }
 
 impl Contourer {
@@ -174,7 +175,7 @@ impl Contourer {
             band_sizes: Vec::new(),
             scratch_pool: Pool::default(),
             layer_memo: CornerMemo::default(),
-            edges: Default::default(),
+            edges: LayerEdges::default(),
         }
     }
 
@@ -227,9 +228,9 @@ impl Contourer {
             exact,
         };
         if self.one_label {
-            self.edges[0].fit(self.grid.dims);
+            self.edges.fit(self.grid.dims);
         }
-        let below = &self.edges[0];
+        let below = self.edges.below();
         let bands: Vec<(BandMesh, BandFlats, (usize, usize))> = (0..rows.div_ceil(BAND))
             .into_par_iter()
             .map_init(
@@ -250,7 +251,7 @@ impl Contourer {
         self.band_sizes = bands.iter().map(|b| b.2).collect();
         let mut global = Vec::new();
         if self.one_label {
-            self.edges[1].begin(self.grid.dims);
+            self.edges.begin_upper(self.grid.dims);
         }
         for (row, _, _) in &bands {
             global.clear();
@@ -271,7 +272,7 @@ impl Contourer {
             m.swap(0, 1);
             m[1].clear();
         }
-        self.edges.swap(0, 1);
+        self.edges.next_layer();
         self.prev = Some((z, plane));
         Some(lo)
     }
@@ -286,16 +287,18 @@ impl Contourer {
     fn index_of(&mut self, pz: usize, label: u16, v: VRef) -> u32 {
         let l = label as usize - 1;
         let plane_len = (self.grid.dims[0] * self.grid.dims[1]) as u64;
-        let (mesh, maps) = (&mut self.meshes[l], &mut self.maps[l]);
-        let slot = ((v.key / KEY_TYPES) / plane_len - pz as u64) as usize;
-        let at = *maps[slot].entry(v.key).or_insert_with(|| {
+        let sample = v.key / KEY_TYPES;
+        let slot = (sample / plane_len - pz as u64) as usize;
+        let mesh = &mut self.meshes[l];
+        let add = || {
             mesh.vertices.push(v.pos);
             (mesh.vertices.len() - 1) as u32
-        });
-        if self.one_label && slot == 1 {
-            self.edges[1].remember(self.grid.dims, v.key, at);
+        };
+        if !self.one_label {
+            return *self.maps[l][slot].entry(v.key).or_insert_with(add);
         }
-        at
+        let at = (sample % plane_len) as usize;
+        self.edges.find_or(slot, at, v.key % KEY_TYPES, add)
     }
 
     /// The meshes, label 1 first (flat regions triangulated now; a region

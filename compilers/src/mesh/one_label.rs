@@ -64,9 +64,16 @@ impl Contourer {
         for (n, l) in cube_loops::case(corner_mask(cube, 1)).iter().enumerate() {
             let k = l.points.len();
             if let Some(apex) = l.apex {
+                // Each point is looked up once, in the order the fan's
+                // corners first use them (the apex, then around the loop),
+                // not once per corner.
+                let mut v = [0u32; MAX_LOOP];
+                for d in 0..k {
+                    let m = (apex + d) % k;
+                    v[m] = band.vertex(self, cube, l.points[m], None);
+                }
                 for t in fan(k, apex) {
-                    let v = t.map(|m| band.vertex(self, cube, l.points[m], None));
-                    band.mesh.tris.push((1, v));
+                    band.mesh.tris.push((1, t.map(|m| v[m])));
                 }
                 continue;
             }
@@ -86,6 +93,9 @@ impl Contourer {
         }
     }
 }
+
+/// Most points in a marching-cubes loop: a cube has twelve edges.
+const MAX_LOOP: usize = 12;
 
 /// The triangles `(apex, i, j)` of the fan over a loop of `k` points from
 /// `apex`: the loop's own points skip it and its two neighbours; an added
@@ -172,6 +182,62 @@ impl<'a> OneLabelBand<'a> {
 /// in the mesh), not one of the band's new vertices.
 const KNOWN: u32 = 1 << 31;
 
+/// The one-label mesh's vertices on the grid edges of the current cube
+/// layer, by edge: every one-label point lies on a grid edge (or is a
+/// loop's centre, which only its cube uses), so the contourer finds a
+/// point's vertex here by index, with no key map.
+#[derive(Default)]
+pub(super) struct LayerEdges {
+    /// The x and y edges of the lower plane (placed by the layer below)
+    /// and of the upper plane.
+    planes: [PlaneEdges; 2],
+    /// The z edges between them, by the edge's lower sample.
+    z: Stamped,
+}
+
+impl LayerEdges {
+    /// Sized for planes of `dims`, keeping the lower plane's vertices.
+    pub fn fit(&mut self, dims: [usize; 3]) {
+        self.planes[0].fit(dims);
+    }
+
+    /// The lower plane's x and y edges.
+    pub fn below(&self) -> &PlaneEdges {
+        &self.planes[0]
+    }
+
+    /// Nothing set yet on the upper plane and the z edges.
+    pub fn begin_upper(&mut self, dims: [usize; 3]) {
+        self.planes[1].begin(dims);
+        self.z.begin(dims[0] * dims[1]);
+    }
+
+    /// The vertex of the point keyed `kind` (see [`Contourer::resolve`])
+    /// at sample `at` of the lower (`plane` 0) or upper (1) plane, or
+    /// `add()`'s, remembered there.
+    pub fn find_or(
+        &mut self,
+        plane: usize,
+        at: usize,
+        kind: u64,
+        add: impl FnOnce() -> u32,
+    ) -> u32 {
+        match kind {
+            1 | 2 => self.planes[plane].find_or(at, kind as usize - 1, add),
+            4 => {
+                debug_assert_eq!(plane, 0, "a z edge starts on the lower plane");
+                self.z.find_or(at, add)
+            }
+            _ => add(),
+        }
+    }
+
+    /// The upper plane becomes the next layer's lower plane.
+    pub fn next_layer(&mut self) {
+        self.planes.swap(0, 1);
+    }
+}
+
 /// The one-label mesh's vertices on the x and y grid edges of one plane, by
 /// edge. Each such edge is shared by the cube layers below and above the
 /// plane: the layer below places its point, and the layer above takes that
@@ -194,15 +260,12 @@ impl PlaneEdges {
         self.0.begin(2 * nx * ny);
     }
 
-    /// Remember mesh vertex `at` under `key` (see [`Contourer::resolve`]),
-    /// when the key names an x or y edge of this plane.
-    pub fn remember(&mut self, [nx, ny, _]: [usize; 3], key: u64, at: u32) {
-        let kind = key % KEY_TYPES;
-        if kind == 1 || kind == 2 {
-            let sample = (key / KEY_TYPES) as usize % (nx * ny);
-            debug_assert!(at < KNOWN, "vertex index {at}");
-            self.0.set(sample * 2 + kind as usize - 1, at);
-        }
+    /// The vertex on the edge from sample `at` (index in the plane) along
+    /// x (`dir` 0) or y (1), or `add()`'s, remembered there.
+    pub fn find_or(&mut self, at: usize, dir: usize, add: impl FnOnce() -> u32) -> u32 {
+        let v = self.0.find_or(at * 2 + dir, add);
+        debug_assert!(v < KNOWN, "vertex index {v}");
+        v
     }
 
     /// The vertex on the edge from sample `(i, j)` along x (`dir` 0) or y
