@@ -321,10 +321,14 @@ fn plan(model: &Model, p: &MeshParams, look: Look) -> Result<Plan, ExportError> 
     // Planes: one slab being contoured, the next being labelled, and the
     // contourer's previous plane; their distances are the slabs' buffers
     // (three circulate: the one sampled into is in `per_layer`).
-    // With one segment the contourer also keeps the vertices on two
-    // planes' x and y edges (`one_label::PlaneEdges`: 8 bytes a slot, two
-    // slots a sample).
-    let plane_edges = if segments == 1 { 2 * layer * 2 * 8 } else { 0 };
+    // With one segment the contourer also keeps its vertices by grid edge
+    // (`one_label::LayerEdges`, 8 bytes a slot): two planes' x and y edges
+    // (two slots a sample) and the layer's z edges (one).
+    let plane_edges = if segments == 1 {
+        (2 * 2 + 1) * layer * 8
+    } else {
+        0
+    };
     let planes = ((2 * slab_layers + 1) * layer * (2 + 4 * stride)
         + 2 * slab_layers * layer * 4
         + plane_edges) as u64;
