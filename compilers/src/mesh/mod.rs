@@ -38,6 +38,7 @@ pub mod indexed;
 mod interface;
 pub(crate) mod kuhn;
 mod layer_dist;
+mod loop_cdt;
 mod mixed;
 pub mod obj;
 mod one_label;

@@ -3,9 +3,11 @@
 //! The outline is projected along the normal's largest axis. A small
 //! outline that is one convex loop (a flat cube's cut) is cut into a strip
 //! of triangles with exact orientation tests alone ([`convex_strip`]); any
-//! other is triangulated by a constrained Delaunay triangulation (spade,
-//! exact predicates), with a point added inside beside each clustered pair
-//! of outline points. Both keep every outline point
+//! other is triangulated by a constrained Delaunay triangulation (exact
+//! predicates), with a point added inside beside each clustered pair
+//! of outline points: one simple loop by [`super::loop_cdt`] (ear cutting
+//! and flips), anything else (holes, a loop it refuses) by spade. Both
+//! keep every outline point
 //! (collinear ones included; dropping one would leave a T-junction). In
 //! the Delaunay path faces inside the outline are found by flood fill from
 //! the hull, flipping at each outline edge. Triangles are oriented like
@@ -15,6 +17,7 @@
 //! (shoelace formula) within 10⁻⁹. A region that fails any check gets `None`, and [`super::flat`]
 //! contours it cube by cube with marching tetrahedra instead.
 
+use super::loop_cdt;
 use super::vertex_keys::FastMap;
 
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
@@ -83,12 +86,20 @@ pub(super) fn triangulate(
         });
     }
     let mut added = Vec::new();
+    let outline_points = pts.len();
     if !even {
         let plane = Plane {
             normal: normal.map(f64::from),
             axes: [drop, u, v],
         };
         added = inner_points(&mut pts, &mut global, &edges, area2, verts, &plane);
+    }
+    // One simple loop: ear cutting and flips; anything else, or a loop
+    // they refuse, spade.
+    if let Some(faces) = loop_cdt::triangulate(&pts, &edges, outline_points, area2)
+        && let Some(tris) = oriented(faces, &pts, &global, area2)
+    {
+        return Some(keep_used(tris, added));
     }
     let (count, constraints) = (pts.len(), edges.len());
     let mut conflict = false;
