@@ -144,155 +144,111 @@ impl IndexedMesh {
 
     /// Count open, repeated and degenerate edges.
     ///
-    /// Directed edges `a → b` are grouped by their start vertex (a counting
-    /// sort, linear in the edge count; each vertex has a handful), in
-    /// parallel over ranges of vertices, and the groups are checked in
-    /// parallel. `a → b` repeated is counted once per
-    /// extra copy; an edge is open when `a → b` occurs more often than `b → a` (each copy
-    /// of `b → a` pairs with one copy of `a → b`).
-    ///
-    /// A vertex is clean when its out-neighbours `O(a)` are distinct and
-    /// equal, as a multiset, to its in-neighbours `I(a)` (every `a → b`
-    /// then has exactly one `b → a`). The multisets are compared by their
-    /// sums of a 64-bit mix of each neighbour, `Σ_{b ∈ O(a)} h(b) =
-    /// Σ_{b ∈ I(a)} h(b)` (mod 2⁶⁴), gathered while the edges are counted:
-    /// one comparison a vertex instead of a search of every neighbour's
-    /// list. Two different multisets with equal sums would take a collision
-    /// of the mix (odds about 2⁻⁶⁴ a vertex); a vertex whose sums differ, or
-    /// whose out-neighbours repeat, is counted exactly as described above.
+    /// Each undirected edge `{m, M}` (`m < M`) is filed under its smaller
+    /// vertex as `2M + d`, `d` = 1 when the triangle runs `m → M`, 0 when
+    /// `M → m` (a counting sort by `m`, linear in the edge count; a vertex
+    /// files a handful). Sorted, a vertex's entries for one `M` are its
+    /// `M → m` copies, then its `m → M` ones: with `f` and `b` copies,
+    /// `(f − 1)⁺ + (b − 1)⁺` are repeated and `|f − b|` open (each copy of
+    /// one direction pairs with one of the other). A clean vertex's
+    /// sorted entries are pairs `2M, 2M + 1`: one scan, no search or hash.
+    /// In parallel over ranges of vertices, each task filing, sorting and
+    /// counting its own. Edges from a vertex to itself belong to
+    /// degenerate triangles, counted as such.
     pub fn edge_report(&self) -> EdgeReport {
-        let mut r = EdgeReport::default();
-        let nv = self.vertices.len();
-        r.degenerate = self
+        let degenerate = self
             .triangles
             .par_iter()
             .filter(|t| t[0] == t[1] || t[1] == t[2] || t[2] == t[0])
             .count();
-        let EdgeLists { start, ends, into } = self.edge_lists();
-        let out = |v: u32| &ends[start[v as usize] as usize..start[v as usize + 1] as usize];
-        let count = |list: &[u32], x: u32| {
-            if list.len() > SHORT {
-                list.partition_point(|&e| e <= x) - list.partition_point(|&e| e < x)
-            } else {
-                list.iter().filter(|&&e| e == x).count()
-            }
+        let (repeated, open) = if self.vertices.len() <= PACKED_VERTICES {
+            self.filed_edge_counts()
+        } else {
+            self.mapped_edge_counts()
         };
-        let seen = |list: &[u32], i: usize| {
-            if list.len() > SHORT {
-                i > 0 && list[i - 1] == list[i]
-            } else {
-                list[..i].contains(&list[i])
-            }
-        };
-        let (repeated, open) = (0..nv as u32)
-            .into_par_iter()
-            .with_min_len(1 << 14)
-            .map(|a| {
-                let list = out(a);
-                let sum = list
-                    .iter()
-                    .fold(0u64, |s, &b| s.wrapping_add(neighbour_mix(b)));
-                // (`seen` for every entry, written out: a short list is
-                // scanned before each entry, a long one is sorted.)
-                let distinct = if list.len() > SHORT {
-                    list.windows(2).all(|w| w[0] != w[1])
-                } else {
-                    (1..list.len()).all(|i| !list[..i].contains(&list[i]))
-                };
-                if sum == into[a as usize] && distinct {
-                    return (0, 0);
-                }
-                let (mut repeated, mut open) = (0, 0);
-                for (i, &b) in list.iter().enumerate() {
-                    if seen(list, i) {
-                        continue; // counted at its first copy
-                    }
-                    let m = count(list, b);
-                    repeated += m - 1;
-                    open += m.saturating_sub(count(out(b), a));
-                }
-                (repeated, open)
-            })
-            .reduce(|| (0, 0), |x, y| (x.0 + y.0, x.1 + y.1));
-        r.repeated = repeated;
-        r.open = open;
-        r
+        EdgeReport {
+            open,
+            repeated,
+            degenerate,
+        }
     }
 
-    /// The directed edges grouped by start vertex (a counting sort; long
-    /// lists sorted), with each vertex's in-neighbour fingerprint (see
-    /// [`Self::edge_report`]). In parallel: each task owns a range of start
-    /// vertices (so it writes only its own part of `ends`) and of end
-    /// vertices (their fingerprints), and reads every triangle to find its
-    /// edges.
-    fn edge_lists(&self) -> EdgeLists {
+    /// `(repeated, open)` by filing each edge under its smaller vertex
+    /// (see [`Self::edge_report`]).
+    fn filed_edge_counts(&self) -> (usize, usize) {
         let nv = self.vertices.len();
         let parts = rayon::current_num_threads().clamp(1, 16).min(nv.max(1));
         let first = |p: usize| (nv * p / parts) as u32;
-        let edges = |t: &[u32; 3]| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])];
-        let counted: Vec<(Vec<u32>, Vec<u64>)> = (0..parts)
+        let per_part: Vec<(usize, usize)> = (0..parts)
             .into_par_iter()
             .map(|p| {
                 let (lo, hi) = (first(p), first(p + 1));
-                let mut degree = vec![0u32; (hi - lo) as usize];
-                // Σ h(a) over the in-neighbours a of each vertex.
-                let mut into = vec![0u64; (hi - lo) as usize];
-                for t in &self.triangles {
-                    for (a, b) in edges(t) {
-                        if (lo..hi).contains(&a) {
-                            degree[(a - lo) as usize] += 1;
-                        }
-                        if (lo..hi).contains(&b) {
-                            let i = &mut into[(b - lo) as usize];
-                            *i = i.wrapping_add(neighbour_mix(a));
-                        }
+                // Counting sort of the part's entries by smaller vertex.
+                let mut start = vec![0u32; (hi - lo) as usize + 1];
+                self.each_filed(lo, hi, |m, _| start[(m - lo) as usize + 1] += 1);
+                for i in 1..start.len() {
+                    start[i] += start[i - 1];
+                }
+                let mut filed = vec![0u32; start[start.len() - 1] as usize];
+                let mut fill = start.clone();
+                self.each_filed(lo, hi, |m, entry| {
+                    let f = &mut fill[(m - lo) as usize];
+                    filed[*f as usize] = entry;
+                    *f += 1;
+                });
+                let (mut repeated, mut open) = (0, 0);
+                for w in start.windows(2) {
+                    let list = &mut filed[w[0] as usize..w[1] as usize];
+                    sort_short(list);
+                    let clean = list.len().is_multiple_of(2)
+                        && list
+                            .chunks_exact(2)
+                            .all(|c| c[0] & 1 == 0 && c[1] == c[0] + 1);
+                    if !clean {
+                        let (r, o) = run_counts(list);
+                        repeated += r;
+                        open += o;
                     }
                 }
-                (degree, into)
+                (repeated, open)
             })
             .collect();
-        let mut start = Vec::with_capacity(nv + 1);
-        start.push(0u32);
-        let mut into = Vec::with_capacity(nv);
-        for (degree, part_into) in counted {
-            for d in degree {
-                start.push(start[start.len() - 1] + d);
-            }
-            into.extend(part_into);
-        }
-        let mut ends = vec![0u32; start[nv] as usize];
-        let mut pieces = Vec::with_capacity(parts);
-        let mut rest = &mut ends[..];
-        for p in 0..parts {
-            let len = (start[first(p + 1) as usize] - start[first(p) as usize]) as usize;
-            let (piece, tail) = rest.split_at_mut(len);
-            pieces.push((p, piece));
-            rest = tail;
-        }
-        pieces.into_par_iter().for_each(|(p, piece)| {
-            let (lo, hi) = (first(p), first(p + 1));
-            let base = start[lo as usize];
-            let mut fill: Vec<u32> = start[lo as usize..hi as usize]
-                .iter()
-                .map(|s| s - base)
-                .collect();
-            for t in &self.triangles {
-                for (a, b) in edges(t) {
-                    if (lo..hi).contains(&a) {
-                        let f = &mut fill[(a - lo) as usize];
-                        piece[*f as usize] = b;
-                        *f += 1;
-                    }
+        per_part
+            .into_iter()
+            .fold((0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
+    }
+
+    /// Calls `file(m, 2M + d)` for each edge of a triangle whose smaller
+    /// vertex `m` lies in `lo..hi` (see [`Self::edge_report`]).
+    fn each_filed(&self, lo: u32, hi: u32, mut file: impl FnMut(u32, u32)) {
+        for t in &self.triangles {
+            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                let (m, big) = if a < b { (a, b) } else { (b, a) };
+                if a != b && (lo..hi).contains(&m) {
+                    file(m, (big << 1) | u32::from(a < b));
                 }
             }
-            for v in lo as usize..hi as usize {
-                let list = &mut piece[(start[v] - base) as usize..(start[v + 1] - base) as usize];
-                if list.len() > SHORT {
-                    list.sort_unstable();
+        }
+    }
+
+    /// `(repeated, open)` counted in a map of undirected edges: for meshes
+    /// whose vertex indices do not leave a bit free for the direction.
+    fn mapped_edge_counts(&self) -> (usize, usize) {
+        let mut copies: std::collections::HashMap<(u32, u32), [usize; 2]> =
+            std::collections::HashMap::new();
+        for t in &self.triangles {
+            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                if a != b {
+                    copies.entry((a.min(b), a.max(b))).or_default()[usize::from(a < b)] += 1;
                 }
             }
-        });
-        EdgeLists { start, ends, into }
+        }
+        copies.values().fold((0, 0), |(r, o), &[b, f]| {
+            (
+                r + b.saturating_sub(1) + f.saturating_sub(1),
+                o + b.abs_diff(f),
+            )
+        })
     }
 
     /// Every edge shared by exactly two triangles, in opposite directions.
@@ -301,25 +257,39 @@ impl IndexedMesh {
     }
 }
 
-/// A vertex has a handful of edges: its list is scanned. Long lists (a fan
-/// in an imported mesh) are sorted and searched, so a hub of degree D costs
-/// D log D, not D².
-const SHORT: usize = 32;
+/// Vertex counts up to this file an edge's larger vertex and direction
+/// in one `u32` (`2M + d`).
+const PACKED_VERTICES: usize = 1 << 31;
 
-/// Directed edges by start vertex: vertex `v`'s end vertices are
-/// `ends[start[v]..start[v + 1]]`; `into[v]` sums the mix of its
-/// in-neighbours.
-struct EdgeLists {
-    start: Vec<u32>,
-    ends: Vec<u32>,
-    into: Vec<u64>,
+/// Sorts one vertex's filed entries: a handful by insertion, a long list
+/// (a fan's hub in an imported mesh) by the library's sort.
+fn sort_short(list: &mut [u32]) {
+    if list.len() > 32 {
+        list.sort_unstable();
+        return;
+    }
+    for i in 1..list.len() {
+        let x = list[i];
+        let mut j = i;
+        while j > 0 && list[j - 1] > x {
+            list[j] = list[j - 1];
+            j -= 1;
+        }
+        list[j] = x;
+    }
 }
 
-/// The 64-bit mix of a vertex index whose sums fingerprint a vertex's
-/// neighbours in [`IndexedMesh::edge_report`] (splitmix64: a bijection of
-/// the index that spreads every input bit over the output).
-fn neighbour_mix(v: u32) -> u64 {
-    crate::dither::splitmix64(0, u64::from(v))
+/// `(repeated, open)` of one vertex's sorted entries (see
+/// [`IndexedMesh::edge_report`]).
+fn run_counts(list: &[u32]) -> (usize, usize) {
+    let (mut repeated, mut open) = (0, 0);
+    for run in list.chunk_by(|a, b| a >> 1 == b >> 1) {
+        let forward = run.iter().filter(|&&e| e & 1 == 1).count();
+        let back = run.len() - forward;
+        repeated += forward.saturating_sub(1) + back.saturating_sub(1);
+        open += forward.abs_diff(back);
+    }
+    (repeated, open)
 }
 
 /// Triangles by vertex positions (bits), each rotated to start at its
@@ -428,6 +398,34 @@ mod tests {
             vertices,
             triangles,
         }
+    }
+
+    #[test]
+    fn filing_and_the_map_count_alike() {
+        // Clean, holed, doubled, flipped and degenerate meshes, with hubs
+        // of a handful of edges and of hundreds (the sorted path).
+        for n in [5, 200] {
+            let m = double_cone(n);
+            let mut variants = vec![m.clone(), cube()];
+            let mut v = m.clone();
+            v.triangles.remove(3);
+            variants.push(v);
+            let mut v = m.clone();
+            v.triangles.extend_from_slice(&m.triangles[..3]);
+            variants.push(v);
+            let mut v = m.clone();
+            v.triangles[1].swap(1, 2);
+            v.triangles[2] = [v.triangles[2][0], v.triangles[2][0], v.triangles[2][1]];
+            variants.push(v);
+            for (i, v) in variants.iter().enumerate() {
+                assert_eq!(v.filed_edge_counts(), v.mapped_edge_counts(), "{n} {i}");
+            }
+        }
+        let mut pinched = cube();
+        pinched.triangles[0] = [0, 0, 2];
+        let r = pinched.edge_report();
+        assert_eq!(r.degenerate, 1, "{r:?}");
+        assert!(!pinched.is_watertight());
     }
 
     #[test]
