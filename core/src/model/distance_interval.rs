@@ -10,7 +10,7 @@
 
 use glam::DVec3;
 
-use super::pnode::{COORD_SLOTS, D_SLOT, NAry, PNode, tile_local};
+use super::pnode::{COORD_SLOTS, D_SLOT, DERIVED_MASK, NAry, PNode, tile_local};
 use super::sdf;
 use crate::aabb::Aabb;
 use crate::interval::Interval;
@@ -107,10 +107,18 @@ fn affine_box(b: &Aabb, m: &glam::DMat3, t: DVec3) -> Aabb {
 }
 
 /// Intervals of the coordinate slots over `b` (x y z rho phic r theta phis d).
-pub fn coord_intervals(b: &Aabb, d: Interval) -> [Interval; COORD_SLOTS] {
+/// `used`: the slots the caller's expressions read (bit `i` for slot `i`);
+/// the derived ones are bounded only when some is read (they cost two
+/// interval squares and roots a call: most of a gradient's bounds along
+/// one axis), and are `EVERYTHING` otherwise.
+pub fn coord_intervals(b: &Aabb, d: Interval, used: u64) -> [Interval; COORD_SLOTS] {
     let x = Interval::new(b.min.x, b.max.x);
     let y = Interval::new(b.min.y, b.max.y);
     let z = Interval::new(b.min.z, b.max.z);
+    if used & DERIVED_MASK == 0 {
+        let all = Interval::EVERYTHING;
+        return [x, y, z, all, all, all, all, all, d];
+    }
     let rho = (x.square() + y.square()).sqrt();
     let r = (x.square() + y.square() + z.square()).sqrt();
     let angle = Interval::new(-std::f64::consts::PI, std::f64::consts::PI);
@@ -198,7 +206,7 @@ impl PNode {
                 clip_h,
                 ..
             } => {
-                let slots = coord_intervals(b, Interval::EVERYTHING);
+                let slots = coord_intervals(b, Interval::EVERYTHING, expr.used_vars());
                 let f = expr.eval_interval(&slots);
                 let clip = Aabb::from_center_size(*clip_c, *clip_h * 2.0);
                 let dc = super::sdf::rect_prism(b.center(), clip.center(), *clip_h);
@@ -333,7 +341,7 @@ impl super::pnode::Grade {
         } else {
             Interval::EVERYTHING
         };
-        Some(coord_intervals(b, d))
+        Some(coord_intervals(b, d, self.used))
     }
 }
 

@@ -256,11 +256,14 @@ impl SimGrade {
             return false;
         }
         let mut slots = [ZERO; 64];
-        slots[..COORD_SLOTS].copy_from_slice(&coord_intervals(b, ZERO));
+        slots[..COORD_SLOTS].copy_from_slice(&coord_intervals(b, ZERO, self.used));
         self.field.bounds(b, &mut slots[COORD_SLOTS..n])
             && normalised_bounds(&self.exprs, &self.mats, &slots[..n], out)
     }
 }
+
+/// Grades of at most this many expressions bound them in a small array.
+const SMALL_GRADE: usize = 8;
 
 /// Bounds of clamped, normalised expressions (see the module docs) added
 /// to their materials' entries of `out`; false when an expression has no
@@ -271,8 +274,17 @@ fn normalised_bounds(
     slots: &[Interval],
     out: &mut [Interval],
 ) -> bool {
-    let mut v = [ZERO; MAX_MATERIALS];
+    // (A few expressions use a small array: zeroing all MAX_MATERIALS
+    // intervals, a kilobyte, cost more than the bounds of a two-way grade.)
     let n = exprs.len();
+    let (mut small, mut all);
+    let v: &mut [Interval] = if n <= SMALL_GRADE {
+        small = [ZERO; SMALL_GRADE];
+        &mut small[..n]
+    } else {
+        all = [ZERO; MAX_MATERIALS];
+        &mut all[..n.min(MAX_MATERIALS)]
+    };
     for (vi, e) in v.iter_mut().zip(exprs) {
         let i = e.eval_interval(slots);
         if !(i.lo.is_finite() && i.hi.is_finite()) {
@@ -280,10 +292,8 @@ fn normalised_bounds(
         }
         *vi = Interval::new(i.lo.max(0.0), i.hi.max(0.0));
     }
-    let (sum_lo, sum_hi) = v[..n]
-        .iter()
-        .fold((0.0, 0.0), |(l, h), x| (l + x.lo, h + x.hi));
-    for (vi, &m) in v[..n].iter().zip(mats) {
+    let (sum_lo, sum_hi) = v.iter().fold((0.0, 0.0), |(l, h), x| (l + x.lo, h + x.hi));
+    for (vi, &m) in v.iter().zip(mats) {
         let (others_lo, others_hi) = (sum_lo - vi.lo, sum_hi - vi.hi);
         let lo = if vi.lo > 0.0 {
             vi.lo / (vi.lo + others_hi.max(0.0))
