@@ -3,9 +3,9 @@
 //! ear cutting and edge flips.
 //!
 //! Why not spade here: most outlines of an imported mesh's faces are one
-//! loop of a few dozen points, and spade's general bulk load (hull,
-//! buckets, constraint insertion by walking) costs several times what
-//! these steps do on so few points.
+//! loop of a few dozen points, where spade's general bulk load (hull,
+//! buckets, constraint insertion by walking) is mostly overhead; see
+//! docs/PERFORMANCE.md, "Contouring", for how to measure both.
 //!
 //! 1. The loop must be simple: no two edges meet but consecutive ones at
 //!    their shared point (a sweep over the edges' boxes, exact tests).

@@ -108,9 +108,9 @@ fn affine_box(b: &Aabb, m: &glam::DMat3, t: DVec3) -> Aabb {
 
 /// Intervals of the coordinate slots over `b` (x y z rho phic r theta phis d).
 /// `used`: the slots the caller's expressions read (bit `i` for slot `i`);
-/// the derived ones are bounded only when some is read (they cost two
-/// interval squares and roots a call: most of a gradient's bounds along
-/// one axis), and are `EVERYTHING` otherwise.
+/// the derived ones are bounded only when some is read (two interval
+/// squares and roots a call, which a gradient along an axis never reads),
+/// and are `EVERYTHING` otherwise.
 pub fn coord_intervals(b: &Aabb, d: Interval, used: u64) -> [Interval; COORD_SLOTS] {
     let x = Interval::new(b.min.x, b.max.x);
     let y = Interval::new(b.min.y, b.max.y);

@@ -275,7 +275,7 @@ fn normalised_bounds(
     out: &mut [Interval],
 ) -> bool {
     // (A few expressions use a small array: zeroing all MAX_MATERIALS
-    // intervals, a kilobyte, cost more than the bounds of a two-way grade.)
+    // intervals, a kilobyte, for every run of a two-way grade is waste.)
     let n = exprs.len();
     let (mut small, mut all);
     let v: &mut [Interval] = if n <= SMALL_GRADE {
