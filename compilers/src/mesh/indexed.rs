@@ -199,7 +199,7 @@ impl IndexedMesh {
                 let (mut repeated, mut open) = (0, 0);
                 for w in start.windows(2) {
                     let list = &mut filed[w[0] as usize..w[1] as usize];
-                    sort_short(list);
+                    list.sort_unstable();
                     let clean = list.len().is_multiple_of(2)
                         && list
                             .chunks_exact(2)
@@ -222,7 +222,7 @@ impl IndexedMesh {
     /// vertex `m` lies in `lo..hi` (see [`Self::edge_report`]).
     fn each_filed(&self, lo: u32, hi: u32, mut file: impl FnMut(u32, u32)) {
         for t in &self.triangles {
-            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+            for (a, b) in sides(t) {
                 let (m, big) = if a < b { (a, b) } else { (b, a) };
                 if a != b && (lo..hi).contains(&m) {
                     file(m, (big << 1) | u32::from(a < b));
@@ -237,7 +237,7 @@ impl IndexedMesh {
         let mut copies: std::collections::HashMap<(u32, u32), [usize; 2]> =
             std::collections::HashMap::new();
         for t in &self.triangles {
-            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+            for (a, b) in sides(t) {
                 if a != b {
                     copies.entry((a.min(b), a.max(b))).or_default()[usize::from(a < b)] += 1;
                 }
@@ -257,27 +257,14 @@ impl IndexedMesh {
     }
 }
 
+/// The directed edges of triangle `t`, in its order.
+fn sides(t: &[u32; 3]) -> [(u32, u32); 3] {
+    [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]
+}
+
 /// Vertex counts up to this file an edge's larger vertex and direction
 /// in one `u32` (`2M + d`).
 const PACKED_VERTICES: usize = 1 << 31;
-
-/// Sorts one vertex's filed entries: a handful by insertion, a long list
-/// (a fan's hub in an imported mesh) by the library's sort.
-fn sort_short(list: &mut [u32]) {
-    if list.len() > 32 {
-        list.sort_unstable();
-        return;
-    }
-    for i in 1..list.len() {
-        let x = list[i];
-        let mut j = i;
-        while j > 0 && list[j - 1] > x {
-            list[j] = list[j - 1];
-            j -= 1;
-        }
-        list[j] = x;
-    }
-}
 
 /// `(repeated, open)` of one vertex's sorted entries (see
 /// [`IndexedMesh::edge_report`]).

@@ -30,7 +30,7 @@ use spade::Point2;
 
 /// Loops with more points than this (a box's long face) take spade's
 /// path: ear cutting tests every remaining non-convex point per ear.
-pub(super) const MAX_POINTS: usize = 256;
+const MAX_POINTS: usize = 256;
 
 const NONE: usize = usize::MAX;
 
@@ -66,9 +66,11 @@ pub(super) fn triangulate(
     Some(mesh.tris)
 }
 
-/// The loop's points in order, counter-clockwise; `None` unless the
-/// edges form one loop through all `n` points.
-fn one_loop(edges: &[[usize; 2]], n: usize, ccw: bool) -> Option<Vec<usize>> {
+/// The loop's points in order, counter-clockwise (`ccw`: the edges
+/// already run so); `None` unless the edges (indices below `n`) form one
+/// loop through all `n` points: each point starts one edge, and following
+/// them from point 0 comes back to it after exactly `n`.
+pub(super) fn one_loop(edges: &[[usize; 2]], n: usize, ccw: bool) -> Option<Vec<usize>> {
     let mut next = vec![NONE; n];
     for &[a, b] in edges {
         if a >= n || b >= n || next[a] != NONE {

@@ -325,32 +325,7 @@ fn convex_strip(pts: &[Point2<f64>], edges: &[[usize; 2]], area2: f64) -> Option
     if n < 3 || edges.len() != n || area2.is_nan() || area2 == 0.0 {
         return None;
     }
-    // One loop: each point starts one edge and ends one, and following the
-    // edges from point 0 comes back after all n.
-    let mut next = vec![usize::MAX; n];
-    let mut ends = vec![false; n];
-    for &[a, b] in edges {
-        if next[a] != usize::MAX || ends[b] {
-            return None;
-        }
-        next[a] = b;
-        ends[b] = true;
-    }
-    let mut ring = Vec::with_capacity(n);
-    let mut v = 0;
-    for k in 0..n {
-        if k > 0 && v == 0 {
-            return None;
-        }
-        ring.push(v);
-        v = next[v];
-    }
-    if v != 0 {
-        return None;
-    }
-    if area2 < 0.0 {
-        ring.reverse();
-    }
+    let mut ring = loop_cdt::one_loop(edges, n, area2 > 0.0)?;
     let at = |i: usize| robust::Coord {
         x: pts[i].x,
         y: pts[i].y,
