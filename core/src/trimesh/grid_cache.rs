@@ -4,11 +4,21 @@
 //! The candidate grid is most of a large mesh's load time (every surface
 //! cell's exact distance and list). It depends on the triangles and the
 //! build constants alone, so the file is named by a hash of the vertex
-//! bits, the triangles, [`FORMAT`] and `candidates::SHAPE`. Nothing read
-//! is trusted: the file holds the mesh it was built from, compared exactly
-//! (a hash collision is caught); a checksum over the whole file catches a
-//! torn or corrupted one; and every length, index and list bound is checked
-//! against the mesh before use. Any failure rebuilds and rewrites.
+//! bits, the triangles as given, [`FORMAT`] and `candidates::SHAPE`, and
+//! it is read while the mesh is built. Nothing read is trusted: the file
+//! holds the mesh it was built from, compared exactly (a hash collision is
+//! caught); checksums over every byte catch a torn or corrupted one; and
+//! every length, index and list bound is checked against the mesh before
+//! use. Any failure rebuilds and rewrites.
+//!
+//! Layout (little-endian): a preamble (magic, format, key, and the lengths
+//! of the three sections), the head (the mesh, the coarse grid, the
+//! candidate grid's shape), the candidate grid's records and items
+//! (`u32`s), then each section's checksum. The arrays are read straight
+//! into their vectors a megabyte at a time on every core, each block
+//! hashed as it arrives: reading the whole file into one buffer and then
+//! decoding it copied every byte twice on one core, most of a cached
+//! mesh's load.
 //!
 //! Writes go to a temporary name in the same folder and are renamed into
 //! place (atomic on POSIX), so a reader never sees half a file; the folder
@@ -17,7 +27,7 @@
 //! not depend on whether the cache was warm.
 
 use std::fs;
-use std::io::Write;
+use std::io::{Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
@@ -32,7 +42,12 @@ use crate::spatial::cells::CellLattice;
 
 const MAGIC: &[u8; 8] = b"VCADGRID";
 /// Bumped whenever the file layout or what the grids mean changes.
-const FORMAT: u32 = 2;
+const FORMAT: u32 = 3;
+/// Bytes before the head: magic, format, key, and the lengths of the head
+/// (bytes) and of the records and items (`u32`s).
+const PREAMBLE: usize = 8 + 4 + 8 + 3 * 8;
+/// Bytes read and hashed apiece (see [`section_sum`]).
+const BLOCK: usize = 1 << 20;
 /// Meshes with fewer triangles build faster than a file is found and read.
 const MIN_TRIANGLES: usize = 1000;
 /// Bound on the folder's size (the bunny's grids are about 23 MB: `ls -l` the
@@ -60,21 +75,40 @@ pub(super) fn dir() -> Option<PathBuf> {
     Some(base.join("mesh-grids"))
 }
 
-/// Sets `mesh`'s coarse and candidate grids: read from `dir` when a valid
-/// file is there, else built (and written there when `dir` is given).
-pub(super) fn attach(mesh: &mut TriangleMesh, dir: Option<&Path>) {
-    let slot = dir
-        .filter(|_| mesh.triangles.len() >= MIN_TRIANGLES)
-        .map(|d| d.join(format!("{:016x}.grid", key(mesh))));
-    if let Some(path) = &slot
-        && let Some((coarse, cands)) = read(path, mesh)
+/// Where a mesh's grids are kept: the file named by the key of the mesh
+/// as given (its vertices and triangles before any flip; the grids are a
+/// function of them), in the cache folder.
+pub(super) struct Slot {
+    dir: PathBuf,
+    path: PathBuf,
+    key: u64,
+}
+
+/// The slot of the mesh with these `vertices` and `triangles` in `dir`;
+/// none for small meshes (they build faster than a file is read).
+pub(super) fn slot(vertices: &[DVec3], triangles: &[[u32; 3]], dir: Option<&Path>) -> Option<Slot> {
+    let dir = dir.filter(|_| triangles.len() >= MIN_TRIANGLES)?;
+    let key = key(vertices, triangles);
+    Some(Slot {
+        dir: dir.to_path_buf(),
+        path: dir.join(format!("{key:016x}.grid")),
+        key,
+    })
+}
+
+/// Sets `mesh`'s coarse and candidate grids: from `read` (the slot's
+/// file, read while the mesh was built) when it is a valid file for this
+/// mesh, else built (and written to the slot).
+pub(super) fn attach(mesh: &mut TriangleMesh, slot: Option<Slot>, read: Option<Sections>) {
+    if let Some(slot) = &slot
+        && let Some((coarse, cands)) = read.and_then(|r| decode(r, slot.key, mesh))
     {
         mesh.coarse = coarse;
         mesh.candidates = cands;
         // Recently used: the trim keeps it (a failure only ages it).
         let _ = fs::File::options()
             .append(true)
-            .open(path)
+            .open(&slot.path)
             .and_then(|f| f.set_modified(SystemTime::now()));
         return;
     }
@@ -82,23 +116,24 @@ pub(super) fn attach(mesh: &mut TriangleMesh, dir: Option<&Path>) {
         mesh.signed_distance(p)
     });
     mesh.candidates = CandidateGrid::new(mesh);
-    if let (Some(path), Some(d)) = (slot, dir) {
+    if let Some(slot) = slot {
         // The cache only saves time: a full disk or a read-only home
         // leaves the export as it was.
-        let _ = write(d, &path, mesh).map(|()| trim(d, MAX_BYTES));
+        let _ = write(&slot, mesh).map(|()| trim(&slot.dir, MAX_BYTES));
     }
 }
 
-/// Hash of the mesh and of everything that shapes its grids.
-fn key(mesh: &TriangleMesh) -> u64 {
+/// Hash of a mesh's vertices and triangles and of everything that shapes
+/// its grids.
+fn key(vertices: &[DVec3], triangles: &[[u32; 3]]) -> u64 {
     let mut h = Hash::new();
     h.word(u64::from(FORMAT));
     candidates::SHAPE.iter().for_each(|c| h.word(c.to_bits()));
-    h.word(mesh.vertices.len() as u64);
-    mesh.vertices
+    h.word(vertices.len() as u64);
+    vertices
         .iter()
         .for_each(|v| v.to_array().iter().for_each(|c| h.word(c.to_bits())));
-    mesh.triangles.iter().for_each(|t| {
+    triangles.iter().for_each(|t| {
         h.word(u64::from(t[0]) | (u64::from(t[1]) << 32));
         h.word(u64::from(t[2]));
     });
@@ -143,59 +178,84 @@ impl Hash {
     }
 }
 
-/// The file's bytes for `mesh`'s grids.
-fn encode(mesh: &TriangleMesh) -> Vec<u8> {
-    let mut w = Vec::with_capacity(
-        64 + mesh
-            .candidates
-            .as_ref()
-            .map_or(0, |g| 4 * (g.records.len() + g.items.len())),
-    );
-    w.extend_from_slice(MAGIC);
-    put_u32(&mut w, FORMAT);
-    put_u64(&mut w, key(mesh));
-    put_u64(&mut w, mesh.vertices.len() as u64);
-    mesh.vertices.iter().for_each(|v| put_vec(&mut w, *v));
-    put_u64(&mut w, mesh.triangles.len() as u64);
+/// The file for `mesh`'s grids (keyed `key`): the preamble and head,
+/// then the candidate grid's records and items, then the three sections'
+/// checksums.
+fn encode(mesh: &TriangleMesh, key: u64) -> Vec<u8> {
+    let mut head = Vec::new();
+    put_u64(&mut head, mesh.vertices.len() as u64);
+    mesh.vertices.iter().for_each(|v| put_vec(&mut head, *v));
+    put_u64(&mut head, mesh.triangles.len() as u64);
     mesh.triangles
         .iter()
-        .for_each(|t| t.iter().for_each(|&i| put_u32(&mut w, i)));
+        .for_each(|t| t.iter().for_each(|&i| put_u32(&mut head, i)));
     match &mesh.coarse {
-        None => w.push(0),
+        None => head.push(0),
         Some(c) => {
-            w.push(1);
-            put_vec(&mut w, c.origin);
-            put_f64(&mut w, c.cell);
-            c.dims.iter().for_each(|&n| put_u64(&mut w, n as u64));
-            put_u64(&mut w, c.d.len() as u64);
-            c.d.iter().for_each(|&x| put_f64(&mut w, x));
+            head.push(1);
+            put_vec(&mut head, c.origin);
+            put_f64(&mut head, c.cell);
+            c.dims.iter().for_each(|&n| put_u64(&mut head, n as u64));
+            put_u64(&mut head, c.d.len() as u64);
+            c.d.iter().for_each(|&x| put_f64(&mut head, x));
         }
     }
-    match &mesh.candidates {
-        None => w.push(0),
+    let (records, items): (&[u32], &[u32]) = match &mesh.candidates {
+        None => {
+            head.push(0);
+            (&[], &[])
+        }
         Some(g) => {
-            w.push(1);
-            put_vec(&mut w, g.cells.origin());
-            put_vec(&mut w, g.cells.cell());
+            head.push(1);
+            put_vec(&mut head, g.cells.origin());
+            put_vec(&mut head, g.cells.cell());
             g.cells
                 .dims()
                 .iter()
-                .for_each(|&n| put_u64(&mut w, n as u64));
-            for list in [&g.records, &g.items] {
-                put_u64(&mut w, list.len() as u64);
-                w.reserve(4 * list.len());
-                list.iter().for_each(|&x| put_u32(&mut w, x));
-            }
-            put_u32(&mut w, g.slot_bits);
-            put_u32(&mut w, g.q_shift);
-            put_f64(&mut w, g.inv_unit);
-            put_f64(&mut w, g.tiny);
+                .for_each(|&n| put_u64(&mut head, n as u64));
+            put_u32(&mut head, g.slot_bits);
+            put_u32(&mut head, g.q_shift);
+            put_f64(&mut head, g.inv_unit);
+            put_f64(&mut head, g.tiny);
+            (&g.records, &g.items)
         }
+    };
+    let mut w = Vec::with_capacity(PREAMBLE + head.len() + 4 * (records.len() + items.len()) + 24);
+    w.extend_from_slice(MAGIC);
+    put_u32(&mut w, FORMAT);
+    put_u64(&mut w, key);
+    for n in [head.len(), records.len(), items.len()] {
+        put_u64(&mut w, n as u64);
     }
-    let mut h = Hash::new();
-    h.bytes(&w);
-    put_u64(&mut w, h.finish());
+    w.extend_from_slice(&head);
+    let mut sums = vec![section_sum(&w)];
+    for list in [records, items] {
+        let at = w.len();
+        list.iter().for_each(|&x| put_u32(&mut w, x));
+        sums.push(section_sum(&w[at..]));
+    }
+    sums.iter().for_each(|&x| put_u64(&mut w, x));
     w
+}
+
+/// A section's checksum: the hash of its [`BLOCK`]s' hashes and its
+/// length, so that a reader hashes blocks on every core as they arrive.
+fn section_sum(bytes: &[u8]) -> u64 {
+    let blocks: Vec<u64> = bytes.par_chunks(BLOCK).map(block_sum).collect();
+    fold_sums(&blocks, bytes.len())
+}
+
+fn block_sum(block: &[u8]) -> u64 {
+    let mut h = Hash::new();
+    h.bytes(block);
+    h.finish()
+}
+
+fn fold_sums(blocks: &[u64], len: usize) -> u64 {
+    let mut h = Hash::new();
+    blocks.iter().for_each(|&b| h.word(b));
+    h.word(len as u64);
+    h.finish()
 }
 
 fn put_u32(w: &mut Vec<u8>, x: u32) {
@@ -211,16 +271,19 @@ fn put_vec(w: &mut Vec<u8>, v: DVec3) {
     v.to_array().iter().for_each(|&x| put_f64(w, x));
 }
 
-/// Writes `mesh`'s grids to `path` through a temporary file in `dir`.
-fn write(dir: &Path, path: &Path, mesh: &TriangleMesh) -> std::io::Result<()> {
-    fs::create_dir_all(dir)?;
+/// Writes `mesh`'s grids to the slot's file through a temporary file in
+/// its folder.
+fn write(slot: &Slot, mesh: &TriangleMesh) -> std::io::Result<()> {
+    fs::create_dir_all(&slot.dir)?;
     let nanos = SystemTime::now()
         .duration_since(SystemTime::UNIX_EPOCH)
         .map_or(0, |d| d.subsec_nanos());
-    let tmp = dir.join(format!(".{}-{nanos}.tmp", std::process::id()));
+    let tmp = slot
+        .dir
+        .join(format!(".{}-{nanos}.tmp", std::process::id()));
     let done = fs::File::create(&tmp)
-        .and_then(|mut f| f.write_all(&encode(mesh)))
-        .and_then(|()| fs::rename(&tmp, path));
+        .and_then(|mut f| f.write_all(&encode(mesh, slot.key)))
+        .and_then(|()| fs::rename(&tmp, &slot.path));
     if done.is_err() {
         let _ = fs::remove_file(&tmp);
     }
@@ -260,30 +323,104 @@ pub(super) fn trim(dir: &Path, max_bytes: u64) {
     }
 }
 
-/// The grids in `path` when it is a valid file for `mesh`.
-fn read(path: &Path, mesh: &TriangleMesh) -> Option<(Option<CoarseGrid>, Option<CandidateGrid>)> {
-    let bytes = fs::read(path).ok()?;
-    let (body, sum) = bytes.split_at_checked(bytes.len().checked_sub(8)?)?;
-    let sum = u64::from_le_bytes(sum.try_into().ok()?);
-    // The checksum beside the decoding, which trusts nothing either: what
-    // it built is dropped unless the checksum holds.
-    let (intact, grids) = rayon::join(
-        || {
-            let mut h = Hash::new();
-            h.bytes(body);
-            h.finish() == sum
-        },
-        || decode(body, mesh),
-    );
-    grids.filter(|_| intact)
+/// A cache file's sections as read, each matching its checksum; whether
+/// they describe the mesh is checked by [`decode`].
+pub(super) struct Sections {
+    /// The preamble and the head.
+    head: Vec<u8>,
+    records: Vec<u32>,
+    items: Vec<u32>,
 }
 
-/// Parses and checks a file's body (its checksum is checked beside this).
-fn decode(body: &[u8], mesh: &TriangleMesh) -> Option<(Option<CoarseGrid>, Option<CandidateGrid>)> {
-    let mut r = Reader { b: body, at: 0 };
-    if r.take(8)? != MAGIC || r.u32()? != FORMAT || r.u64()? != key(mesh) {
+/// The slot's file, read a [`BLOCK`] at a time on every core straight into
+/// its arrays (no copy of the whole file first), each block hashed as it
+/// arrives; `None` when it is missing, of the wrong length or format, or
+/// a checksum fails.
+pub(super) fn load(slot: &Slot) -> Option<Sections> {
+    let mut f = fs::File::open(&slot.path).ok()?;
+    let len = f.metadata().ok()?.len();
+    let mut pre = [0u8; PREAMBLE];
+    f.read_exact(&mut pre).ok()?;
+    let mut r = Reader { b: &pre, at: 0 };
+    if r.take(8)? != MAGIC || r.u32()? != FORMAT || r.u64()? != slot.key {
         return None;
     }
+    let (head, records, items) = (r.u64()?, r.u64()?, r.u64()?);
+    let head = (PREAMBLE as u64).checked_add(head)?;
+    let records_at = head;
+    let items_at = records_at.checked_add(records.checked_mul(4)?)?;
+    let sums_at = items_at.checked_add(items.checked_mul(4)?)?;
+    if sums_at.checked_add(24)? != len {
+        return None;
+    }
+    let mut sums = [0u8; 24];
+    f.seek(SeekFrom::Start(sums_at)).ok()?;
+    f.read_exact(&mut sums).ok()?;
+    let sum = |i: usize| u64::from_le_bytes(sums[8 * i..8 * i + 8].try_into().unwrap_or_default());
+    let path = &slot.path;
+    let ((head, records), items) = rayon::join(
+        || {
+            rayon::join(
+                || read_section::<u8>(path, 0, usize::try_from(head).ok()?, sum(0)),
+                || read_section::<u32>(path, records_at, usize::try_from(records).ok()?, sum(1)),
+            )
+        },
+        || read_section::<u32>(path, items_at, usize::try_from(items).ok()?, sum(2)),
+    );
+    Some(Sections {
+        head: head?,
+        records: records?,
+        items: items?,
+    })
+}
+
+/// `n` little-endian elements at byte `at` of the file at `path`, when
+/// their checksum is `sum`. Each block is read through a handle of its
+/// own (portable, and no shared file position); a file replaced or cut
+/// short meanwhile fails a read or the checksum.
+fn read_section<T: bytemuck::Pod + Send + Sync>(
+    path: &Path,
+    at: u64,
+    n: usize,
+    sum: u64,
+) -> Option<Vec<T>> {
+    let mut v = vec![T::zeroed(); n];
+    let per = BLOCK / std::mem::size_of::<T>();
+    let blocks: Option<Vec<u64>> = v
+        .par_chunks_mut(per)
+        .enumerate()
+        .map(|(i, chunk)| {
+            let bytes: &mut [u8] = bytemuck::cast_slice_mut(chunk);
+            let mut f = fs::File::open(path).ok()?;
+            f.seek(SeekFrom::Start(at + (i * BLOCK) as u64)).ok()?;
+            f.read_exact(bytes).ok()?;
+            Some(block_sum(bytes))
+        })
+        .collect();
+    (fold_sums(&blocks?, n * std::mem::size_of::<T>()) == sum).then_some(v)
+}
+
+/// The grids of a file's `sections` when they were built for `mesh`
+/// (keyed `key`); nothing read is trusted.
+fn decode(
+    sections: Sections,
+    key: u64,
+    mesh: &TriangleMesh,
+) -> Option<(Option<CoarseGrid>, Option<CandidateGrid>)> {
+    let Sections {
+        head,
+        mut records,
+        mut items,
+    } = sections;
+    if cfg!(target_endian = "big") {
+        records.iter_mut().for_each(|x| *x = u32::from_le(*x));
+        items.iter_mut().for_each(|x| *x = u32::from_le(*x));
+    }
+    let mut r = Reader { b: &head, at: 0 };
+    if r.take(8)? != MAGIC || r.u32()? != FORMAT || r.u64()? != key {
+        return None;
+    }
+    r.take(24)?;
     // The mesh it was built from, exactly.
     if r.u64()? != mesh.vertices.len() as u64 || mesh.vertices.iter().any(|v| r.vec() != Some(*v)) {
         return None;
@@ -302,11 +439,11 @@ fn decode(body: &[u8], mesh: &TriangleMesh) -> Option<(Option<CoarseGrid>, Optio
         _ => return None,
     };
     let cands = match r.u8()? {
-        0 => None,
-        1 => Some(candidate_grid(&mut r, mesh)?),
+        0 if records.is_empty() && items.is_empty() => None,
+        1 => Some(candidate_grid(&mut r, records, items, mesh)?),
         _ => return None,
     };
-    (r.at == body.len()).then_some((coarse, cands))
+    (r.at == head.len()).then_some((coarse, cands))
 }
 
 fn coarse(r: &mut Reader) -> Option<CoarseGrid> {
@@ -324,9 +461,13 @@ fn coarse(r: &mut Reader) -> Option<CoarseGrid> {
     })
 }
 
-fn candidate_grid(r: &mut Reader, mesh: &TriangleMesh) -> Option<CandidateGrid> {
+fn candidate_grid(
+    r: &mut Reader,
+    records: Vec<u32>,
+    items: Vec<u32>,
+    mesh: &TriangleMesh,
+) -> Option<CandidateGrid> {
     let (min, cell, dims) = (r.vec()?, r.vec()?, r.dims()?);
-    let (records, items) = (r.u32s()?, r.u32s()?);
     let (slot_bits, q_shift) = (r.u32()?, r.u32()?);
     let (inv_unit, tiny) = (r.f64()?, r.f64()?);
     let positive = |x: f64| x.is_finite() && x > 0.0;
@@ -419,14 +560,6 @@ impl Reader<'_> {
     fn array(&mut self, size: usize) -> Option<&[u8]> {
         let n = usize::try_from(self.u64()?).ok()?;
         self.take(n.checked_mul(size)?)
-    }
-    fn u32s(&mut self) -> Option<Vec<u32>> {
-        let b = self.array(4)?;
-        Some(
-            b.par_chunks_exact(4)
-                .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-                .collect(),
-        )
     }
     fn f64s(&mut self) -> Option<Vec<f64>> {
         let b = self.array(8)?;

@@ -287,7 +287,7 @@ impl TriangleMesh {
     /// (none: always built).
     pub(crate) fn from_triangles_cached(
         vertices: Vec<DVec3>,
-        mut triangles: Vec<[u32; 3]>,
+        triangles: Vec<[u32; 3]>,
         cache: Option<&Path>,
     ) -> Result<TriangleMesh, MeshError> {
         if triangles.is_empty() {
@@ -306,6 +306,19 @@ impl TriangleMesh {
                 });
             }
         }
+        // The cached grids' file is read while the mesh is built.
+        let slot = grid_cache::slot(&vertices, &triangles, cache);
+        let (mut mesh, read) = rayon::join(
+            || Self::assemble(vertices, triangles),
+            || slot.as_ref().and_then(grid_cache::load),
+        );
+        grid_cache::attach(&mut mesh, slot, read);
+        Ok(mesh)
+    }
+
+    /// The mesh of valid `vertices` and `triangles` (flipped when inside
+    /// out), without its grids.
+    fn assemble(vertices: Vec<DVec3>, mut triangles: Vec<[u32; 3]>) -> TriangleMesh {
         let prep = |tris: &[[u32; 3]]| -> Vec<Tri> {
             tris.iter()
                 .map(|t| {
@@ -358,7 +371,7 @@ impl TriangleMesh {
             }
         });
         let bbox = boxes.iter().fold(Aabb::EMPTY, |acc, b| acc.union(b));
-        let mut mesh = TriangleMesh {
+        TriangleMesh {
             vertices,
             triangles,
             nodes: tree.nodes,
@@ -372,9 +385,7 @@ impl TriangleMesh {
             topology,
             bbox,
             warnings,
-        };
-        grid_cache::attach(&mut mesh, cache);
-        Ok(mesh)
+        }
     }
 
     /// Axis-aligned bounds of the triangles.
