@@ -438,11 +438,13 @@ fn sampled_triangles(model: &Model, grid: Grid, classifier: &Classifier) -> u64 
             return 0;
         }
         let mut contourer = Contourer::new(grid, classifier.segments(), classifier.interface());
-        // Both planes share the slab's distances, as in the export.
+        // Both planes share the slab's distances, as in the export. The
+        // contourer numbers them 0 and 1: its plane `k` is layer `z + k`.
         let dist = std::sync::Arc::new(std::mem::take(&mut slab.dist));
-        for (l, z) in [(0, z), (1, z + 1)] {
-            let plane = classifier.plane_into(&slab, &dist, l, dims, z, Plane::default());
-            contourer.push_plane(l, plane.0, &|[i, j, k]| sampler.evaluate([i, j, z + k]));
+        let exact = |[i, j, k]: [usize; 3]| sampler.evaluate([i, j, z + k]);
+        for l in 0..2 {
+            let plane = classifier.plane_into(&slab, &dist, l, dims, z + l, Plane::default());
+            contourer.push_plane(l, plane.0, &exact);
         }
         made += contourer.triangles();
     }
