@@ -18,7 +18,7 @@ use std::time::Instant;
 use glam::DVec3;
 use volcad_compilers::dither::Diffuser;
 use volcad_compilers::job;
-use volcad_compilers::lazy_random::choose_random_row;
+use volcad_compilers::lazy_random::{RunMemo, choose_random_row};
 use volcad_compilers::mesh::{MeshFormats, MeshParams, SegmentBy, export_meshes, segment_meshes};
 use volcad_compilers::png_stack::{Dither, PngParams, export_png_stack};
 use volcad_core::Model;
@@ -87,20 +87,25 @@ fn stage_times(model: &Model, voxel: f64, dither: Dither) -> (u64, f64, f64) {
                 Dither::Random => {
                     use rayon::prelude::*;
                     let lazy = slab.rect_rows(z + l, nx, ny);
-                    codes.par_chunks_mut(nx).enumerate().for_each(|(y, c)| {
-                        let v = y * nx;
-                        choose_random_row(
-                            model,
-                            &grid,
-                            1,
-                            [y, z + l],
-                            &d[v..v + nx],
-                            &f[v * k..(v + nx) * k],
-                            k,
-                            lazy.row(y),
-                            c,
-                        );
-                    });
+                    let shared = RunMemo::applies(model);
+                    codes.par_chunks_mut(nx).enumerate().for_each_init(
+                        RunMemo::default,
+                        |memo, (y, c)| {
+                            let v = y * nx;
+                            choose_random_row(
+                                model,
+                                &grid,
+                                1,
+                                [y, z + l],
+                                &d[v..v + nx],
+                                &f[v * k..(v + nx) * k],
+                                k,
+                                lazy.row(y),
+                                c,
+                                shared.then_some(memo),
+                            );
+                        },
+                    );
                 }
                 Dither::Diffusion => diffuser.layer(z + l, d, f, &mut codes),
             }

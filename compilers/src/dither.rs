@@ -10,10 +10,10 @@
 //!
 //! * **Random** ([`choose_random`]): a counter-based generator keyed by the
 //!   seed and the voxel's *global* index `n = (z·ny + y)·nx + x` (grid
-//!   indices, `y` not flipped): `h = mix(seed + (n + 1)·γ)`, the `n`-th
-//!   SplitMix64 output, `u = (h >> 40) / 2²⁴ ∈ [0, 1)`; the material is the
-//!   first `i` with `u·T < Σ_{j ≤ i} f_j`. No state, so any voxel can be
-//!   computed alone: layers, rows and threads are independent.
+//!   indices, `y` not flipped) draws `u ∈ [0, 1)` ([`crate::draws`]); the
+//!   material is the first `i` with `u·T < Σ_{j ≤ i} f_j`. No state, so
+//!   any voxel can be computed alone: layers, rows and threads are
+//!   independent.
 //! * **Error diffusion** ([`Diffuser`]): vector error diffusion in 3D. Each
 //!   voxel picks the material with the largest target
 //!   `t_i = f_i / T + e_i` (incoming error `e`, ties to the lowest slot), and
@@ -99,12 +99,6 @@ pub fn splitmix64(seed: u64, index: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-/// A uniform number in `[0, 1)` from the top 24 bits of a hash (exact in f32).
-#[inline]
-pub(crate) fn unit_f32(h: u64) -> f32 {
-    (h >> 40) as f32 * (1.0 / 16_777_216.0)
-}
-
 /// Random choice for a run of consecutive voxels whose first voxel has global
 /// index `first_index`; `dist` and `out` have one entry per voxel, `fracs`
 /// `k` per voxel.
@@ -116,14 +110,13 @@ pub fn choose_random(
     k: usize,
     out: &mut [u8],
 ) {
-    for (v, o) in out.iter_mut().enumerate() {
-        *o = if dist[v] > 0.0 {
+    crate::draws::each(seed, first_index, out.len(), |v, r| {
+        out[v] = if dist[v] > 0.0 {
             0
         } else {
-            let r = unit_f32(splitmix64(seed, first_index + v as u64));
             pick_random(&fracs[v * k..(v + 1) * k], r)
         };
-    }
+    });
 }
 
 /// The code of an inside voxel with fractions `f` for the uniform number
@@ -425,7 +418,7 @@ mod tests {
                 assert_eq!(out[v], 0);
                 continue;
             }
-            let u = unit_f32(splitmix64(5, 1000 + v as u64)) * total;
+            let u = crate::draws::draw(5, 1000 + v as u64) * total;
             let mut acc = 0.0;
             let mut want = f.iter().rposition(|x| *x > 0.0).unwrap();
             for (i, fi) in f.iter().enumerate() {

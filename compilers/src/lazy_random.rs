@@ -23,7 +23,8 @@ use volcad_core::interval::Interval;
 use volcad_core::model::MAX_MATERIALS;
 use volcad_core::sampler::{Grid, RowSpan};
 
-use crate::dither::{BOUND_MARGIN as EPS, MIN_TOTAL, pick_random, splitmix64, unit_f32};
+use crate::dither::{BOUND_MARGIN as EPS, MIN_TOTAL, pick_random};
+use crate::draws::{mix32, unit};
 /// Longest run of voxels bounded together (a sampler tile's width).
 const RUN: usize = 32;
 
@@ -80,14 +81,24 @@ impl Shares {
         Self::count(&self.lo[..self.k], &self.hi[..self.k], r)
     }
 
-    /// The first `K` bounds by value, for [`Shares::count`] with `K` known
-    /// to the compiler: the loop unrolls and the bounds stay in registers
-    /// (with a run-time `k`, picking is a loop of unknown length per voxel).
+    /// The first `K` bounds by value, rounded outwards to `f32`, for
+    /// [`decide`] with `K` known to the compiler: the loop over voxels
+    /// vectorises with the bounds in registers. Rounded outwards, they
+    /// settle a pick only where the `f64` bounds settle it (the same pick),
+    /// and leave a few more open.
     #[inline(always)]
-    fn first<const K: usize>(&self) -> ([f64; K], [f64; K]) {
+    fn first<const K: usize>(&self) -> ([f32; K], [f32; K]) {
+        let down = |x: f64| {
+            let y = x as f32;
+            if f64::from(y) > x { y.next_down() } else { y }
+        };
+        let up = |x: f64| {
+            let y = x as f32;
+            if f64::from(y) < x { y.next_up() } else { y }
+        };
         (
-            std::array::from_fn(|j| self.lo[j]),
-            std::array::from_fn(|j| self.hi[j]),
+            std::array::from_fn(|j| down(self.lo[j])),
+            std::array::from_fn(|j| up(self.hi[j])),
         )
     }
 
@@ -110,13 +121,54 @@ impl Shares {
     }
 }
 
+/// Share bounds of the runs a worker has bounded, by their columns. Where
+/// the fractions vary along x alone ([`Model::fraction_axes`]), a run's
+/// bounds hold for every run over the same columns, so each row takes
+/// those of the rows before it instead of bounding its runs again.
+#[derive(Default)]
+pub struct RunMemo {
+    /// `(first column, end column, shares)`, by columns; `None` where the
+    /// bounds could not be used.
+    runs: Vec<(usize, usize, Option<Shares>)>,
+}
+
+impl RunMemo {
+    /// Whether runs of `model` may share their bounds so: its fractions
+    /// vary along neither y nor z.
+    pub fn applies(model: &Model) -> bool {
+        let [_, y, z] = model.fraction_axes();
+        !(y || z)
+    }
+
+    /// The shares of the run over columns `x0..end`, filled by `fill` (its
+    /// success) the first time.
+    fn get(
+        &mut self,
+        x0: usize,
+        end: usize,
+        fill: impl FnOnce(&mut Shares) -> bool,
+    ) -> Option<&Shares> {
+        let i = match self.runs.binary_search_by_key(&(x0, end), |r| (r.0, r.1)) {
+            Ok(i) => i,
+            Err(i) => {
+                let mut s = Shares::EMPTY;
+                let ok = fill(&mut s);
+                self.runs.insert(i, (x0, end, ok.then_some(s)));
+                i
+            }
+        };
+        self.runs[i].2.as_ref()
+    }
+}
+
 /// Random picks for row `y` of layer `z` (`out` and `dist` one per voxel of
 /// the row, `fracs` `k` per voxel): as [`crate::dither::choose_random`],
 /// with lazy voxels' fractions bounded per run and evaluated only where
 /// the bounds leave the pick open. Lazy: the voxels of `lazy_spans` (the
 /// row's runs of the sampler's lazy rectangles, whose entries in `fracs`
-/// are not written) and inside voxels whose fractions are `NaN`. Returns
-/// how many lazy voxels were evaluated.
+/// are not written) and inside voxels whose fractions are `NaN`. `memo`:
+/// the worker's bounded runs, only where the model's fractions vary along
+/// x alone. Returns how many lazy voxels were evaluated.
 #[allow(clippy::too_many_arguments)]
 pub fn choose_random_row(
     model: &Model,
@@ -128,6 +180,7 @@ pub fn choose_random_row(
     k: usize,
     lazy_spans: &[RowSpan],
     out: &mut [u8],
+    memo: Option<&mut RunMemo>,
 ) -> usize {
     let nx = grid.dims[0];
     let mut row = Row {
@@ -142,6 +195,7 @@ pub fn choose_random_row(
         f: [0.0; MAX_MATERIALS],
         f32s: [0.0; MAX_MATERIALS],
         shares: Shares::EMPTY,
+        memo,
         evaluated: 0,
     };
     // Outside the rectangles, an inside voxel marked `NaN` is lazy.
@@ -171,6 +225,7 @@ struct Row<'a> {
     f: [f64; MAX_MATERIALS],
     f32s: [f32; MAX_MATERIALS],
     shares: Shares,
+    memo: Option<&'a mut RunMemo>,
     evaluated: usize,
 }
 
@@ -202,10 +257,15 @@ impl Row<'_> {
                 .unwrap_or((x + RUN).min(xs.end));
             let b =
                 volcad_core::Aabb::new(self.grid.center(x, y, z), self.grid.center(end - 1, y, z));
-            let sums = (self.model.fraction_bounds(&b, &mut self.iv[..k])
-                && self.shares.set(&self.iv[..k]))
-            .then_some(&self.shares);
-            let (model, grid, evaluated) = (self.model, self.grid, &mut self.evaluated);
+            let (model, iv) = (self.model, &mut self.iv);
+            let sums = match &mut self.memo {
+                Some(m) => m.get(x, end, |s| {
+                    model.fraction_bounds(&b, &mut iv[..k]) && s.set(&iv[..k])
+                }),
+                None => (model.fraction_bounds(&b, &mut iv[..k]) && self.shares.set(&iv[..k]))
+                    .then_some(&self.shares),
+            };
+            let (grid, evaluated) = (self.grid, &mut self.evaluated);
             let (f, f32s) = (&mut self.f, &mut self.f32s);
             let x0 = x;
             let mut open = |i: usize, r: f32| {
@@ -240,16 +300,18 @@ fn run(
     decide: impl Fn(f32) -> Option<u8>,
     open: &mut impl FnMut(usize, f32) -> u8,
 ) {
-    for (i, o) in out.iter_mut().enumerate() {
-        let r = unit_f32(splitmix64(seed, first + i as u64));
-        *o = match decide(r) {
+    crate::draws::each(seed, first, out.len(), |i, r| {
+        out[i] = match decide(r) {
             Some(code) => code,
             None => open(i, r),
         };
-    }
+    });
 }
 
-/// [`run`] deciding from `K` shares held by value (see [`Shares::first`]).
+/// [`run`] deciding from `K` shares held by value (see [`Shares::first`]):
+/// every voxel's pick from the bounds first, in one loop with no call or
+/// branch that vectorises (0 where they leave it open), then the open
+/// ones evaluated.
 #[inline(always)]
 fn run_k<const K: usize>(
     s: &Shares,
@@ -259,7 +321,38 @@ fn run_k<const K: usize>(
     open: &mut impl FnMut(usize, f32) -> u8,
 ) {
     let (lo, hi) = s.first::<K>();
-    run(seed, first, out, |r| Shares::count(&lo, &hi, r), open);
+    for (at, key, low, len) in crate::draws::pieces(seed, first, out.len()) {
+        let part = &mut out[at..at + len];
+        decide::<K>(&lo, &hi, key, low, part);
+        for (i, o) in part.iter_mut().enumerate() {
+            if *o == 0 {
+                *o = open(at + i, unit(mix32(key ^ low.wrapping_add(i as u32))));
+            }
+        }
+    }
+}
+
+/// The picks the share bounds `lo`, `hi` settle for the voxels drawing
+/// with `key` from low index `low` on, 0 for those they leave open (as
+/// [`Shares::count`], in `f32`).
+#[inline(always)]
+fn decide<const K: usize>(lo: &[f32; K], hi: &[f32; K], key: u32, low: u32, out: &mut [u8]) {
+    for (i, o) in out.iter_mut().enumerate() {
+        let r = unit(mix32(key ^ low.wrapping_add(i as u32)));
+        let mut pick = 0u8;
+        let mut open = false;
+        for j in 0..K {
+            let below = hi[j] < r;
+            let above = lo[j] > r;
+            pick += u8::from(below);
+            open |= !(below | above);
+        }
+        *o = if open || usize::from(pick) >= K {
+            0
+        } else {
+            pick + 1
+        };
+    }
 }
 
 #[cfg(test)]
@@ -287,6 +380,8 @@ mod tests {
         let (mut a, mut b) = (Slab::default(), Slab::default());
         let (mut ca, mut cb) = (vec![0u8; nx], vec![0u8; nx]);
         let (mut marked, mut evaluated, mut inside) = (0, 0, 0);
+        let mut memo = RunMemo::default();
+        let shared = RunMemo::applies(m);
         // Stale fractions in the reused buffer must not matter where the
         // lazy sampler lists rectangles.
         b.fracs = vec![0.25; nx * ny * k];
@@ -302,7 +397,9 @@ mod tests {
                 crate::dither::choose_random(seed, ((z * ny + y) * nx) as u64, d, f, k, &mut ca);
                 let (d, f) = (&b.dist[y * nx..][..nx], &b.fracs[y * nx * k..][..nx * k]);
                 let spans = rows.row(y);
-                evaluated += choose_random_row(m, &grid, seed, [y, z], d, f, k, spans, &mut cb);
+                let memo = shared.then_some(&mut memo);
+                evaluated +=
+                    choose_random_row(m, &grid, seed, [y, z], d, f, k, spans, &mut cb, memo);
                 assert_eq!(ca, cb, "row {y} of layer {z}");
                 marked += (0..nx)
                     .filter(|&x| {
@@ -322,6 +419,9 @@ mod tests {
             r#"Rotate(10, 20, 30, Vec3(0,0,0), FGrade(["x*x/20", "0.3", "1 - y/8", "z/4 + 0.5"], [m.id("red"), m.id("green"), m.id("blue"), m.id("yellow")], true, Sphere(Vec3(0,0,0), 4, m.id("gray"))))"#,
             // A grade that reaches zero total: void inside the shape.
             r#"FGrade(["x", "0"], [m.id("red"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(6,4,4), m.id("gray")))"#,
+            // Graded along y: each row's runs have bounds of their own (a
+            // run sharing another row's would pick wrongly).
+            r#"FGrade(["y/60+0.5", "-y/60+0.5"], [m.id("red"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(15,10,5), m.id("gray")))"#,
             // Three materials (the picks' other unrolled case; two and
             // four are above).
             r#"FGrade(["x/15+0.5", "0.2", "-x/15+0.5"], [m.id("red"), m.id("green"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(15,10,5), m.id("gray")))"#,

@@ -22,6 +22,7 @@ pub mod bitmaps;
 pub mod color;
 pub mod design;
 pub mod dither;
+pub mod draws;
 mod estimate;
 pub mod mesh;
 pub mod par_deflate;

@@ -540,20 +540,27 @@ fn pick_codes(
             let lazy: Vec<_> = (0..slab.layers)
                 .map(|l| slab.rect_rows(z0 + l, nx, ny))
                 .collect();
-            codes.par_chunks_mut(nx).enumerate().for_each(|(row, c)| {
-                let v = row * nx;
-                lazy_random::choose_random_row(
-                    model,
-                    &grid,
-                    seed,
-                    [row % ny, z0 + row / ny],
-                    &slab.dist[v..v + nx],
-                    &slab.fracs[v * k..(v + nx) * k],
-                    k,
-                    lazy[row / ny].row(row % ny),
-                    c,
-                );
-            })
+            // Runs along x share their bounds from row to row where the
+            // fractions do not vary along y or z.
+            let shared = lazy_random::RunMemo::applies(model);
+            codes.par_chunks_mut(nx).enumerate().for_each_init(
+                lazy_random::RunMemo::default,
+                |memo, (row, c)| {
+                    let v = row * nx;
+                    lazy_random::choose_random_row(
+                        model,
+                        &grid,
+                        seed,
+                        [row % ny, z0 + row / ny],
+                        &slab.dist[v..v + nx],
+                        &slab.fracs[v * k..(v + nx) * k],
+                        k,
+                        lazy[row / ny].row(row % ny),
+                        c,
+                        shared.then_some(memo),
+                    );
+                },
+            )
         }
     }
 }

@@ -84,9 +84,9 @@ pub fn diffuse_layer(
             }
             let pick = match jitter {
                 Some((seed, first)) => {
-                    let h = crate::dither::splitmix64(seed, first + v as u64);
+                    let u = crate::draws::draw(seed, first + v as u64);
                     let mut s = t;
-                    s[0] += JITTER * (2.0 * crate::dither::unit_f32(h) - 1.0);
+                    s[0] += JITTER * (2.0 * u - 1.0);
                     nearest(resins, &s)
                 }
                 None => nearest(resins, &t),

@@ -52,6 +52,31 @@ const MAX_OVERLAPPING: usize = 8;
 pub(crate) const ZERO: Interval = Interval { lo: 0.0, hi: 0.0 };
 
 impl PNode {
+    /// The axes along which the fractions of inside points may vary: none
+    /// for one material; those a grade's expressions read where they read
+    /// `x`, `y` or `z` alone (a derived coordinate or the distance mixes
+    /// the axes), through moves, per-axis scales, tiles, offsets and the
+    /// first child of an intersection or difference (the fractions there
+    /// are the child's at a point moved along each axis alone); every axis
+    /// where this is not known.
+    pub fn fraction_axes(&self) -> [bool; 3] {
+        const ALL: [bool; 3] = [true; 3];
+        if self.leaf_material().is_some() {
+            return [false; 3];
+        }
+        match self {
+            PNode::FGrade(g) if g.used & !0b111 == 0 => [0, 1, 2].map(|i| g.used & (1 << i) != 0),
+            PNode::Translate { child, .. }
+            | PNode::Scale { child, .. }
+            | PNode::Tile { child, .. }
+            | PNode::Offset { child, .. }
+            | PNode::Shell { child, .. } => child.fraction_axes(),
+            PNode::Intersection(n) if !n.blend => n.children[0].fraction_axes(),
+            PNode::Difference { a, .. } => a.fraction_axes(),
+            _ => ALL,
+        }
+    }
+
     /// Bounds of the fractions at the inside points of `b` into `out`
     /// (`[0, 0]` on entry); false when this node cannot bound them.
     pub fn frac_bounds(&self, b: &Aabb, out: &mut [Interval]) -> bool {
@@ -356,6 +381,46 @@ mod tests {
             }
         }
         checked
+    }
+
+    #[test]
+    fn fraction_axes_follow_the_expressions_read() {
+        let cases = [
+            (
+                r#"FGrade(["x/15+0.5", "-x/15+0.5"], [m.id("red"), m.id("blue")], true, RectPrism(Vec3(0,0,0), Vec3(15,10,5), m.id("gray")))"#,
+                [true, false, false],
+            ),
+            (
+                r#"Translate(1, 2, 3, Intersection(false, [FGrade(["z", "1 - z"], [m.id("red"), m.id("blue")], true, Sphere(Vec3(0,0,0), 4, m.id("gray"))), Sphere(Vec3(1,0,0), 4, m.id("gray"))]))"#,
+                [false, false, true],
+            ),
+            (
+                r#"Sphere(Vec3(0,0,0), 4, m.id("gray"))"#,
+                [false, false, false],
+            ),
+            // Turned, a grade along x varies along every axis.
+            (
+                r#"Rotate(0, 0, 30, Vec3(0,0,0), FGrade(["x", "1 - x"], [m.id("red"), m.id("blue")], true, Sphere(Vec3(0,0,0), 4, m.id("gray"))))"#,
+                [true; 3],
+            ),
+            // A derived coordinate or the distance mixes the axes.
+            (
+                r#"FGrade(["rho/4", "1 - rho/4"], [m.id("red"), m.id("blue")], true, Sphere(Vec3(0,0,0), 4, m.id("gray")))"#,
+                [true; 3],
+            ),
+            (
+                r#"FGrade(["-d", "1 + d"], [m.id("red"), m.id("blue")], true, Sphere(Vec3(0,0,0), 4, m.id("gray")))"#,
+                [true; 3],
+            ),
+            // Which child's fractions hold depends on the point.
+            (
+                r#"Union(false, [FGrade(["x", "1 - x"], [m.id("red"), m.id("blue")], true, Sphere(Vec3(0,0,0), 4, m.id("gray"))), Sphere(Vec3(5,0,0), 4, m.id("green"))])"#,
+                [true; 3],
+            ),
+        ];
+        for (src, want) in cases {
+            assert_eq!(model(src).fraction_axes(), want, "{src}");
+        }
     }
 
     #[test]

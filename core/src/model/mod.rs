@@ -413,6 +413,13 @@ impl Model {
         self.root.frac_bounds(b, out)
     }
 
+    /// The axes along which the fractions of inside points may vary
+    /// (`PNode::fraction_axes`): bounds of the fractions over a run of
+    /// voxels along an axis they do not vary along hold for every such run.
+    pub fn fraction_axes(&self) -> [bool; 3] {
+        self.root.fraction_axes()
+    }
+
     /// The fractions every inside point has, into `out` (as an evaluation
     /// writes them), when they do not depend on the point at all (one
     /// material, or a grade of constants); false otherwise.
