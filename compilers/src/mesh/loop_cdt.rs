@@ -297,23 +297,40 @@ impl Mesh {
     /// Side `k` of `t` (a → b, `c` opposite) and the triangle `u` = b a d
     /// across it, with the four outer neighbours; `None` on the outline.
     fn quad(&self, t: usize, k: usize) -> Option<Quad> {
+        let (u, j, corners) = self.across(t, k)?;
+        Some(self.outer(t, k, u, j, corners))
+    }
+
+    /// [`Self::quad`]'s triangle `u`, the side `j` of `u` that is b → a,
+    /// and the corners a b c d, without the outer neighbours: the flips
+    /// read these for every edge they test and the rest only for the few
+    /// they flip.
+    #[inline(always)]
+    fn across(&self, t: usize, k: usize) -> Option<(usize, usize, [usize; 4])> {
         let u = self.nbr[t][k];
         if u == NONE {
             return None;
         }
         let [a, b, c] = [0, 1, 2].map(|i| self.tris[t][(k + i) % 3]);
         let j = self.side_of(u, b, a);
-        Some(Quad {
+        Some((u, j, [a, b, c, self.tris[u][(j + 2) % 3]]))
+    }
+
+    /// The quad of [`Self::across`]'s answer.
+    #[inline(always)]
+    fn outer(&self, t: usize, k: usize, u: usize, j: usize, corners: [usize; 4]) -> Quad {
+        Quad {
             u,
-            corners: [a, b, c, self.tris[u][(j + 2) % 3]],
+            corners,
             t_bc: self.nbr[t][(k + 1) % 3],
             t_ca: self.nbr[t][(k + 2) % 3],
             u_ad: self.nbr[u][(j + 1) % 3],
             u_db: self.nbr[u][(j + 2) % 3],
-        })
+        }
     }
 
     /// The side of `u` that is the edge b → a.
+    #[inline(always)]
     fn side_of(&self, u: usize, b: usize, a: usize) -> usize {
         let t = self.tris[u];
         (0..3)
@@ -458,8 +475,8 @@ impl Mesh {
     /// `d` across it lies strictly in the circle through a, b, c; returns
     /// the other triangle it changed.
     fn flip(&mut self, t: usize, k: usize, at: &impl Fn(usize) -> Coord<f64>) -> Option<usize> {
-        let q = self.quad(t, k)?;
-        let (u, [a, b, c, d]) = (q.u, q.corners);
+        let (u, j, corners) = self.across(t, k)?;
+        let [a, b, c, d] = corners;
         if incircle(at(a), at(b), at(c), at(d)) <= 0.0 {
             return None;
         }
@@ -468,6 +485,7 @@ impl Mesh {
         if orient2d(at(c), at(a), at(d)) <= 0.0 || orient2d(at(d), at(b), at(c)) <= 0.0 {
             return None;
         }
+        let q = self.outer(t, k, u, j, corners);
         self.tris[t] = [c, a, d];
         self.nbr[t] = [q.t_ca, q.u_ad, u];
         self.tris[u] = [d, b, c];
