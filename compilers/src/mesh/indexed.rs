@@ -36,10 +36,12 @@ impl EdgeReport {
     }
 }
 
+#[inline]
 fn f64x3(p: [f32; 3]) -> [f64; 3] {
     p.map(f64::from)
 }
 
+#[inline]
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
@@ -52,6 +54,7 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
+#[inline]
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
@@ -62,7 +65,10 @@ impl IndexedMesh {
         self.triangles.is_empty()
     }
 
-    /// Positions of triangle `t` in f64.
+    /// Positions of triangle `t` in f64. (Inlined: returned through the
+    /// stack, its nine values were reloaded with wider loads than stored,
+    /// a stall per triangle in the writers and checks.)
+    #[inline]
     pub fn corners(&self, t: usize) -> [[f64; 3]; 3] {
         self.triangles[t].map(|i| f64x3(self.vertices[i as usize]))
     }
@@ -131,6 +137,7 @@ impl IndexedMesh {
     }
 
     /// Unit normal of triangle `t` (zero for a degenerate one).
+    #[inline]
     pub fn normal(&self, t: usize) -> [f32; 3] {
         let [a, b, c] = self.corners(t);
         let n = cross(sub(b, a), sub(c, a));
