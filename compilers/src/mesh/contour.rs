@@ -288,7 +288,11 @@ impl Contourer {
         let l = label as usize - 1;
         let plane_len = (self.grid.dims[0] * self.grid.dims[1]) as u64;
         let sample = v.key / KEY_TYPES;
-        let slot = (sample / plane_len - pz as u64) as usize;
+        // The key's sample lies in plane pz or pz + 1 (slot 0 or 1): a
+        // compare, where dividing by the plane's length was a hardware
+        // division a vertex.
+        let rel = sample - pz as u64 * plane_len;
+        let slot = usize::from(rel >= plane_len);
         let mesh = &mut self.meshes[l];
         let add = || {
             mesh.vertices.push(v.pos);
@@ -297,7 +301,7 @@ impl Contourer {
         if !self.one_label {
             return *self.maps[l][slot].entry(v.key).or_insert_with(add);
         }
-        let at = (sample % plane_len) as usize;
+        let at = (rel - slot as u64 * plane_len) as usize;
         self.edges.find_or(slot, at, v.key % KEY_TYPES, add)
     }
 
