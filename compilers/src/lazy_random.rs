@@ -121,6 +121,11 @@ impl Shares {
     }
 }
 
+/// Most runs a [`RunMemo`] keeps (a kilobyte each): runs that start at
+/// the first lazy voxel of a surface tile start anywhere, and a wide grid
+/// has many; a full memo starts over.
+const MAX_RUNS: usize = 4096;
+
 /// Share bounds of the runs a worker has bounded, by their columns. Where
 /// the fractions vary along x alone ([`Model::fraction_axes`]), a run's
 /// bounds hold for every run over the same columns, so each row takes
@@ -150,7 +155,11 @@ impl RunMemo {
     ) -> Option<&Shares> {
         let i = match self.runs.binary_search_by_key(&(x0, end), |r| (r.0, r.1)) {
             Ok(i) => i,
-            Err(i) => {
+            Err(mut i) => {
+                if self.runs.len() >= MAX_RUNS {
+                    self.runs.clear();
+                    i = 0;
+                }
                 let mut s = Shares::EMPTY;
                 let ok = fill(&mut s);
                 self.runs.insert(i, (x0, end, ok.then_some(s)));
@@ -410,6 +419,24 @@ mod tests {
             }
         }
         (marked, evaluated, inside)
+    }
+
+    #[test]
+    fn a_memo_of_many_runs_stays_bounded_and_answers_each() {
+        let mut memo = RunMemo::default();
+        for x0 in 0..3 * MAX_RUNS {
+            let s = memo.get(x0, x0 + 7, |s| {
+                s.k = 2;
+                s.lo[0] = x0 as f64;
+                true
+            });
+            assert_eq!(s.map(|s| s.lo[0]), Some(x0 as f64));
+            assert!(memo.runs.len() <= MAX_RUNS);
+        }
+        // Kept runs are answered without filling again.
+        let last = 3 * MAX_RUNS - 1;
+        let again = memo.get(last, last + 7, |_| panic!("filled twice"));
+        assert_eq!(again.map(|s| s.lo[0]), Some(last as f64));
     }
 
     #[test]
