@@ -16,7 +16,7 @@ use crate::dither::splitmix64;
 
 /// Wellons' "lowbias32" finaliser.
 #[inline(always)]
-pub(crate) fn mix32(mut x: u32) -> u32 {
+fn mix32(mut x: u32) -> u32 {
     x ^= x >> 16;
     x = x.wrapping_mul(0x7feb_352d);
     x ^= x >> 15;
@@ -26,13 +26,13 @@ pub(crate) fn mix32(mut x: u32) -> u32 {
 
 /// The key of the voxels whose global index has high 32 bits `hi`.
 #[inline]
-pub(crate) fn key(seed: u64, hi: u32) -> u32 {
+fn key(seed: u64, hi: u32) -> u32 {
     (splitmix64(seed, u64::from(hi)) >> 32) as u32
 }
 
 /// `u ∈ [0, 1)` from a hash's top 24 bits.
 #[inline(always)]
-pub(crate) fn unit(h: u32) -> f32 {
+fn unit(h: u32) -> f32 {
     (h >> 8) as f32 * (1.0 / 16_777_216.0)
 }
 
@@ -40,6 +40,13 @@ pub(crate) fn unit(h: u32) -> f32 {
 #[inline]
 pub fn draw(seed: u64, index: u64) -> f32 {
     unit(mix32(key(seed, (index >> 32) as u32) ^ index as u32))
+}
+
+/// The number of voxel `i` of a piece (see [`pieces`]) drawing with `key`
+/// from low index `low` on.
+#[inline(always)]
+pub(crate) fn nth(key: u32, low: u32, i: usize) -> f32 {
+    unit(mix32(key ^ low.wrapping_add(i as u32)))
 }
 
 /// The voxels `first..first + n` in pieces that share their index's high
@@ -69,7 +76,7 @@ pub(crate) fn pieces(
 pub(crate) fn each(seed: u64, first: u64, n: usize, mut f: impl FnMut(usize, f32)) {
     for (at, key, lo, len) in pieces(seed, first, n) {
         for i in 0..len {
-            f(at + i, unit(mix32(key ^ lo.wrapping_add(i as u32))));
+            f(at + i, nth(key, lo, i));
         }
     }
 }

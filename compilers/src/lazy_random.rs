@@ -24,7 +24,6 @@ use volcad_core::model::MAX_MATERIALS;
 use volcad_core::sampler::{Grid, RowSpan};
 
 use crate::dither::{BOUND_MARGIN as EPS, MIN_TOTAL, pick_random};
-use crate::draws::{mix32, unit};
 /// Longest run of voxels bounded together (a sampler tile's width).
 const RUN: usize = 32;
 
@@ -103,21 +102,22 @@ impl Shares {
     }
 
     /// The pick from share bounds `lo`, `hi` (one pair a material) when
-    /// every share is certainly below or above `r`.
+    /// every share is certainly below or above `r`: `f64` bounds, or the
+    /// `f32` ones of [`Shares::first`] (which the run loop vectorises).
     #[inline(always)]
-    fn count(lo: &[f64], hi: &[f64], r: f32) -> Option<u8> {
-        let r = f64::from(r);
+    fn count<F: Copy + PartialOrd + From<f32>>(lo: &[F], hi: &[F], r: f32) -> Option<u8> {
+        let r = F::from(r);
         // Without branches (the pick is unpredictable in a mix): count the
         // shares certainly below r, note any that may be on either side.
-        let mut pick = 0usize;
+        let mut pick = 0u8;
         let mut open = false;
         for (lo, hi) in lo.iter().zip(hi) {
             let below = *hi < r;
             let above = *lo > r;
-            pick += usize::from(below);
+            pick += u8::from(below);
             open |= !(below | above);
         }
-        (!open && pick < lo.len()).then_some(pick as u8 + 1)
+        (!open && usize::from(pick) < lo.len()).then_some(pick + 1)
     }
 }
 
@@ -335,32 +335,18 @@ fn run_k<const K: usize>(
         decide::<K>(&lo, &hi, key, low, part);
         for (i, o) in part.iter_mut().enumerate() {
             if *o == 0 {
-                *o = open(at + i, unit(mix32(key ^ low.wrapping_add(i as u32))));
+                *o = open(at + i, crate::draws::nth(key, low, i));
             }
         }
     }
 }
 
 /// The picks the share bounds `lo`, `hi` settle for the voxels drawing
-/// with `key` from low index `low` on, 0 for those they leave open (as
-/// [`Shares::count`], in `f32`).
+/// with `key` from low index `low` on, 0 for those they leave open.
 #[inline(always)]
 fn decide<const K: usize>(lo: &[f32; K], hi: &[f32; K], key: u32, low: u32, out: &mut [u8]) {
     for (i, o) in out.iter_mut().enumerate() {
-        let r = unit(mix32(key ^ low.wrapping_add(i as u32)));
-        let mut pick = 0u8;
-        let mut open = false;
-        for j in 0..K {
-            let below = hi[j] < r;
-            let above = lo[j] > r;
-            pick += u8::from(below);
-            open |= !(below | above);
-        }
-        *o = if open || usize::from(pick) >= K {
-            0
-        } else {
-            pick + 1
-        };
+        *o = Shares::count(lo, hi, crate::draws::nth(key, low, i)).unwrap_or(0);
     }
 }
 

@@ -16,9 +16,8 @@
 //! candidate grid's shape), the candidate grid's records and items
 //! (`u32`s), then each section's checksum. The arrays are read straight
 //! into their vectors a megabyte at a time on every core, each block
-//! hashed as it arrives: reading the whole file into one buffer and then
-//! decoding it copied every byte twice on one core, most of a cached
-//! mesh's load.
+//! hashed as it arrives, rather than the whole file read into one buffer
+//! and then decoded, which copied every byte twice on one core.
 //!
 //! Writes go to a temporary name in the same folder and are renamed into
 //! place (atomic on POSIX), so a reader never sees half a file; the folder
@@ -101,7 +100,7 @@ pub(super) fn slot(vertices: &[DVec3], triangles: &[[u32; 3]], dir: Option<&Path
 /// mesh, else built (and written to the slot).
 pub(super) fn attach(mesh: &mut TriangleMesh, slot: Option<Slot>, read: Option<Sections>) {
     if let Some(slot) = &slot
-        && let Some((coarse, cands)) = read.and_then(|r| decode(r, slot.key, mesh))
+        && let Some((coarse, cands)) = read.and_then(|r| decode(r, mesh))
     {
         mesh.coarse = coarse;
         mesh.candidates = cands;
@@ -400,11 +399,10 @@ fn read_section<T: bytemuck::Pod + Send + Sync>(
     (fold_sums(&blocks?, n * std::mem::size_of::<T>()) == sum).then_some(v)
 }
 
-/// The grids of a file's `sections` when they were built for `mesh`
-/// (keyed `key`); nothing read is trusted.
+/// The grids of a file's `sections` when they were built for `mesh`;
+/// nothing read is trusted.
 fn decode(
     sections: Sections,
-    key: u64,
     mesh: &TriangleMesh,
 ) -> Option<(Option<CoarseGrid>, Option<CandidateGrid>)> {
     let Sections {
@@ -416,11 +414,11 @@ fn decode(
         records.iter_mut().for_each(|x| *x = u32::from_le(*x));
         items.iter_mut().for_each(|x| *x = u32::from_le(*x));
     }
-    let mut r = Reader { b: &head, at: 0 };
-    if r.take(8)? != MAGIC || r.u32()? != FORMAT || r.u64()? != key {
-        return None;
-    }
-    r.take(24)?;
+    // (The preamble was checked by `load`, against this slot's key.)
+    let mut r = Reader {
+        b: &head,
+        at: PREAMBLE,
+    };
     // The mesh it was built from, exactly.
     if r.u64()? != mesh.vertices.len() as u64 || mesh.vertices.iter().any(|v| r.vec() != Some(*v)) {
         return None;
