@@ -48,19 +48,17 @@ use super::band_scratch::{Pool, Stamped};
 use super::cube_loops;
 use super::flat::{FlatKey, FlatMemo, KeptCubes, Regions, SampleAt};
 use super::indexed::IndexedMesh;
-use super::interface::{Cube, Interface, cut_field, front_back};
+use super::interface::{Cube, Interface, corner_mask, cut_field, front_back};
 use super::kuhn::{
     CUT_FACES, FACES, Pt, by_inclusion, chain, edge, face_cut, odd_one_out, tet_corners,
     two_label_cut,
 };
 use super::layer_dist::LayerDist;
 use super::mixed::mixed_cubes;
-use super::one_label::OneLabelBand;
-use super::one_label::{LayerEdges, PlaneEdges};
+use super::one_label::{LayerEdges, OneLabelBand, PlaneEdges};
 pub use super::unevaluated::ExactAt;
 use super::unevaluated::{CornerMemo, Layer};
-use super::vertex_keys::{BandMesh, KeyMap};
-use super::vertex_keys::{Tri, VRef};
+use super::vertex_keys::{BandMesh, KeyMap, Tri, VRef};
 
 /// One z plane of samples (`nx·ny` each, x fastest).
 #[derive(Clone, Debug, Default)]
@@ -275,6 +273,14 @@ impl Contourer {
         self.edges.next_layer();
         self.prev = Some((z, plane));
         Some(lo)
+    }
+
+    /// Room for about `triangles` triangles (the plan's estimate) over the
+    /// labels, half as many vertices: a mesh grown by doubling is copied
+    /// into fresh memory, zeroed by the kernel, while the other core waits.
+    pub fn reserve(&mut self, triangles: usize) {
+        let per = triangles / self.meshes.len().max(1);
+        self.meshes.iter_mut().for_each(|m| m.reserve(per));
     }
 
     /// Triangles made so far (flat regions are triangulated by `finish`).
@@ -674,11 +680,6 @@ impl Contourer {
             }
         }
     }
-}
-
-/// The corners of `cube` labelled `label`, as bits.
-pub(super) fn corner_mask(cube: &Cube, label: u16) -> u8 {
-    (0..8).fold(0, |m, c| m | u8::from(cube.label[c] == label) << c)
 }
 
 /// Buffers one row's tets reuse.

@@ -60,6 +60,14 @@ fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 }
 
 impl IndexedMesh {
+    /// Room for `triangles` more triangles and half as many vertices,
+    /// where it can be had (else the mesh grows as it goes).
+    pub fn reserve(&mut self, triangles: usize) {
+        if self.triangles.try_reserve(triangles).is_ok() {
+            let _ = self.vertices.try_reserve(triangles / 2);
+        }
+    }
+
     /// True when there are no triangles.
     pub fn is_empty(&self) -> bool {
         self.triangles.is_empty()
@@ -139,7 +147,14 @@ impl IndexedMesh {
     /// Unit normal of triangle `t` (zero for a degenerate one).
     #[inline]
     pub fn normal(&self, t: usize) -> [f32; 3] {
-        let [a, b, c] = self.corners(t);
+        self.normal_of(self.triangles[t])
+    }
+
+    /// Unit normal of the triangle with corners `tri` (zero for a
+    /// degenerate one).
+    #[inline]
+    pub fn normal_of(&self, tri: [u32; 3]) -> [f32; 3] {
+        let [a, b, c] = tri.map(|i| f64x3(self.vertices[i as usize]));
         let n = cross(sub(b, a), sub(c, a));
         let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
         if len > 0.0 {

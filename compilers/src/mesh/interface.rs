@@ -67,3 +67,8 @@ pub(super) fn cut_field(iface: Interface, la: u16, lb: u16, d: f32, f: &[f32]) -
         }
     }
 }
+
+/// The corners of `cube` labelled `label`, as bits.
+pub(super) fn corner_mask(cube: &Cube, label: u16) -> u8 {
+    (0..8).fold(0, |m, c| m | u8::from(cube.label[c] == label) << c)
+}

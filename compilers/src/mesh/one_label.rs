@@ -8,9 +8,9 @@
 use glam::DVec3;
 
 use super::band_scratch::Stamped;
-use super::contour::{BAND, Contourer, KEY_TYPES, LOOP_KEY, Scratch, corner_mask};
+use super::contour::{BAND, Contourer, KEY_TYPES, LOOP_KEY, Scratch};
 use super::cube_loops;
-use super::interface::Cube;
+use super::interface::{Cube, corner_mask};
 use super::kuhn::Pt;
 use super::vertex_keys::{BandMesh, Tri, VRef};
 

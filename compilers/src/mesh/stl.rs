@@ -1,11 +1,13 @@
 //! Binary STL: 80-byte header, triangle count (u32), then per triangle the
 //! unit normal, three vertices (f32 × 3 each, mm) and a zero attribute
 //! (u16), all little-endian. The header never starts with `solid`, so no
-//! reader takes the file for ASCII STL.
+//! reader takes the file for ASCII STL. Records are formatted on every
+//! core in blocks and written in order ([`write_blocks`]).
 
 use std::io::{self, Write};
 
 use super::indexed::IndexedMesh;
+use super::text_blocks::write_blocks;
 
 /// Write `mesh` as binary STL; `name` goes into the header (truncated).
 pub fn write_stl(mesh: &IndexedMesh, name: &str, w: &mut impl Write) -> io::Result<()> {
@@ -17,17 +19,16 @@ pub fn write_stl(mesh: &IndexedMesh, name: &str, w: &mut impl Write) -> io::Resu
     let count = u32::try_from(mesh.triangles.len())
         .map_err(|_| io::Error::other("more than 2^32 triangles do not fit in STL"))?;
     w.write_all(&count.to_le_bytes())?;
-    let mut rec = [0u8; 50];
-    for (t, tri) in mesh.triangles.iter().enumerate() {
-        let n = mesh.normal(t);
-        let vals = n
-            .iter()
-            .chain(tri.iter().flat_map(|i| mesh.vertices[*i as usize].iter()));
-        for (dst, v) in rec.chunks_exact_mut(4).zip(vals) {
+    // Records formatted in parallel blocks, written in order.
+    write_blocks(&mesh.triangles, w, |out, tri| {
+        let mut rec = [0u8; 50];
+        let corner = |k: usize| mesh.vertices[tri[k] as usize];
+        let vals = [mesh.normal_of(*tri), corner(0), corner(1), corner(2)];
+        for (dst, v) in rec.chunks_exact_mut(4).zip(vals.as_flattened()) {
             dst.copy_from_slice(&v.to_le_bytes());
         }
-        w.write_all(&rec)?;
-    }
+        out.extend_from_slice(&rec);
+    })?;
     Ok(())
 }
 

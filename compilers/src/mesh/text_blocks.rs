@@ -1,7 +1,8 @@
-//! Text files of millions of similar lines (OBJ and 3MF vertices and
-//! triangles), formatted on every core: blocks of [`BLOCK`] items become
-//! text in parallel, in batches that bound the memory held, and are written
-//! in order, so the bytes are those of one loop over the items.
+//! Files of millions of similar records (OBJ and 3MF vertex and triangle
+//! lines, binary STL triangles), formatted on every core: blocks of
+//! [`BLOCK`] items become bytes in parallel, in batches that bound the
+//! memory held, and are written in order, so the bytes are those of one
+//! loop over the items.
 
 use std::io::{self, Write};
 
