@@ -10,9 +10,7 @@
 //! a list with `push` becomes quadratic.
 //!
 //! Instead the binaries install [`CountingAllocator`], which keeps the
-//! number of live heap bytes in one relaxed atomic (the memory itself comes
-//! from mimalloc, which reuses freed pages instead of handing them back to
-//! the kernel and faulting them in again), and a running script
+//! number of live heap bytes in one relaxed atomic, and a running script
 //! reads it at every operation (the progress hook it already has for
 //! cancel). It stops when the heap has grown by more than its budget since
 //! the script started (`ScriptOptions::max_heap`). Growth by doubling is
@@ -24,16 +22,14 @@
 //! Where no counting allocator is installed (a library user's program),
 //! [`live_bytes`] is `None` and scripts run without the check.
 
-use std::alloc::{GlobalAlloc, Layout};
+use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
-
-use mimalloc::MiMalloc;
 
 /// Live heap bytes, as counted by [`CountingAllocator`] (0 when it is not
 /// the global allocator).
 static LIVE: AtomicUsize = AtomicUsize::new(0);
 
-/// mimalloc, counting live bytes. Install it in a binary:
+/// The system allocator, counting live bytes. Install it in a binary:
 ///
 /// ```ignore
 /// #[global_allocator]
@@ -41,12 +37,12 @@ static LIVE: AtomicUsize = AtomicUsize::new(0);
 /// ```
 pub struct CountingAllocator;
 
-// SAFETY: every call is forwarded to `MiMalloc` with the same arguments; the
+// SAFETY: every call is forwarded to `System` with the same arguments; the
 // counter is bookkeeping only and never affects the returned memory.
 unsafe impl GlobalAlloc for CountingAllocator {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         // SAFETY: forwarded unchanged (the caller upholds `alloc`'s contract).
-        let p = unsafe { MiMalloc.alloc(layout) };
+        let p = unsafe { System.alloc(layout) };
         if !p.is_null() {
             LIVE.fetch_add(layout.size(), Ordering::Relaxed);
         }
@@ -55,7 +51,7 @@ unsafe impl GlobalAlloc for CountingAllocator {
 
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
         // SAFETY: forwarded unchanged.
-        let p = unsafe { MiMalloc.alloc_zeroed(layout) };
+        let p = unsafe { System.alloc_zeroed(layout) };
         if !p.is_null() {
             LIVE.fetch_add(layout.size(), Ordering::Relaxed);
         }
@@ -64,13 +60,13 @@ unsafe impl GlobalAlloc for CountingAllocator {
 
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
         // SAFETY: forwarded unchanged.
-        unsafe { MiMalloc.dealloc(ptr, layout) };
+        unsafe { System.dealloc(ptr, layout) };
         LIVE.fetch_sub(layout.size(), Ordering::Relaxed);
     }
 
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
         // SAFETY: forwarded unchanged.
-        let p = unsafe { MiMalloc.realloc(ptr, layout, new_size) };
+        let p = unsafe { System.realloc(ptr, layout, new_size) };
         if !p.is_null() {
             let old = layout.size();
             if new_size >= old {
