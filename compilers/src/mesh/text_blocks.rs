@@ -10,29 +10,38 @@ use rayon::prelude::*;
 
 /// Items formatted per parallel task.
 const BLOCK: usize = 1 << 15;
-/// Blocks formatted per batch before they are written: about 25 MB of text
-/// held per file being written (several files are written at once).
-const BLOCKS_PER_BATCH: usize = 16;
+/// Most blocks formatted per batch before they are written (about 25 MB of
+/// text held per file being written; several files are written at once).
+const MAX_BLOCKS_PER_BATCH: usize = 16;
 
-/// Formats `items` with `line` in parallel blocks and writes the text in
-/// order (the same bytes as one loop over the items).
+/// Formats `items` with `line` in parallel blocks and writes the bytes in
+/// order (the same bytes as one loop over the items). A batch is two
+/// blocks a thread, and its buffers serve every batch: memory touched for
+/// the first time costs a page fault and the kernel's zeroing per page, a
+/// fresh batch each time cost more than formatting it.
 pub fn write_blocks<T: Sync>(
     items: &[T],
     m: &mut impl Write,
     line: impl Fn(&mut Vec<u8>, &T) + Sync,
 ) -> io::Result<()> {
-    for batch in items.chunks(BLOCK * BLOCKS_PER_BATCH) {
-        let texts: Vec<Vec<u8>> = batch
-            .par_chunks(BLOCK)
-            .map(|block| {
-                let mut out = Vec::with_capacity(block.len() * 64);
+    let per_batch = (2 * rayon::current_num_threads()).clamp(2, MAX_BLOCKS_PER_BATCH);
+    let mut texts: Vec<Vec<u8>> = Vec::new();
+    for batch in items.chunks(BLOCK * per_batch) {
+        let n = batch.len().div_ceil(BLOCK);
+        if texts.len() < n {
+            texts.resize_with(n, Vec::new);
+        }
+        texts[..n]
+            .par_iter_mut()
+            .zip(batch.par_chunks(BLOCK))
+            .for_each(|(out, block)| {
+                out.clear();
+                out.reserve(block.len() * 64);
                 for it in block {
-                    line(&mut out, it);
+                    line(out, it);
                 }
-                out
-            })
-            .collect();
-        for t in &texts {
+            });
+        for t in &texts[..n] {
             m.write_all(t)?;
         }
     }
