@@ -2,7 +2,7 @@
 //! unit normal, three vertices (f32 × 3 each, mm) and a zero attribute
 //! (u16), all little-endian. The header never starts with `solid`, so no
 //! reader takes the file for ASCII STL. Records are formatted on every
-//! core in blocks and written in order ([`write_blocks`]).
+//! core in blocks and written in order (`text_blocks::write_blocks`).
 
 use std::io::{self, Write};
 
