@@ -276,8 +276,8 @@ impl Contourer {
     }
 
     /// Room for about `triangles` triangles (the plan's estimate) over the
-    /// labels, half as many vertices: a mesh grown by doubling is copied
-    /// into fresh memory, zeroed by the kernel, while the other core waits.
+    /// labels, and half as many vertices, so that the meshes do not grow
+    /// by doubling as layers come (an allocator may copy them each time).
     pub fn reserve(&mut self, triangles: usize) {
         let per = triangles / self.meshes.len().max(1);
         self.meshes.iter_mut().for_each(|m| m.reserve(per));

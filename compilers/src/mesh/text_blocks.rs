@@ -17,8 +17,7 @@ const MAX_BLOCKS_PER_BATCH: usize = 16;
 /// Formats `items` with `line` in parallel blocks and writes the bytes in
 /// order (the same bytes as one loop over the items). A batch is two
 /// blocks a thread, and its buffers serve every batch: memory touched for
-/// the first time costs a page fault and the kernel's zeroing per page, a
-/// fresh batch each time cost more than formatting it.
+/// the first time costs a page fault and the kernel's zeroing per page.
 pub fn write_blocks<T: Sync>(
     items: &[T],
     m: &mut impl Write,
