@@ -275,14 +275,6 @@ impl Contourer {
         Some(lo)
     }
 
-    /// Room for about `triangles` triangles (the plan's estimate) over the
-    /// labels, and half as many vertices, so that the meshes do not grow
-    /// by doubling as layers come (an allocator may copy them each time).
-    pub fn reserve(&mut self, triangles: usize) {
-        let per = triangles / self.meshes.len().max(1);
-        self.meshes.iter_mut().for_each(|m| m.reserve(per));
-    }
-
     /// Triangles made so far (flat regions are triangulated by `finish`).
     pub fn triangles(&self) -> usize {
         self.meshes.iter().map(|m| m.triangles.len()).sum()

@@ -60,14 +60,6 @@ fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 }
 
 impl IndexedMesh {
-    /// Room for `triangles` more triangles and half as many vertices,
-    /// where it can be had (else the mesh grows as it goes).
-    pub fn reserve(&mut self, triangles: usize) {
-        if self.triangles.try_reserve(triangles).is_ok() {
-            let _ = self.vertices.try_reserve(triangles / 2);
-        }
-    }
-
     /// True when there are no triangles.
     pub fn is_empty(&self) -> bool {
         self.triangles.is_empty()
@@ -144,16 +136,10 @@ impl IndexedMesh {
         (sine2.sqrt().asin().to_degrees().min(60.0), edge2.sqrt())
     }
 
-    /// Unit normal of triangle `t` (zero for a degenerate one).
-    #[inline]
-    pub fn normal(&self, t: usize) -> [f32; 3] {
-        self.normal_of(self.triangles[t])
-    }
-
-    /// Unit normal of the triangle with corners `tri` (zero for a
+    /// Unit normal of the triangle with vertices `tri` (zero for a
     /// degenerate one).
     #[inline]
-    pub fn normal_of(&self, tri: [u32; 3]) -> [f32; 3] {
+    pub fn normal(&self, tri: [u32; 3]) -> [f32; 3] {
         let [a, b, c] = tri.map(|i| f64x3(self.vertices[i as usize]));
         let n = cross(sub(b, a), sub(c, a));
         let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
@@ -361,7 +347,7 @@ mod tests {
         assert!(m.is_watertight());
         assert!((m.volume() - 1.0).abs() < 1e-12);
         assert!((m.area() - 6.0).abs() < 1e-12);
-        assert_eq!(m.normal(0), [0.0, 0.0, -1.0]);
+        assert_eq!(m.normal(m.triangles[0]), [0.0, 0.0, -1.0]);
         let (angle, edge) = m.shape();
         assert!((angle - 45.0).abs() < 1e-9 && edge == 1.0, "{angle} {edge}");
         let needle = IndexedMesh {

@@ -469,7 +469,6 @@ fn build(
         Flat::Off => contourer.with_flat_merge(false),
         Flat::FallbackOnly => contourer.with_fallback_only(),
     };
-    contourer.reserve(usize::try_from(pl.estimate.triangles).unwrap_or(usize::MAX));
     let exact = |at: [usize; 3]| sampler.evaluate(at);
     let mut tally = Tally::new(pl.classifier.segments());
     let mut slab = Slab::default();

@@ -23,7 +23,7 @@ pub fn write_stl(mesh: &IndexedMesh, name: &str, w: &mut impl Write) -> io::Resu
     write_blocks(&mesh.triangles, w, |out, tri| {
         let mut rec = [0u8; 50];
         let corner = |k: usize| mesh.vertices[tri[k] as usize];
-        let vals = [mesh.normal_of(*tri), corner(0), corner(1), corner(2)];
+        let vals = [mesh.normal(*tri), corner(0), corner(1), corner(2)];
         for (dst, v) in rec.chunks_exact_mut(4).zip(vals.as_flattened()) {
             dst.copy_from_slice(&v.to_le_bytes());
         }

@@ -10,8 +10,9 @@ use rayon::prelude::*;
 
 /// Items formatted per parallel task.
 const BLOCK: usize = 1 << 15;
-/// Most blocks formatted per batch before they are written (about 25 MB of
-/// text held per file being written; several files are written at once).
+/// Most blocks formatted per batch before they are written (sixteen hold
+/// about 25 MB of text per file being written; several files are written
+/// at once).
 const MAX_BLOCKS_PER_BATCH: usize = 16;
 
 /// Formats `items` with `line` in parallel blocks and writes the bytes in
