@@ -227,6 +227,9 @@ struct Plan {
     uniform_tiles: bool,
     /// How flat regions are contoured: merged, except in tests.
     flat: Flat,
+    /// Every inside voxel's label and fraction, when the design's fixed
+    /// mix decides them (see [`segment::fixed_class`]).
+    fixed: Option<(u16, f32)>,
 }
 
 /// How flat regions are contoured ([`Flat::Merge`], except in tests that
@@ -289,6 +292,7 @@ fn plan(model: &Model, p: &MeshParams, look: Look) -> Result<Plan, ExportError> 
         .clamp(1, SLAB_LAYERS)
         .min(nz);
     let pr = coarse_estimate(model, p.voxel);
+    let fixed = segment::fixed_class(&classifier, model);
     let face = (p.voxel.x * p.voxel.y * p.voxel.z).powf(2.0 / 3.0);
     let segments = classifier.segments();
     // Interfaces add surface; assume about half the outer area per extra segment.
@@ -307,7 +311,7 @@ fn plan(model: &Model, p: &MeshParams, look: Look) -> Result<Plan, ExportError> 
         && pr.cell.max_element() > SAMPLE_BEYOND * p.voxel.min_element()
         && pair_bytes <= SLAB_BUDGET
     {
-        sampled_triangles(model, grid, &classifier) as f64
+        sampled_triangles(model, grid, &classifier, fixed) as f64
     } else {
         0.0
     };
@@ -355,6 +359,7 @@ fn plan(model: &Model, p: &MeshParams, look: Look) -> Result<Plan, ExportError> 
         estimate,
         uniform_tiles: true,
         flat: Flat::Merge,
+        fixed,
     })
 }
 
@@ -419,7 +424,12 @@ fn sampler_for<'a>(model: &'a Model, grid: Grid, uniform: Option<UniformTest<'a>
 /// on the bunny lattice at 0.26 mm (struts 1 mm across, coarse cells 1.6 mm)
 /// it saw the bunny and not the struts, and estimated 2.1 million
 /// triangles for 9.9 million.
-fn sampled_triangles(model: &Model, grid: Grid, classifier: &Classifier) -> u64 {
+fn sampled_triangles(
+    model: &Model,
+    grid: Grid,
+    classifier: &Classifier,
+    fixed: Option<(u16, f32)>,
+) -> u64 {
     let dims = grid.dims;
     let layers = dims[2].saturating_sub(1);
     if layers == 0 {
@@ -443,12 +453,38 @@ fn sampled_triangles(model: &Model, grid: Grid, classifier: &Classifier) -> u64 
         let dist = std::sync::Arc::new(std::mem::take(&mut slab.dist));
         let exact = |[i, j, k]: [usize; 3]| sampler.evaluate([i, j, z + k]);
         for l in 0..2 {
-            let plane = classifier.plane_into(&slab, &dist, l, dims, z + l, Plane::default());
+            let plane = label_plane(
+                classifier,
+                fixed,
+                &slab,
+                &dist,
+                [l, z + l],
+                dims,
+                Plane::default(),
+            );
             contourer.push_plane(l, plane.0, &exact);
         }
         made += contourer.triangles();
     }
     (made as f64 * layers as f64 / picks.max(1) as f64) as u64
+}
+
+/// Layer `l` (global layer `z`) of `slab` labelled: from the signs alone
+/// where the design's `fixed` mix decides every inside voxel, else voxel
+/// by voxel.
+fn label_plane(
+    classifier: &Classifier,
+    fixed: Option<(u16, f32)>,
+    slab: &Slab,
+    dist: &std::sync::Arc<Vec<f32>>,
+    [l, z]: [usize; 2],
+    dims: [usize; 3],
+    reuse: Plane,
+) -> (Plane, Tally) {
+    match fixed {
+        Some(class) => segment::fixed_plane_into(dist, l, dims, z, reuse, class),
+        None => classifier.plane_into(slab, dist, l, dims, z, reuse),
+    }
 }
 
 fn build(
@@ -491,8 +527,15 @@ fn build(
         Ok::<_, ExportError>(
             jobs.into_par_iter()
                 .map(|(z, reuse)| {
-                    pl.classifier
-                        .plane_into(slab, &dist, z - z0, dims, z, reuse)
+                    label_plane(
+                        &pl.classifier,
+                        pl.fixed,
+                        slab,
+                        &dist,
+                        [z - z0, z],
+                        dims,
+                        reuse,
+                    )
                 })
                 .collect::<Vec<_>>(),
         )

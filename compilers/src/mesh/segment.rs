@@ -270,12 +270,7 @@ impl Classifier {
         let layer = nx * ny;
         let k = slab.k;
         let stride = self.interface().stride();
-        let Plane {
-            mut label,
-            dist: _,
-            mut value,
-        } = reuse;
-        let dist = LayerDist::new(slab_dist, l * layer..(l + 1) * layer);
+        let (mut label, dist, mut value) = reuse.for_layer(slab_dist, l, layer);
         let rows_dist: &[f32] = &dist;
         let fracs = &slab.fracs[l * layer * k..(l + 1) * layer * k];
         label.clear();
@@ -346,6 +341,107 @@ impl Classifier {
             tally.add_row(c, f);
         }
         (Plane { label, dist, value }, tally)
+    }
+}
+
+/// The label and classifying fraction of every inside voxel of a design
+/// whose fractions are fixed (one material, or a grade of constants),
+/// when its planes carry no interface values (one segment): every such
+/// voxel's sampled fractions are the design's mix, bit for bit, so
+/// [`fixed_plane_into`] labels a plane from the distances' signs alone.
+pub fn fixed_class(classifier: &Classifier, model: &Model) -> Option<(u16, f32)> {
+    let k = model.materials().len();
+    if classifier.interface().stride() != 0 || k == 0 {
+        return None;
+    }
+    let mut f = [0.0f64; MAX_MATERIALS];
+    if !model.fixed_fractions(&mut f[..k]) {
+        return None;
+    }
+    // As the sampler stores them (`f32`).
+    let one: [f32; MAX_MATERIALS] = std::array::from_fn(|i| f[i] as f32);
+    Some(classifier.classify(&one[..k], &mut []))
+}
+
+/// [`Classifier::plane_into`] for a design of [`fixed_class`] `(lab, fv)`:
+/// `lab` where the distance is not above zero, void elsewhere and on the
+/// grid's outer layer, with the same tallies; no fractions are read, and
+/// no zeroing pass precedes the labels (each is written once).
+pub fn fixed_plane_into(
+    slab_dist: &Arc<Vec<f32>>,
+    l: usize,
+    [nx, ny, nz]: [usize; 3],
+    z: usize,
+    reuse: Plane,
+    (lab, fv): (u16, f32),
+) -> (Plane, Tally) {
+    let layer = nx * ny;
+    let (mut label, dist, mut value) = reuse.for_layer(slab_dist, l, layer);
+    let rows_dist: &[f32] = &dist;
+    // Every label is written below: a reused plane keeps its length.
+    label.resize(layer, 0);
+    value.clear();
+    let edge_plane = z == 0 || z + 1 == nz || nx < 3;
+    let counts: Vec<u64> = label
+        .par_chunks_mut(nx)
+        .enumerate()
+        .map(|(y, labels)| {
+            if edge_plane || y == 0 || y + 1 == ny {
+                labels.fill(0);
+                return 0;
+            }
+            let row = &rows_dist[y * nx + 1..(y + 1) * nx - 1];
+            labels[0] = 0;
+            labels[nx - 1] = 0;
+            sign_labels(&mut labels[1..nx - 1], row, lab)
+        })
+        .collect();
+    let mut tally = Tally::new(1);
+    if lab > 0 {
+        for n in counts {
+            tally.add_row(&[n], &[f64::from(fv) * n as f64]);
+        }
+    }
+    (Plane { label, dist, value }, tally)
+}
+
+/// `lab` into `labels` where `dist` is not above zero (a NaN is not
+/// outside, as in [`Classifier::plane_into`]: hence the negated
+/// comparisons), 0 elsewhere; returns how many got `lab`. Eight at a time
+/// as fixed-size arrays, which compile to vector compares and stores (a
+/// loop over the row did not).
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
+fn sign_labels(labels: &mut [u16], dist: &[f32], lab: u16) -> u64 {
+    let mut inside = 0u64;
+    let mut out = labels.chunks_exact_mut(8);
+    let mut ds = dist.chunks_exact(8);
+    for (o, d) in (&mut out).zip(&mut ds) {
+        let m: [u16; 8] = std::array::from_fn(|k| u16::from(!(d[k] > 0.0)));
+        for k in 0..8 {
+            o[k] = m[k] * lab;
+        }
+        inside += u64::from(m.iter().sum::<u16>());
+    }
+    for (o, d) in out.into_remainder().iter_mut().zip(ds.remainder()) {
+        let m = u16::from(!(*d > 0.0));
+        *o = m * lab;
+        inside += u64::from(m);
+    }
+    inside
+}
+
+impl Plane {
+    /// This retired plane's label and value buffers, for layer `l` (of
+    /// `layer` voxels) of the shared slab distances `slab_dist`, with that
+    /// layer's view.
+    fn for_layer(
+        self,
+        slab_dist: &Arc<Vec<f32>>,
+        l: usize,
+        layer: usize,
+    ) -> (Vec<u16>, LayerDist, Vec<f32>) {
+        let dist = LayerDist::new(slab_dist, l * layer..(l + 1) * layer);
+        (self.label, dist, self.value)
     }
 }
 

@@ -304,3 +304,76 @@ fn blocks_through_layers_agree_on_labels() {
         );
     }
 }
+
+/// A design of one fixed mix labels its planes from the distances' signs
+/// (`segment::fixed_plane_into`) as voxel by voxel classification does:
+/// the same labels and voxel counts, layer by layer, through the sampler
+/// the export uses; a graded design does not take that path.
+#[test]
+fn fixed_mixes_label_planes_from_signs_alone() {
+    let designs = [
+        (
+            r#"Intersection(false, [Tile(GraphLattice(LatticeType::BodyCenteredCubic, Vec3(5,5,5), 0.35, m.id("gray"))), Sphere(Vec3(0,0,0), 10, m.id("gray"))])"#,
+            "gray",
+            0.15,
+        ),
+        (
+            r#"Rotate(20, 10, 0, Vec3(0,0,0), Union(false, [Sphere(Vec3(0,0,0), 4, m.id("red")), RectPrism(Vec3(3,0,0), Vec3(4,6,6), m.id("red"))]))"#,
+            "red",
+            0.08,
+        ),
+        (
+            r#"FGrade(["0.3", "0.7"], [m.id("red"), m.id("blue")], false, Sphere(Vec3(0,0,0), 4, m.id("gray")))"#,
+            "red",
+            0.1,
+        ),
+    ];
+    for (src, material, voxel) in designs {
+        let m = model(src);
+        let id = m.table().id(material).expect("material");
+        let p = params(voxel, SegmentBy::Material(id), 1);
+        let pl = plan(&m, &p, Look::Coarse).expect("plan");
+        let class = pl.fixed.unwrap_or_else(|| panic!("{src}: no fixed class"));
+        let dims = pl.grid.dims;
+        let test = |b: &[volcad_core::interval::Interval]| pl.classifier.uniform(b);
+        let sampler = Sampler::new(&m, pl.grid, Consumer::MeshContour(&test));
+        let cancel = AtomicBool::new(false);
+        let mut slab = Slab::default();
+        let (mut z0, mut inside) = (0, 0);
+        while z0 < dims[2] {
+            let z1 = (z0 + 4).min(dims[2]);
+            sampler
+                .sample_layers(z0, z1, &mut slab, &cancel)
+                .expect("sample");
+            let dist = std::sync::Arc::new(slab.dist.clone());
+            for z in z0..z1 {
+                let l = z - z0;
+                let (a, ta) = pl
+                    .classifier
+                    .plane_into(&slab, &dist, l, dims, z, Plane::default());
+                // Into a reused plane, as the export does.
+                let reuse = Plane {
+                    label: vec![7; dims[0] * dims[1]],
+                    ..Plane::default()
+                };
+                let (b, tb) = segment::fixed_plane_into(&dist, l, dims, z, reuse, class);
+                assert_eq!(a.label, b.label, "{src}: labels of layer {z}");
+                assert_eq!(ta.voxels, tb.voxels, "{src}: counts of layer {z}");
+                let (fa, fb) = (ta.sum_f[0], tb.sum_f[0]);
+                assert!((fa - fb).abs() <= 1e-9 * fa.abs(), "{src}: {fa} vs {fb}");
+                inside += ta.voxels[0];
+            }
+            z0 = z1;
+        }
+        assert!(inside > 1000, "{src}: {inside} voxels inside");
+    }
+    let bar = graded_bar();
+    let red = bar.table().id("red").expect("red");
+    let pl = plan(
+        &bar,
+        &params(0.2, SegmentBy::Material(red), 1),
+        Look::Coarse,
+    )
+    .expect("plan");
+    assert_eq!(pl.fixed, None, "a graded bar's labels need its fractions");
+}
