@@ -56,9 +56,16 @@ pub struct CoarseEstimate {
     pub cell: DVec3,
 }
 
-/// Sample `model` coarsely over its bounding box with voxels no finer than `voxel`.
-/// Returns the default (all zero) for an unbounded or empty box.
+/// Sample `model` coarsely over its bounding box with voxels no finer than
+/// `voxel`; the default (all zero) for an unbounded or empty box. Kept
+/// with the model ([`Model::derived`]): an export's estimate and its job
+/// both ask.
 pub fn coarse_estimate(model: &Model, voxel: DVec3) -> CoarseEstimate {
+    let key = voxel.to_array().map(f64::to_bits);
+    model.derived(key, || sampled_coarse(model, voxel))
+}
+
+fn sampled_coarse(model: &Model, voxel: DVec3) -> CoarseEstimate {
     let bbox = model.bbox();
     let coarse = (bbox.size() / COARSE_CELLS as f64).max(voxel);
     let Ok(grid) = Grid::covering(&bbox, coarse, (COARSE_CELLS as u128 + 1).pow(3)) else {

@@ -46,7 +46,7 @@ use volcad_core::sampler::Grid;
 
 use super::band_scratch::{Pool, Stamped};
 use super::cube_loops;
-use super::flat::{FlatKey, FlatMemo, KeptCubes, Regions, SampleAt};
+use super::flat::{BandFlats, FlatMemo, Regions, SampleAt};
 use super::indexed::IndexedMesh;
 use super::interface::{Cube, Interface, corner_mask, cut_field, front_back};
 use super::kuhn::{
@@ -84,23 +84,6 @@ const TET_KEY: u64 = 72;
 /// Centre points of one-label loops (up to four a cube): 78..=81.
 pub(super) const LOOP_KEY: u64 = 78;
 pub(super) const KEY_TYPES: u64 = 128;
-
-/// A band's flat cubes: row, column, key and the corners of the key's `x`
-/// label (bit mask), with their samples kept for the fallback.
-#[derive(Default)]
-struct BandFlats {
-    at: Vec<([usize; 2], FlatKey, u8)>,
-    kept: KeptCubes,
-}
-
-impl BandFlats {
-    fn with_capacity(cubes: usize, dims: [usize; 3]) -> Self {
-        BandFlats {
-            at: Vec::with_capacity(cubes),
-            kept: KeptCubes::with_capacity(cubes, dims),
-        }
-    }
-}
 
 /// Rows of cubes a contouring task takes: fewer, larger tasks cost less
 /// to schedule and allocate for than one per row (most rows of a solid
@@ -150,6 +133,9 @@ pub struct Contourer {
     /// One label: the mesh's points on the layer's grid edges (see
     /// `one_label::LayerEdges`).
     edges: LayerEdges,
+    /// Count only (an estimate's sampled layers): the bands' triangles so
+    /// far, none numbered into meshes.
+    counted: Option<usize>,
 }
 
 impl Contourer {
@@ -174,7 +160,15 @@ impl Contourer {
             scratch_pool: Pool::default(),
             layer_memo: CornerMemo::default(),
             edges: LayerEdges::default(),
+            counted: None,
         }
+    }
+
+    /// Count the triangles pushed ([`Self::triangles`]) and build no
+    /// meshes: an estimate needs the count, not the sequential numbering.
+    pub(super) fn counting_only(mut self) -> Self {
+        self.counted = Some(0);
+        self
     }
 
     /// Turn flat-region merging on (the default) or off.
@@ -215,9 +209,8 @@ impl Contourer {
         assert_eq!(pz + 1, z, "planes must come in order");
         let ny = self.grid.dims[1];
         // Rows in parallel, each with its vertices deduplicated per label;
-        // then one sequential pass gives each new vertex its index in its
-        // label's mesh (one map lookup per row vertex instead of one per
-        // triangle corner: the sequential part was a third of contouring).
+        // then one sequential pass numbers each new vertex in its label's
+        // mesh (a lookup per row vertex, not per triangle corner).
         let rows = ny.saturating_sub(1);
         let sizes = &self.band_sizes;
         let layer = Layer {
@@ -247,6 +240,11 @@ impl Contourer {
             )
             .collect();
         self.band_sizes = bands.iter().map(|b| b.2).collect();
+        if let Some(n) = &mut self.counted {
+            *n += bands.iter().map(|b| b.0.tris.len()).sum::<usize>();
+            self.prev = Some((z, plane));
+            return Some(lo);
+        }
         let mut global = Vec::new();
         if self.one_label {
             self.edges.begin_upper(self.grid.dims);
@@ -277,7 +275,7 @@ impl Contourer {
 
     /// Triangles made so far (flat regions are triangulated by `finish`).
     pub fn triangles(&self) -> usize {
-        self.meshes.iter().map(|m| m.triangles.len()).sum()
+        self.counted.unwrap_or(0) + self.meshes.iter().map(|m| m.triangles.len()).sum::<usize>()
     }
 
     /// Index in `label`'s mesh of vertex `v` (added when new), for the

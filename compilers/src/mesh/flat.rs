@@ -65,6 +65,24 @@ pub(super) struct FlatKey {
     normal: [i32; 3],
 }
 
+/// A contouring band's flat cubes: row, column, key and the corners of
+/// the key's `x` label (bit mask), with their samples kept for the
+/// fallback.
+#[derive(Default)]
+pub(super) struct BandFlats {
+    pub at: Vec<([usize; 2], FlatKey, u8)>,
+    pub kept: KeptCubes,
+}
+
+impl BandFlats {
+    pub fn with_capacity(cubes: usize, dims: [usize; 3]) -> Self {
+        BandFlats {
+            at: Vec::with_capacity(cubes),
+            kept: KeptCubes::with_capacity(cubes, dims),
+        }
+    }
+}
+
 /// The key of a flat cube, or `None` (see the module docs).
 pub(super) fn flat_key(voxel: DVec3, iface: Interface, cube: &Cube) -> Option<FlatKey> {
     let l0 = cube.label[0];

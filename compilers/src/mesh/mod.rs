@@ -447,7 +447,8 @@ fn sampled_triangles(
         {
             return 0;
         }
-        let mut contourer = Contourer::new(grid, classifier.segments(), classifier.interface());
+        let mut contourer =
+            Contourer::new(grid, classifier.segments(), classifier.interface()).counting_only();
         // Both planes share the slab's distances, as in the export. The
         // contourer numbers them 0 and 1: its plane `k` is layer `z + k`.
         let dist = std::sync::Arc::new(std::mem::take(&mut slab.dist));

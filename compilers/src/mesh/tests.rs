@@ -377,3 +377,49 @@ fn fixed_mixes_label_planes_from_signs_alone() {
     .expect("plan");
     assert_eq!(pl.fixed, None, "a graded bar's labels need its fractions");
 }
+
+/// An estimate's counting contourer (no meshes built) counts the
+/// triangles a building one makes, layer by layer, with one label and with
+/// several.
+#[test]
+fn counting_contourers_count_what_building_ones_make() {
+    let bar = graded_bar();
+    let red = bar.table().id("red").expect("red");
+    for segments in [1, 3] {
+        let p = params(0.2, SegmentBy::Material(red), segments);
+        let pl = plan(&bar, &p, Look::Coarse).expect("plan");
+        let dims = pl.grid.dims;
+        let sampler = sampler_for(&bar, pl.grid, None);
+        let mut slab = Slab::default();
+        let cancel = AtomicBool::new(false);
+        sampler
+            .sample_layers(0, dims[2], &mut slab, &cancel)
+            .expect("sample");
+        let dist = std::sync::Arc::new(std::mem::take(&mut slab.dist));
+        let exact = |at: [usize; 3]| sampler.evaluate(at);
+        let new = || Contourer::new(pl.grid, segments, pl.classifier.interface());
+        let (mut build, mut count) = (new(), new().counting_only());
+        for z in 0..dims[2] {
+            let plane = || {
+                label_plane(
+                    &pl.classifier,
+                    pl.fixed,
+                    &slab,
+                    &dist,
+                    [z, z],
+                    dims,
+                    Plane::default(),
+                )
+                .0
+            };
+            build.push_plane(z, plane(), &exact);
+            count.push_plane(z, plane(), &exact);
+            assert_eq!(
+                count.triangles(),
+                build.triangles(),
+                "{segments} segments, layer {z}"
+            );
+        }
+        assert!(build.triangles() > 1000, "{} triangles", build.triangles());
+    }
+}

@@ -7,6 +7,7 @@
 //! so `materials()` lists the ids it uses, ascending, and a point's fractions
 //! are `k = materials().len()` numbers in that order.
 
+mod derived;
 mod distance_interval;
 mod flatten;
 mod fraction_bound;
@@ -86,6 +87,8 @@ pub struct Model {
     /// made on first use and shared by clones (see
     /// [`Model::sampled_thinnest_below`]).
     sampled: Arc<std::sync::Mutex<Option<SampledMemo>>>,
+    /// Results other crates derive from the model (see [`Model::derived`]).
+    derived: derived::Derived,
 }
 
 /// The distance of one script subtree in its own frame (the attribute
@@ -272,6 +275,7 @@ impl Model {
             node_count: root.count_nodes(),
             prepare_time: start.elapsed(),
             sampled: Arc::default(),
+            derived: derived::Derived::default(),
         })
     }
 
@@ -294,7 +298,20 @@ impl Model {
     /// names and colours for the design's materials).
     pub fn with_table(mut self, table: Arc<MaterialTable>) -> Model {
         self.table = table;
+        self.derived = derived::Derived::default();
         self
+    }
+
+    /// `make()`, computed once per `key` and result type for this model
+    /// and its clones: for results that depend on the model and `key`
+    /// alone (another crate's look at the design, by voxel size). At most
+    /// a few are kept, the oldest dropped first.
+    pub fn derived<K, T>(&self, key: K, make: impl FnOnce() -> T) -> T
+    where
+        K: PartialEq + Send + Sync + 'static,
+        T: Clone + Send + Sync + 'static,
+    {
+        self.derived.get_or(key, make)
     }
 
     /// The shared table.
