@@ -59,6 +59,9 @@ fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
+/// Triangles a task of [`IndexedMesh::volume_and_shape`] sums in order.
+const VOLUME_CHUNK: usize = 1 << 14;
+
 impl IndexedMesh {
     /// True when there are no triangles.
     pub fn is_empty(&self) -> bool {
@@ -76,16 +79,7 @@ impl IndexedMesh {
     /// Enclosed volume (mm³): positive for an outward-oriented closed mesh.
     /// Relative to the mesh's first vertex, so far-off meshes keep precision.
     pub fn volume(&self) -> f64 {
-        let Some(o) = self.vertices.first().map(|p| f64x3(*p)) else {
-            return 0.0;
-        };
-        let mut six_v = 0.0;
-        for t in 0..self.triangles.len() {
-            let [a, b, c] = self.corners(t).map(|p| sub(p, o));
-            let n = cross(b, c);
-            six_v += a[0] * n[0] + a[1] * n[1] + a[2] * n[2];
-        }
-        six_v / 6.0
+        self.volume_and_shape().0
     }
 
     /// Surface area (mm²).
@@ -103,6 +97,20 @@ impl IndexedMesh {
     /// shortest edge (mm): slivers and needles show here before another
     /// program trips on them. `(180, inf)` without triangles.
     pub fn shape(&self) -> (f64, f64) {
+        self.volume_and_shape().1
+    }
+
+    /// [`Self::volume`] and [`Self::shape`] in one pass on every core (each
+    /// reads every triangle's corners). The volume is summed in chunks of
+    /// a fixed size and the chunks' sums in order, so its bits do not
+    /// depend on the thread count.
+    pub fn volume_and_shape(&self) -> (f64, (f64, f64)) {
+        let Some(o) = self.vertices.first().map(|p| f64x3(*p)) else {
+            return (0.0, (180.0, f64::INFINITY));
+        };
+        if self.triangles.is_empty() {
+            return (0.0, (180.0, f64::INFINITY));
+        }
         // A triangle's smallest angle is opposite its shortest edge and is
         // at most 60°, where the sine rises with the angle. The sine at the
         // corner between edges u and v is |u × v| / (|u| |v|), and |u × v|
@@ -112,28 +120,42 @@ impl IndexedMesh {
         // triangle. Keep the smallest over triangles, with the shortest
         // squared edge, and take the roots and one asin at the end (exact
         // for needles, where the acos of the normalised dot product rounds
-        // to 0).
-        if self.triangles.is_empty() {
-            return (180.0, f64::INFINITY);
-        }
-        let (sine2, edge2) = (0..self.triangles.len())
-            .into_par_iter()
-            .map(|t| {
+        // to 0). The volume is the sum of a · (b × c) / 6 relative to `o`.
+        let chunk = |(k, tris): (usize, &[[u32; 3]])| {
+            let (mut six_v, mut sine2, mut edge2) = (0.0, 1.0f64, f64::INFINITY);
+            for t in k * VOLUME_CHUNK..k * VOLUME_CHUNK + tris.len() {
                 let [a, b, c] = self.corners(t);
+                let n = cross(sub(b, o), sub(c, o));
+                let ao = sub(a, o);
+                six_v += ao[0] * n[0] + ao[1] * n[1] + ao[2] * n[2];
                 let (u, v, w) = (sub(b, a), sub(c, b), sub(a, c));
                 let l = [dot(u, u), dot(v, v), dot(w, w)];
                 let n = cross(u, v);
                 let shortest = l[0].min(l[1]).min(l[2]);
                 let all = l[0] * l[1] * l[2];
-                let sine2 = if all > 0.0 {
+                let s2 = if all > 0.0 {
                     (dot(n, n) * shortest / all).min(1.0)
                 } else {
                     0.0
                 };
-                (sine2, shortest)
-            })
-            .reduce(|| (1.0, f64::INFINITY), |a, b| (a.0.min(b.0), a.1.min(b.1)));
-        (sine2.sqrt().asin().to_degrees().min(60.0), edge2.sqrt())
+                sine2 = sine2.min(s2);
+                edge2 = edge2.min(shortest);
+            }
+            (six_v, sine2, edge2)
+        };
+        let parts: Vec<(f64, f64, f64)> = self
+            .triangles
+            .par_chunks(VOLUME_CHUNK)
+            .enumerate()
+            .map(chunk)
+            .collect();
+        let (six_v, sine2, edge2) = parts
+            .iter()
+            .fold((0.0, 1.0f64, f64::INFINITY), |(v, s, e), p| {
+                (v + p.0, s.min(p.1), e.min(p.2))
+            });
+        let angle = sine2.sqrt().asin().to_degrees().min(60.0);
+        (six_v / 6.0, (angle, edge2.sqrt()))
     }
 
     /// Unit normal of the triangle with vertices `tri` (zero for a
@@ -308,6 +330,35 @@ pub(super) fn tri_set(m: &IndexedMesh) -> Vec<[[u32; 3]; 3]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A sphere's volume and shape have the same bits on one thread and on
+    /// several (its triangles span several chunks).
+    #[test]
+    fn volume_and_shape_do_not_depend_on_threads() {
+        let grid = volcad_core::sampler::Grid::covering(
+            &volcad_core::Aabb::new(glam::DVec3::splat(-6.0), glam::DVec3::splat(6.0)),
+            glam::DVec3::splat(0.1),
+            u128::MAX,
+        )
+        .expect("grid");
+        let values: Vec<f32> = (0..grid.count() as usize)
+            .map(|v| {
+                let [nx, ny, _] = grid.dims;
+                let (x, y, z) = (v % nx, v / nx % ny, v / (nx * ny));
+                (grid.center(x, y, z).length() - 5.0) as f32
+            })
+            .collect();
+        let m = super::super::marching_cubes(&grid, &values);
+        assert!(m.triangles.len() > 3 * VOLUME_CHUNK, "{}", m.triangles.len());
+        let on = |threads| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build();
+            pool.expect("pool").install(|| m.volume_and_shape())
+        };
+        let one = on(1);
+        assert_eq!(one, on(4));
+        let exact = 4.0 / 3.0 * std::f64::consts::PI * 125.0;
+        assert!((one.0 - exact).abs() < 0.01 * exact, "{} vs {exact}", one.0);
+    }
 
     /// The unit cube, outward oriented (12 triangles).
     pub(crate) fn cube() -> IndexedMesh {

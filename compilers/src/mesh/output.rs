@@ -130,15 +130,13 @@ pub(super) fn body_notes(b: &bodies::Bodies, voxel: f64, design: &StatedGaps) ->
 /// every segment. The contouring guarantees watertightness; checked anyway
 /// (a linear pass over the edges), every segment on its own thread.
 pub(super) fn checks(segs: &[SegmentMesh]) -> Vec<Check> {
-    // The three at once, beside the writers and the body count: the
-    // volume's sum runs on one thread (in a fixed order, so the same bits
-    // on any thread count) while the other two split their work.
+    // Both at once, beside the writers and the body count, each split
+    // over the cores (the volume in fixed chunks, so the same bits on any
+    // thread count).
     segs.par_iter()
         .map(|s| {
-            let (watertight, (volume, shape)) = rayon::join(
-                || s.mesh.is_watertight(),
-                || rayon::join(|| s.mesh.volume(), || s.mesh.shape()),
-            );
+            let (watertight, (volume, shape)) =
+                rayon::join(|| s.mesh.is_watertight(), || s.mesh.volume_and_shape());
             Check {
                 volume,
                 watertight,
