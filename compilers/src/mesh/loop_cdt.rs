@@ -11,7 +11,8 @@
 //!    their shared point (a sweep over the edges' boxes, exact tests).
 //! 2. Ears are cut (Meisters' two-ears theorem: a simple polygon of more
 //!    than three points has an ear; only points that are not strictly
-//!    convex can lie in one, Eberly, "Triangulation by Ear Clipping").
+//!    convex can lie in one, Eberly, "Triangulation by Ear Clipping"),
+//!    every other point round the loop.
 //! 3. Each inner point splits the triangle it lies in (or the two beside
 //!    the inner edge it lies on); one outside the loop is not used.
 //! 4. Lawson flips: an inner edge whose opposite point lies strictly in
@@ -207,7 +208,11 @@ fn cut_ears(ring: &[usize], at: &impl Fn(usize) -> Coord<f64>, mesh: &mut Mesh) 
             left -= 1;
             is_convex[p] = convex(prev[p], p, x);
             is_convex[x] = convex(p, x, next[x]);
-            (v, stalled) = (p, 0);
+            // The next ear tried is two points on, not `p`: going back
+            // fans every cut from one point (slivers the flips then undo);
+            // going round cuts every other corner, smaller triangles
+            // first, much nearer the Delaunay one.
+            (v, stalled) = (next[x], 0);
         } else {
             v = x;
             stalled += 1;
