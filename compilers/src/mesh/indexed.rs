@@ -349,7 +349,11 @@ mod tests {
             })
             .collect();
         let m = super::super::marching_cubes(&grid, &values);
-        assert!(m.triangles.len() > 3 * VOLUME_CHUNK, "{}", m.triangles.len());
+        assert!(
+            m.triangles.len() > 3 * VOLUME_CHUNK,
+            "{}",
+            m.triangles.len()
+        );
         let on = |threads| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build();
             pool.expect("pool").install(|| m.volume_and_shape())

@@ -37,8 +37,11 @@ pub(super) fn to_script_error(
                 .is_ok_and(|s| s == HEAP_STOP) =>
         {
             format!(
-                "stopped: the script's data grew past {} of memory (a value doubled in a loop?)",
-                crate::heap::human_bytes(max_heap)
+                "stopped: the script's data grew past {} of memory (a value doubled in a \
+                 loop?); the budget is {} (MiB) when set, else a quarter of the memory \
+                 available when the script started, small on a machine short of memory",
+                crate::heap::human_bytes(max_heap),
+                crate::heap::BUDGET_VAR
             )
         }
         EvalAltResult::ErrorTerminated(..) => "stopped: the script was cancelled".into(),
