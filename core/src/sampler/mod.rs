@@ -41,7 +41,7 @@ mod leaf;
 mod slab;
 pub use consumer::{Consumer, UniformTest};
 pub use grid::{Grid, GridError};
-use slab::{Counts, Rect, Rows, fill_short, merge_rects, row_blocks, x_tiles};
+use slab::{Counts, Rect, Rows, fill_run, fill_short, merge_rects, row_blocks, x_tiles};
 pub use slab::{RectRows, RowSpan, Slab, SolidRect, fill_pattern};
 
 /// Counts of how voxels were obtained (for reports and benchmarks).
@@ -574,14 +574,23 @@ impl<'a> Sampler<'a> {
                 _ => out.rect_fracs.resize(out.rect_fracs.len() + k, f32::NAN),
             }
         }
+        out.counts.skipped += (w * h) as u64;
+        if w == 0 || h == 0 {
+            return;
+        }
+        let first = (y0 - row0) * nx + x0;
+        // Distances row by row, with no other test a row: most fills
+        // write nothing else (a mesh's outside tiles, listed rectangles).
+        for row in out.dist[first..first + (h - 1) * nx + w].chunks_mut(nx) {
+            fill_run(&mut row[..w], value);
+        }
+        if k == 0 || as_rect || (matches!(how, Fill::Outside) && !self.outside_fracs) {
+            return;
+        }
         // (Zeroed only when voxels are evaluated: most fills are small.)
         let mut f = None;
         for y in y0..y0 + h {
             let row = (y - row0) * nx;
-            out.dist[row + x0..row + x0 + w].fill(value);
-            if k == 0 || as_rect || (matches!(how, Fill::Outside) && !self.outside_fracs) {
-                continue;
-            }
             // Whole runs at once where every voxel gets the same
             // fractions (a per-voxel `fill` was a library call each).
             let run = &mut out.fracs[(row + x0) * k..(row + x0 + w) * k];
@@ -604,7 +613,6 @@ impl<'a> Sampler<'a> {
                 }
             }
         }
-        out.counts.skipped += (w * h) as u64;
     }
 
     /// Refine a tile as four quarters.
