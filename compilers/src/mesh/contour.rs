@@ -54,7 +54,7 @@ use super::kuhn::{
     two_label_cut,
 };
 use super::layer_dist::LayerDist;
-use super::mixed::mixed_cubes;
+use super::mixed::{around, mixed_cubes, mixed_from_bits};
 use super::one_label::{LayerEdges, OneLabelBand, PlaneEdges};
 pub use super::unevaluated::ExactAt;
 use super::unevaluated::{CornerMemo, Layer};
@@ -69,6 +69,10 @@ pub struct Plane {
     pub dist: LayerDist,
     /// Interface values, `Interface::stride` per sample.
     pub value: Vec<f32>,
+    /// One label's planes may carry their labels as bits too (bit `x % 64`
+    /// of word `x / 64` of a row of `nx.div_ceil(64)` words set where the
+    /// label is not 0), for the mixed-cube scan; empty otherwise.
+    pub bits: Vec<u64>,
 }
 
 /// Edge-point parameter clamp: keeps every point a twentieth of an edge off
@@ -336,14 +340,16 @@ impl Contourer {
         let mut scratch = Scratch::default();
         let mut memo = FlatMemo::default();
         let (lo, hi) = (layer.lo, layer.hi);
+        let (words, bits) = (nx.div_ceil(64), !lo.bits.is_empty() && !hi.bits.is_empty());
+        let mut xs = Vec::new();
         for j in js {
-            let rows = [
-                &lo.label[j * nx..(j + 1) * nx],
-                &lo.label[(j + 1) * nx..(j + 2) * nx],
-                &hi.label[j * nx..(j + 1) * nx],
-                &hi.label[(j + 1) * nx..(j + 2) * nx],
-            ];
-            for i in mixed_cubes(rows) {
+            xs.clear();
+            if bits {
+                xs.extend(mixed_from_bits(around(&lo.bits, &hi.bits, j, words), nx));
+            } else {
+                xs.extend(mixed_cubes(around(&lo.label, &hi.label, j, nx)));
+            }
+            for &i in &xs {
                 let cube = self.cube([i, j, z], layer, corners);
                 if self.merge
                     && let Some(key) = memo.key(self.grid.voxel, self.iface, &cube)

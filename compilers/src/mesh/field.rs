@@ -31,6 +31,7 @@ pub(super) fn contour_field(mut c: Contourer, grid: &Grid, values: &[f32]) -> In
                 label,
                 dist: dist.into(),
                 value: Vec::new(),
+                bits: Vec::new(),
             },
             &|[i, j, k]| values[(k * ny + j) * nx + i],
         );

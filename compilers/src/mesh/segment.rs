@@ -270,7 +270,12 @@ impl Classifier {
         let layer = nx * ny;
         let k = slab.k;
         let stride = self.interface().stride();
-        let (mut label, dist, mut value) = reuse.for_layer(slab_dist, l, layer);
+        let Plane {
+            mut label,
+            dist,
+            mut value,
+            ..
+        } = reuse.for_layer(slab_dist, l, layer);
         let rows_dist: &[f32] = &dist;
         let fracs = &slab.fracs[l * layer * k..(l + 1) * layer * k];
         label.clear();
@@ -340,7 +345,16 @@ impl Classifier {
         for (c, f) in counts.chunks(per_row).zip(sums.chunks(per_row)) {
             tally.add_row(c, f);
         }
-        (Plane { label, dist, value }, tally)
+        let bits = Vec::new();
+        (
+            Plane {
+                label,
+                dist,
+                value,
+                bits,
+            },
+            tally,
+        )
     }
 }
 
@@ -365,8 +379,9 @@ pub fn fixed_class(classifier: &Classifier, model: &Model) -> Option<(u16, f32)>
 
 /// [`Classifier::plane_into`] for a design of [`fixed_class`] `(lab, fv)`:
 /// `lab` where the distance is not above zero, void elsewhere and on the
-/// grid's outer layer, with the same tallies; no fractions are read, and
-/// no zeroing pass precedes the labels (each is written once).
+/// grid's outer layer, with the same tallies, and the labels as bits too
+/// ([`Plane::bits`]); no fractions are read, and no zeroing pass precedes
+/// the labels (each is written once).
 pub fn fixed_plane_into(
     slab_dist: &Arc<Vec<f32>>,
     l: usize,
@@ -376,24 +391,37 @@ pub fn fixed_plane_into(
     (lab, fv): (u16, f32),
 ) -> (Plane, Tally) {
     let layer = nx * ny;
-    let (mut label, dist, mut value) = reuse.for_layer(slab_dist, l, layer);
+    let words = nx.div_ceil(64);
+    let Plane {
+        mut label,
+        dist,
+        mut value,
+        mut bits,
+    } = reuse.for_layer(slab_dist, l, layer);
     let rows_dist: &[f32] = &dist;
-    // Every label is written below: a reused plane keeps its length.
+    // Every label and word is written below: a reused plane keeps its length.
     label.resize(layer, 0);
+    bits.resize(words * ny, 0);
     value.clear();
-    let edge_plane = z == 0 || z + 1 == nz || nx < 3;
+    // (One segment: `lab` is 1, or 0 when the mix is void.)
+    debug_assert!(lab <= 1, "one segment's label {lab}");
+    let void = z == 0 || z + 1 == nz || nx < 3 || lab == 0;
     let counts: Vec<u64> = label
         .par_chunks_mut(nx)
+        .zip(bits.par_chunks_mut(words))
         .enumerate()
-        .map(|(y, labels)| {
-            if edge_plane || y == 0 || y + 1 == ny {
+        .map(|(y, (labels, bits))| {
+            if void || y == 0 || y + 1 == ny {
                 labels.fill(0);
+                bits.fill(0);
                 return 0;
             }
-            let row = &rows_dist[y * nx + 1..(y + 1) * nx - 1];
+            sign_labels(labels, &rows_dist[y * nx..(y + 1) * nx], lab);
+            // The grid's outer columns are void.
             labels[0] = 0;
             labels[nx - 1] = 0;
-            sign_labels(&mut labels[1..nx - 1], row, lab)
+            label_bits(labels, bits);
+            bits.iter().map(|w| u64::from(w.count_ones())).sum()
         })
         .collect();
     let mut tally = Tally::new(1);
@@ -402,17 +430,21 @@ pub fn fixed_plane_into(
             tally.add_row(&[n], &[f64::from(fv) * n as f64]);
         }
     }
-    (Plane { label, dist, value }, tally)
+    let plane = Plane {
+        label,
+        dist,
+        value,
+        bits,
+    };
+    (plane, tally)
 }
 
 /// `lab` into `labels` where `dist` is not above zero (a NaN is not
 /// outside, as in [`Classifier::plane_into`]: hence the negated
-/// comparisons), 0 elsewhere; returns how many got `lab`. Eight at a time
-/// as fixed-size arrays, which compile to vector compares and stores (a
-/// loop over the row did not).
+/// comparisons), 0 elsewhere. Eight at a time as fixed-size arrays, which
+/// compile to vector compares and stores (a loop over the row did not).
 #[allow(clippy::neg_cmp_op_on_partial_ord)]
-fn sign_labels(labels: &mut [u16], dist: &[f32], lab: u16) -> u64 {
-    let mut inside = 0u64;
+fn sign_labels(labels: &mut [u16], dist: &[f32], lab: u16) {
     let mut out = labels.chunks_exact_mut(8);
     let mut ds = dist.chunks_exact(8);
     for (o, d) in (&mut out).zip(&mut ds) {
@@ -420,28 +452,41 @@ fn sign_labels(labels: &mut [u16], dist: &[f32], lab: u16) -> u64 {
         for k in 0..8 {
             o[k] = m[k] * lab;
         }
-        inside += u64::from(m.iter().sum::<u16>());
     }
     for (o, d) in out.into_remainder().iter_mut().zip(ds.remainder()) {
-        let m = u16::from(!(*d > 0.0));
-        *o = m * lab;
-        inside += u64::from(m);
+        *o = u16::from(!(*d > 0.0)) * lab;
     }
-    inside
+}
+
+/// Bit `x % 64` of word `x / 64` set where `labels[x]` is 1 (labels 0 or
+/// 1): four labels a multiplication, read as one 64-bit word whose four
+/// low bits of 16 the product gathers into bits 48..52 (the partial
+/// products below bit 48 fall on distinct bits, so nothing carries in).
+fn label_bits(labels: &[u16], bits: &mut [u64]) {
+    const GATHER: u64 = 1 << 48 | 1 << 33 | 1 << 18 | 1 << 3;
+    for (w, chunk) in bits.iter_mut().zip(labels.chunks(64)) {
+        let (quads, rest) = chunk.as_chunks::<4>();
+        let mut word = 0u64;
+        for (q, l) in quads.iter().enumerate() {
+            let v = u64::from(l[0])
+                | u64::from(l[1]) << 16
+                | u64::from(l[2]) << 32
+                | u64::from(l[3]) << 48;
+            word |= (v.wrapping_mul(GATHER) >> 48 & 0xF) << (4 * q);
+        }
+        for (k, l) in rest.iter().enumerate() {
+            word |= u64::from(*l) << (4 * quads.len() + k);
+        }
+        *w = word;
+    }
 }
 
 impl Plane {
-    /// This retired plane's label and value buffers, for layer `l` (of
-    /// `layer` voxels) of the shared slab distances `slab_dist`, with that
-    /// layer's view.
-    fn for_layer(
-        self,
-        slab_dist: &Arc<Vec<f32>>,
-        l: usize,
-        layer: usize,
-    ) -> (Vec<u16>, LayerDist, Vec<f32>) {
+    /// This retired plane's buffers, for layer `l` (of `layer` voxels) of
+    /// the shared slab distances `slab_dist`, with that layer's view.
+    fn for_layer(self, slab_dist: &Arc<Vec<f32>>, l: usize, layer: usize) -> Plane {
         let dist = LayerDist::new(slab_dist, l * layer..(l + 1) * layer);
-        (self.label, dist, self.value)
+        Plane { dist, ..self }
     }
 }
 

@@ -358,6 +358,13 @@ fn fixed_mixes_label_planes_from_signs_alone() {
                 };
                 let (b, tb) = segment::fixed_plane_into(&dist, l, dims, z, reuse, class);
                 assert_eq!(a.label, b.label, "{src}: labels of layer {z}");
+                let words = dims[0].div_ceil(64);
+                let mut bits = vec![0u64; words * dims[1]];
+                for (v, l) in a.label.iter().enumerate() {
+                    let (x, y) = (v % dims[0], v / dims[0]);
+                    bits[y * words + x / 64] |= u64::from(*l != 0) << (x % 64);
+                }
+                assert_eq!(bits, b.bits, "{src}: label bits of layer {z}");
                 assert_eq!(ta.voxels, tb.voxels, "{src}: counts of layer {z}");
                 let (fa, fb) = (ta.sum_f[0], tb.sum_f[0]);
                 assert!((fa - fb).abs() <= 1e-9 * fa.abs(), "{src}: {fa} vs {fb}");

@@ -149,6 +149,7 @@ fn two_segments(iface: Interface) -> [Vec<IndexedMesh>; 3] {
                     label,
                     dist: d.into(),
                     value,
+                    bits: Vec::new(),
                 },
                 &|[i, j, k]| dist[(k * ny + j) * nx + i],
             );
