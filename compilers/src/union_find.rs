@@ -11,6 +11,15 @@ pub fn find(parent: &mut [u32], mut i: u32) -> u32 {
     i
 }
 
+/// The root of `i`, without shortening the path (for readers that share
+/// `parent`).
+pub fn root(parent: &[u32], mut i: u32) -> u32 {
+    while parent[i as usize] != i {
+        i = parent[i as usize];
+    }
+    i
+}
+
 /// Join the sets of `a` and `b`.
 pub fn join(parent: &mut [u32], a: u32, b: u32) {
     let (a, b) = (find(parent, a), find(parent, b));

@@ -417,11 +417,30 @@ impl Regions {
                 outline: Vec::new(),
             })
             .collect();
-        for e in 0..self.edges.len() {
-            let r = crate::union_find::find(&mut self.parent, self.edges[e].cube);
-            if let Ok(s) = roots.binary_search(&r) {
-                regions[s].edges.push(e as u32);
-                regions[s].outline.push(self.edges[e].xi);
+        // Each edge's region on every core (roots read without shortening
+        // paths), then the edges dealt out in order into lists sized first.
+        let region_of: Vec<u32> = {
+            let parent = &self.parent;
+            self.edges
+                .par_iter()
+                .map(|e| {
+                    let r = crate::union_find::root(parent, e.cube);
+                    roots.binary_search(&r).map_or(u32::MAX, |s| s as u32)
+                })
+                .collect()
+        };
+        let mut sizes = vec![0usize; regions.len()];
+        for &s in region_of.iter().filter(|&&s| s != u32::MAX) {
+            sizes[s as usize] += 1;
+        }
+        for (r, &n) in regions.iter_mut().zip(&sizes) {
+            r.edges.reserve_exact(n);
+            r.outline.reserve_exact(n);
+        }
+        for (e, &s) in region_of.iter().enumerate() {
+            if let Some(r) = regions.get_mut(s as usize) {
+                r.edges.push(e as u32);
+                r.outline.push(self.edges[e].xi);
             }
         }
         let tris: Vec<Option<Triangulated>> = {
@@ -445,6 +464,22 @@ impl Regions {
                     regions[s].cubes.push(id);
                 }
             }
+        }
+        // The meshes grow once, not by doubling (each doubling copies the
+        // mesh and faults in fresh pages).
+        let mut more = vec![(0usize, 0usize); meshes.len()];
+        for (r, t) in regions.iter().zip(&tris) {
+            let Some(t) = t else { continue };
+            for label in [r.key.x as usize, r.key.y as usize] {
+                if label > 0 {
+                    more[label - 1].0 += t.added.len();
+                    more[label - 1].1 += t.tris.len();
+                }
+            }
+        }
+        for (m, (v, t)) in meshes.iter_mut().zip(more) {
+            m.vertices.reserve(v);
+            m.triangles.reserve(t);
         }
         let mut scratch = Vec::new();
         for (r, t) in regions.iter().zip(tris) {
