@@ -156,6 +156,11 @@ fn bad_input_is_a_clear_error() {
     let err = fails(&run("64"));
     assert!(err.contains("runaway.rhai:3:"), "{err}");
     assert!(err.contains("grew past 64 MiB of memory"), "{err}");
+    // It says where the budget comes from.
+    assert!(
+        err.contains("the budget is VOLCAD_SCRIPT_MEMORY_MB"),
+        "{err}"
+    );
     let err = fails(&run("lots"));
     assert!(
         err.contains("VOLCAD_SCRIPT_MEMORY_MB=lots: give the script's memory budget"),

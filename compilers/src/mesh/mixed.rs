@@ -67,7 +67,7 @@ pub(super) fn mixed_from_bits([a, b, c, d]: [&[u64]; 4], nx: usize) -> impl Iter
         let base = 64 * w;
         let mut bits = here | right | step;
         if base + 64 > cubes {
-            bits &= (1u64 << cubes.saturating_sub(base).min(63)) - 1;
+            bits &= (1u64 << cubes.saturating_sub(base)) - 1;
         }
         std::iter::from_fn(move || {
             (bits != 0).then(|| {
