@@ -409,11 +409,18 @@ pub fn segment_meshes(
 
 /// The sampler of a mesh export: fractions, and (unless `uniform` is
 /// `None`, in tests) label-uniform solid tiles filled with one evaluation.
-fn sampler_for<'a>(model: &'a Model, grid: Grid, uniform: Option<UniformTest<'a>>) -> Sampler<'a> {
-    let consumer = match uniform {
-        Some(u) => Consumer::MeshContour(u),
+fn sampler_for<'a>(
+    model: &'a Model,
+    grid: Grid,
+    uniform: Option<UniformTest<'a>>,
+    fixed: Option<(u16, f32)>,
+) -> Sampler<'a> {
+    let consumer = match (uniform, fixed) {
+        // Labels from signs alone (`label_plane`): no fractions to write.
+        (Some(_), Some(_)) => Consumer::MeshContourSigns,
+        (Some(u), None) => Consumer::MeshContour(u),
         // The reference the tests compare with: every voxel sampled.
-        None => Consumer::ViewportBake,
+        (None, _) => Consumer::ViewportBake,
     };
     Sampler::new(model, grid, consumer)
 }
@@ -436,7 +443,7 @@ fn sampled_triangles(
         return 0;
     }
     let uniform = |b: &[volcad_core::interval::Interval]| classifier.uniform(b);
-    let sampler = sampler_for(model, grid, Some(&uniform));
+    let sampler = sampler_for(model, grid, Some(&uniform), fixed);
     let mut slab = Slab::default();
     let (mut made, mut picks) = (0, 0);
     for z in sampled_layers(0..layers, SAMPLED_LAYERS) {
@@ -498,7 +505,12 @@ fn build(
     let dims = pl.grid.dims;
     let nz = dims[2];
     let uniform = |b: &[volcad_core::interval::Interval]| pl.classifier.uniform(b);
-    let sampler = sampler_for(model, pl.grid, pl.uniform_tiles.then_some(&uniform));
+    let sampler = sampler_for(
+        model,
+        pl.grid,
+        pl.uniform_tiles.then_some(&uniform),
+        pl.fixed,
+    );
     let mut contourer =
         Contourer::new(pl.grid, pl.classifier.segments(), pl.classifier.interface());
     contourer = match pl.flat {

@@ -396,7 +396,7 @@ fn counting_contourers_count_what_building_ones_make() {
         let p = params(0.2, SegmentBy::Material(red), segments);
         let pl = plan(&bar, &p, Look::Coarse).expect("plan");
         let dims = pl.grid.dims;
-        let sampler = sampler_for(&bar, pl.grid, None);
+        let sampler = sampler_for(&bar, pl.grid, None, None);
         let mut slab = Slab::default();
         let cancel = AtomicBool::new(false);
         sampler

@@ -60,6 +60,13 @@ pub enum Consumer<'a> {
     /// holding the block's (looser) interval end, whose sign is all a
     /// mesher reads there.
     MeshContour(UniformTest<'a>),
+    /// A mesh export whose labels come from the distances' signs alone
+    /// (one segment of a design whose mix is fixed): as
+    /// [`Consumer::MeshContour`], without fractions (`Slab::k` is 0) or
+    /// rectangles. The distances written are the same bits: with its mix
+    /// fixed, `MeshContour` evaluates no fraction either, and settles the
+    /// same tiles with the same margins.
+    MeshContourSigns,
     /// A slice stack of a design with one material everywhere: signs only.
     PngStackSingle,
     /// An error-diffusion slice stack: signs and every voxel's fractions.
@@ -134,6 +141,12 @@ impl<'a> Consumer<'a> {
             lipschitz_skip: true,
             ..plain
         };
+        let contour = Needs {
+            blocks: true,
+            unevaluated_near: true,
+            outside_fracs: false,
+            ..signs
+        };
         match self {
             Consumer::ViewportBake | Consumer::PngStackKeepOut => plain,
             Consumer::SurfaceContour => Needs {
@@ -143,12 +156,11 @@ impl<'a> Consumer<'a> {
             Consumer::MeshContour(test) => Needs {
                 uniform: Some(test),
                 solid_rects: true,
-                blocks: true,
-                signs_only: true,
-                lipschitz_skip: true,
-                unevaluated_near: true,
-                outside_fracs: false,
-                ..plain
+                ..contour
+            },
+            Consumer::MeshContourSigns => Needs {
+                fracs: false,
+                ..contour
             },
             Consumer::PngStackSingle => Needs {
                 fracs: false,

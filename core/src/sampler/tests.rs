@@ -235,3 +235,33 @@ fn leaf_bounds_keep_what_consumers_read() {
         evaluated(&off)
     );
 }
+
+#[test]
+fn mesh_contour_signs_writes_the_fixed_mix_distances_without_fractions() {
+    // One material (a fixed mix): a mesh export of one segment labels by
+    // signs, and its sampler must write the distances the fraction-writing
+    // one does, bit for bit, through blocks, leaves and settled tiles.
+    let m = model(
+        r#"let m = default_materials();
+        let cell = GraphLattice(LatticeType::BodyCenteredCubic, Vec3(4, 4, 4), 0.4, m.id("gray"));
+        Intersection(false, [Tile(cell), Sphere(Vec3(0, 0, 0), 6)])"#,
+    );
+    let grid = Grid::covering(&m.bbox(), DVec3::splat(0.12), 1 << 30).unwrap();
+    let always = |_: &[Interval]| true;
+    let (with, with_evaluated) =
+        sample_all(&Sampler::new(&m, grid, Consumer::MeshContour(&always)));
+    let (signs, signs_evaluated) = sample_all(&Sampler::new(&m, grid, Consumer::MeshContourSigns));
+    assert!(with.k > 0 && signs.k == 0, "k {} and {}", with.k, signs.k);
+    assert!(signs.fracs.is_empty() && signs.rects.is_empty());
+    assert_eq!(with.dist.len(), signs.dist.len());
+    let differ = (with.dist.iter().zip(&signs.dist))
+        .filter(|(a, b)| a.to_bits() != b.to_bits())
+        .count();
+    assert_eq!(differ, 0, "voxels whose distance bits differ");
+    assert_eq!(with_evaluated, signs_evaluated);
+    assert!(
+        signs.dist.iter().any(|d| d.is_infinite()),
+        "no unevaluated voxel"
+    );
+    assert!(signs.dist.iter().filter(|d| **d <= 0.0).count() > 10_000);
+}
