@@ -54,7 +54,7 @@ use super::kuhn::{
     two_label_cut,
 };
 use super::layer_dist::LayerDist;
-use super::mixed::{around, mixed_cubes, mixed_from_bits};
+use super::mixed::{around, mixed_cubes, push_mixed_from_bits};
 use super::one_label::{LayerEdges, OneLabelBand, PlaneEdges};
 pub use super::unevaluated::ExactAt;
 use super::unevaluated::{CornerMemo, Layer};
@@ -345,7 +345,7 @@ impl Contourer {
         for j in js {
             xs.clear();
             if bits {
-                xs.extend(mixed_from_bits(around(&lo.bits, &hi.bits, j, words), nx));
+                push_mixed_from_bits(around(&lo.bits, &hi.bits, j, words), nx, &mut xs);
             } else {
                 xs.extend(mixed_cubes(around(&lo.label, &hi.label, j, nx)));
             }

@@ -46,19 +46,22 @@ pub(super) fn mixed_cubes([a, b, c, d]: [&[u16]; 4]) -> impl Iterator<Item = usi
 
 /// [`mixed_cubes`] from one label's rows as bits (bit `x % 64` of word
 /// `x / 64` set where voxel `x`'s label is not 0; bits past the row's
-/// `nx` voxels clear): the same cubes, 64 at a time with a few word
-/// operations, where the labels cost about one instruction a cube.
-pub(super) fn mixed_from_bits([a, b, c, d]: [&[u64]; 4], nx: usize) -> impl Iterator<Item = usize> {
+/// `nx` voxels clear), appended to `out`: the same cubes, 64 at a time
+/// with a few word operations, where the labels cost about one
+/// instruction a cube. A plain loop into the caller's list: as an
+/// iterator (`flat_map` of `from_fn`) each cube was a push with its own
+/// capacity check and the iterator's state carried between them.
+pub(super) fn push_mixed_from_bits([a, b, c, d]: [&[u64]; 4], nx: usize, out: &mut Vec<usize>) {
     let cubes = nx.saturating_sub(1);
     let words = a.len();
-    let col = move |w: usize| {
+    let col = |w: usize| {
         if w < words {
             (a[w] ^ b[w]) | (a[w] ^ c[w]) | (a[w] ^ d[w])
         } else {
             0
         }
     };
-    (0..words).flat_map(move |w| {
+    for w in 0..words {
         // Cube t of the word: columns t and t + 1 (bit 0 of the next word).
         let next_a = if w + 1 < words { a[w + 1] } else { 0 };
         let here = col(w);
@@ -69,14 +72,15 @@ pub(super) fn mixed_from_bits([a, b, c, d]: [&[u64]; 4], nx: usize) -> impl Iter
         if base + 64 > cubes {
             bits &= (1u64 << cubes.saturating_sub(base)) - 1;
         }
-        std::iter::from_fn(move || {
-            (bits != 0).then(|| {
-                let t = bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                base + t
-            })
-        })
-    })
+        if bits == 0 {
+            continue;
+        }
+        out.reserve(bits.count_ones() as usize);
+        while bits != 0 {
+            out.push(base + bits.trailing_zeros() as usize);
+            bits &= bits - 1;
+        }
+    }
 }
 
 /// Bit `t` set when cube `t` of these `n + 1`-long rows (`n ≤ 64`) is mixed.
@@ -171,7 +175,9 @@ mod tests {
         cases(7, 2.0, |rows, len, density| {
             let bits = rows.map(as_bits);
             let words = [&bits[0][..], &bits[1][..], &bits[2][..], &bits[3][..]];
-            let found: Vec<usize> = mixed_from_bits(words, len).collect();
+            let mut found = vec![usize::MAX];
+            push_mixed_from_bits(words, len, &mut found);
+            assert_eq!(found.remove(0), usize::MAX, "appends");
             assert_eq!(found, naive(rows), "{len} {density}");
         });
     }
