@@ -54,7 +54,9 @@ pub(super) fn front_back(a: u16, b: u16) -> (u16, u16) {
 /// sample with distance `d` and interface values `f` (the distance next to
 /// void, `f − c` at the range boundary `c`, `f_lb − f_la` for dominant
 /// materials); `None` for [`Interface::Midpoint`] between segments. With
-/// `(la, lb)` from [`front_back`] it is negative on `la`'s side.
+/// `(la, lb)` from [`front_back`] it is negative on `la`'s side. Inlined:
+/// called twice for every vertex placed, where the first test decides.
+#[inline]
 pub(super) fn cut_field(iface: Interface, la: u16, lb: u16, d: f32, f: &[f32]) -> Option<f64> {
     if la == 0 || lb == 0 {
         return Some(f64::from(d));
