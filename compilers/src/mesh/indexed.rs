@@ -209,19 +209,30 @@ impl IndexedMesh {
         let nv = self.vertices.len();
         let parts = rayon::current_num_threads().clamp(1, 16).min(nv.max(1));
         let first = |p: usize| (nv * p / parts) as u32;
+        let spans = if parts > 1 { self.spans() } else { Vec::new() };
         let per_part: Vec<(usize, usize)> = (0..parts)
             .into_par_iter()
             .map(|p| {
                 let (lo, hi) = (first(p), first(p + 1));
+                // The triangles a part must read: those of the chunks whose
+                // vertices reach its range (one chunk, all, for one part).
+                let tris: Vec<&[[u32; 3]]> = if spans.is_empty() {
+                    vec![&self.triangles[..]]
+                } else {
+                    (self.triangles.chunks(SPAN_CHUNK).zip(&spans))
+                        .filter(|(_, s)| s[0] < hi && s[1] >= lo)
+                        .map(|(c, _)| c)
+                        .collect()
+                };
                 // Counting sort of the part's entries by smaller vertex.
                 let mut start = vec![0u32; (hi - lo) as usize + 1];
-                self.each_filed(lo, hi, |m, _| start[(m - lo) as usize + 1] += 1);
+                each_filed(&tris, lo, hi, |m, _| start[(m - lo) as usize + 1] += 1);
                 for i in 1..start.len() {
                     start[i] += start[i - 1];
                 }
                 let mut filed = vec![0u32; start[start.len() - 1] as usize];
                 let mut fill = start.clone();
-                self.each_filed(lo, hi, |m, entry| {
+                each_filed(&tris, lo, hi, |m, entry| {
                     let f = &mut fill[(m - lo) as usize];
                     filed[*f as usize] = entry;
                     *f += 1;
@@ -248,17 +259,23 @@ impl IndexedMesh {
             .fold((0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
     }
 
-    /// Calls `file(m, 2M + d)` for each edge of a triangle whose smaller
-    /// vertex `m` lies in `lo..hi` (see [`Self::edge_report`]).
-    fn each_filed(&self, lo: u32, hi: u32, mut file: impl FnMut(u32, u32)) {
-        for t in &self.triangles {
-            for (a, b) in sides(t) {
-                let (m, big) = if a < b { (a, b) } else { (b, a) };
-                if a != b && (lo..hi).contains(&m) {
-                    file(m, (big << 1) | u32::from(a < b));
-                }
-            }
-        }
+    /// The least and greatest vertex of each chunk of [`SPAN_CHUNK`]
+    /// triangles. A contoured mesh numbers its vertices as its triangles
+    /// come, band by band, so a chunk's vertices span a narrow range: a
+    /// part of [`Self::filed_edge_counts`] reads only the chunks that
+    /// reach its vertices, not every triangle twice.
+    fn spans(&self) -> Vec<[u32; 2]> {
+        self.triangles
+            .par_chunks(SPAN_CHUNK)
+            .map(|c| {
+                c.iter().fold([u32::MAX, 0], |[lo, hi], t| {
+                    [
+                        lo.min(t[0].min(t[1]).min(t[2])),
+                        hi.max(t[0].max(t[1]).max(t[2])),
+                    ]
+                })
+            })
+            .collect()
     }
 
     /// `(repeated, open)` counted in a map of undirected edges: for meshes
@@ -286,6 +303,23 @@ impl IndexedMesh {
         !self.is_empty() && self.edge_report().is_clean()
     }
 }
+
+/// Calls `file(m, 2M + d)` for each edge of the triangles of `chunks`
+/// whose smaller vertex `m` lies in `lo..hi`, in order (see
+/// [`IndexedMesh::edge_report`]).
+fn each_filed(chunks: &[&[[u32; 3]]], lo: u32, hi: u32, mut file: impl FnMut(u32, u32)) {
+    for t in chunks.iter().flat_map(|c| c.iter()) {
+        for (a, b) in sides(t) {
+            let (m, big) = if a < b { (a, b) } else { (b, a) };
+            if a != b && (lo..hi).contains(&m) {
+                file(m, (big << 1) | u32::from(a < b));
+            }
+        }
+    }
+}
+
+/// Triangles a chunk of [`IndexedMesh::spans`].
+const SPAN_CHUNK: usize = 1 << 12;
 
 /// The directed edges of triangle `t`, in its order.
 fn sides(t: &[u32; 3]) -> [(u32, u32); 3] {
@@ -335,20 +369,7 @@ mod tests {
     /// several (its triangles span several chunks).
     #[test]
     fn volume_and_shape_do_not_depend_on_threads() {
-        let grid = volcad_core::sampler::Grid::covering(
-            &volcad_core::Aabb::new(glam::DVec3::splat(-6.0), glam::DVec3::splat(6.0)),
-            glam::DVec3::splat(0.1),
-            u128::MAX,
-        )
-        .expect("grid");
-        let values: Vec<f32> = (0..grid.count() as usize)
-            .map(|v| {
-                let [nx, ny, _] = grid.dims;
-                let (x, y, z) = (v % nx, v / nx % ny, v / (nx * ny));
-                (grid.center(x, y, z).length() - 5.0) as f32
-            })
-            .collect();
-        let m = super::super::marching_cubes(&grid, &values);
+        let m = sphere(0.1);
         assert!(
             m.triangles.len() > 3 * VOLUME_CHUNK,
             "{}",
@@ -362,6 +383,25 @@ mod tests {
         assert_eq!(one, on(4));
         let exact = 4.0 / 3.0 * std::f64::consts::PI * 125.0;
         assert!((one.0 - exact).abs() < 0.01 * exact, "{} vs {exact}", one.0);
+    }
+
+    /// A sphere of radius 5 mm marched at `voxel` (triangles in contour
+    /// order).
+    fn sphere(voxel: f64) -> IndexedMesh {
+        let grid = volcad_core::sampler::Grid::covering(
+            &volcad_core::Aabb::new(glam::DVec3::splat(-6.0), glam::DVec3::splat(6.0)),
+            glam::DVec3::splat(voxel),
+            u128::MAX,
+        )
+        .expect("grid");
+        let values: Vec<f32> = (0..grid.count() as usize)
+            .map(|v| {
+                let [nx, ny, _] = grid.dims;
+                let (x, y, z) = (v % nx, v / nx % ny, v / (nx * ny));
+                (grid.center(x, y, z).length() - 5.0) as f32
+            })
+            .collect();
+        super::super::marching_cubes(&grid, &values)
     }
 
     /// The unit cube, outward oriented (12 triangles).
@@ -476,6 +516,38 @@ mod tests {
         let r = pinched.edge_report();
         assert_eq!(r.degenerate, 1, "{r:?}");
         assert!(!pinched.is_watertight());
+    }
+
+    /// A sphere of many chunks ([`SPAN_CHUNK`]), clean and with defects
+    /// far apart, its triangles in contour order and shuffled (chunks whose
+    /// vertices span everything): the parts' chunk filter files what the
+    /// map counts, on any thread count.
+    #[test]
+    fn chunked_filing_counts_what_the_map_does() {
+        let clean = sphere(0.15);
+        let n = clean.triangles.len();
+        assert!(n > 8 * SPAN_CHUNK, "{n}");
+        let mut holed = clean.clone();
+        holed.triangles.remove(n / 3);
+        holed.triangles.push(clean.triangles[n - 7]);
+        let t = holed.triangles[n / 2];
+        holed.triangles[n / 2] = [t[0], t[2], t[1]];
+        let mut shuffled = holed.clone();
+        let mut rng = volcad_core::bench::XorShift::new(3);
+        for i in (1..shuffled.triangles.len()).rev() {
+            let j = (rng.next_f64() * (i + 1) as f64) as usize;
+            shuffled.triangles.swap(i, j.min(i));
+        }
+        for m in [&clean, &holed, &shuffled] {
+            let want = m.mapped_edge_counts();
+            for threads in [1, 2, 5] {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build();
+                let got = pool.expect("pool").install(|| m.filed_edge_counts());
+                assert_eq!(got, want, "{threads} threads");
+            }
+        }
+        assert_eq!(clean.mapped_edge_counts(), (0, 0));
+        assert_ne!(holed.mapped_edge_counts(), (0, 0));
     }
 
     #[test]
