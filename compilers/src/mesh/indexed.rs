@@ -36,9 +36,10 @@ impl EdgeReport {
     }
 }
 
+/// (Written out: `array::map` was left a call, once per triangle read.)
 #[inline]
 fn f64x3(p: [f32; 3]) -> [f64; 3] {
-    p.map(f64::from)
+    [f64::from(p[0]), f64::from(p[1]), f64::from(p[2])]
 }
 
 #[inline]
@@ -166,7 +167,11 @@ impl IndexedMesh {
         let n = cross(sub(b, a), sub(c, a));
         let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
         if len > 0.0 {
-            n.map(|v| (v / len) as f32)
+            [
+                (n[0] / len) as f32,
+                (n[1] / len) as f32,
+                (n[2] / len) as f32,
+            ]
         } else {
             [0.0; 3]
         }

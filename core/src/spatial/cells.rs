@@ -103,10 +103,19 @@ impl CellLattice {
         Some((self.index([x, y, z]), [x, y, z]))
     }
 
-    /// Centre of cell `c`.
+    /// Centre of cell `c` (within `dims`).
     #[inline(always)]
     pub fn centre(&self, c: [usize; 3]) -> DVec3 {
-        self.min + (DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64) + 0.5) * self.cell
+        debug_assert!(
+            (0..3).all(|i| c[i] < self.dims[i]),
+            "{c:?} beyond {:?}",
+            self.dims
+        );
+        // Through `u32` (every cell is below 2³², `new` asserts it): one
+        // conversion instruction each where a `usize`'s takes several, on
+        // the path of every query. The same values.
+        let f = |i: usize| f64::from(c[i] as u32);
+        self.min + (DVec3::new(f(0), f(1), f(2)) + 0.5) * self.cell
     }
 
     /// Cells along each axis.
