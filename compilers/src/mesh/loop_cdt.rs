@@ -58,7 +58,7 @@ pub(super) fn triangulate(
         return None;
     }
     // Ears give n − 2 triangles and each inner point two more: room for
-    // all at once (grown push by push, these were a tenth of the time).
+    // all at once (grown push by push, each growth copied them).
     let most = n - 2 + 2 * (pts.len() - outline);
     let mut mesh = Mesh {
         tris: Vec::with_capacity(most),

@@ -408,7 +408,9 @@ pub fn segment_meshes(
 }
 
 /// The sampler of a mesh export: fractions, and (unless `uniform` is
-/// `None`, in tests) label-uniform solid tiles filled with one evaluation.
+/// `None`, in tests) label-uniform solid tiles filled with one evaluation;
+/// where the labels come from signs alone (a `fixed` class), distances
+/// only.
 fn sampler_for<'a>(
     model: &'a Model,
     grid: Grid,
