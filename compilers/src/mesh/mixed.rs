@@ -54,21 +54,23 @@ pub(super) fn mixed_cubes([a, b, c, d]: [&[u16]; 4]) -> impl Iterator<Item = usi
 pub(super) fn push_mixed_from_bits([a, b, c, d]: [&[u64]; 4], nx: usize, out: &mut Vec<usize>) {
     let cubes = nx.saturating_sub(1);
     let words = a.len();
-    let col = |w: usize| {
-        if w < words {
-            (a[w] ^ b[w]) | (a[w] ^ c[w]) | (a[w] ^ d[w])
-        } else {
-            0
-        }
-    };
+    // (The four rows have one length: no bounds checks below.)
+    let (b, c, d) = (&b[..words], &c[..words], &d[..words]);
+    let col = |w: usize| (a[w] ^ b[w]) | (a[w] ^ c[w]) | (a[w] ^ d[w]);
+    // Each word's column mix once, carried to the word before it.
+    let mut here = if words > 0 { col(0) } else { 0 };
     for w in 0..words {
         // Cube t of the word: columns t and t + 1 (bit 0 of the next word).
-        let next_a = if w + 1 < words { a[w + 1] } else { 0 };
-        let here = col(w);
-        let right = (here >> 1) | (col(w + 1) << 63);
+        let (next_col, next_a) = if w + 1 < words {
+            (col(w + 1), a[w + 1])
+        } else {
+            (0, 0)
+        };
+        let right = (here >> 1) | (next_col << 63);
         let step = a[w] ^ ((a[w] >> 1) | (next_a << 63));
         let base = 64 * w;
         let mut bits = here | right | step;
+        here = next_col;
         if base + 64 > cubes {
             bits &= (1u64 << cubes.saturating_sub(base)) - 1;
         }

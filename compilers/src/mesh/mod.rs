@@ -45,6 +45,7 @@ mod one_label;
 mod outline;
 mod output;
 pub mod segment;
+mod sign_row;
 pub mod stl;
 mod text_blocks;
 pub mod threemf;

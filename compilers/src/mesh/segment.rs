@@ -25,6 +25,7 @@ use volcad_core::sampler::{RectRows, Slab, fill_pattern};
 use super::contour::Plane;
 use super::interface::Interface;
 use super::layer_dist::LayerDist;
+use super::sign_row::sign_row;
 use crate::dither::{BOUND_MARGIN as EPS, MIN_TOTAL};
 
 /// How voxels are put into segments.
@@ -416,11 +417,12 @@ pub fn fixed_plane_into(
                 bits.fill(0);
                 return 0;
             }
-            sign_labels(labels, &rows_dist[y * nx..(y + 1) * nx], lab);
+            sign_row(labels, bits, &rows_dist[y * nx..(y + 1) * nx], lab);
             // The grid's outer columns are void.
             labels[0] = 0;
             labels[nx - 1] = 0;
-            label_bits(labels, bits);
+            bits[0] &= !1;
+            bits[(nx - 1) / 64] &= !(1 << ((nx - 1) % 64));
             bits.iter().map(|w| u64::from(w.count_ones())).sum()
         })
         .collect();
@@ -437,48 +439,6 @@ pub fn fixed_plane_into(
         bits,
     };
     (plane, tally)
-}
-
-/// `lab` into `labels` where `dist` is not above zero (a NaN is not
-/// outside, as in [`Classifier::plane_into`]: hence the negated
-/// comparisons), 0 elsewhere. Eight at a time as fixed-size arrays, which
-/// compile to vector compares and stores (a loop over the row did not).
-#[allow(clippy::neg_cmp_op_on_partial_ord)]
-fn sign_labels(labels: &mut [u16], dist: &[f32], lab: u16) {
-    let mut out = labels.chunks_exact_mut(8);
-    let mut ds = dist.chunks_exact(8);
-    for (o, d) in (&mut out).zip(&mut ds) {
-        let m: [u16; 8] = std::array::from_fn(|k| u16::from(!(d[k] > 0.0)));
-        for k in 0..8 {
-            o[k] = m[k] * lab;
-        }
-    }
-    for (o, d) in out.into_remainder().iter_mut().zip(ds.remainder()) {
-        *o = u16::from(!(*d > 0.0)) * lab;
-    }
-}
-
-/// Bit `x % 64` of word `x / 64` set where `labels[x]` is 1 (labels 0 or
-/// 1): four labels a multiplication, read as one 64-bit word whose four
-/// low bits of 16 the product gathers into bits 48..52 (the partial
-/// products below bit 48 fall on distinct bits, so nothing carries in).
-fn label_bits(labels: &[u16], bits: &mut [u64]) {
-    const GATHER: u64 = 1 << 48 | 1 << 33 | 1 << 18 | 1 << 3;
-    for (w, chunk) in bits.iter_mut().zip(labels.chunks(64)) {
-        let (quads, rest) = chunk.as_chunks::<4>();
-        let mut word = 0u64;
-        for (q, l) in quads.iter().enumerate() {
-            let v = u64::from(l[0])
-                | u64::from(l[1]) << 16
-                | u64::from(l[2]) << 32
-                | u64::from(l[3]) << 48;
-            word |= (v.wrapping_mul(GATHER) >> 48 & 0xF) << (4 * q);
-        }
-        for (k, l) in rest.iter().enumerate() {
-            word |= u64::from(*l) << (4 * quads.len() + k);
-        }
-        *w = word;
-    }
 }
 
 impl Plane {
