@@ -43,31 +43,39 @@ fn sign_row_sse2(labels: &mut [u16], bits: &mut [u64], dist: &[f32], lab: u16) {
         .zip(dist.chunks(64))
         .zip(labels.chunks_mut(64))
     {
+        // A whole word as fixed-size arrays: eight steps of constant
+        // offsets, no bounds checks or iterator state between them.
+        let (Ok(d), Ok(l)) = (
+            <&[f32; 64]>::try_from(ds),
+            <&mut [u16; 64]>::try_from(&mut *ls),
+        ) else {
+            let mut m = 0u64;
+            for (x, (d, l)) in ds.iter().zip(ls.iter_mut()).enumerate() {
+                #[allow(clippy::neg_cmp_op_on_partial_ord)]
+                let inside = !(*d > 0.0);
+                *l = u16::from(inside) * lab;
+                m |= u64::from(inside) << x;
+            }
+            *word = m & keep;
+            continue;
+        };
         let mut m = 0u64;
-        let mut d8 = ds.chunks_exact(8);
-        let mut l8 = ls.chunks_exact_mut(8);
-        for (k, (d, out)) in (&mut d8).zip(&mut l8).enumerate() {
+        for k in 0..8 {
             // SAFETY: SSE2 is in every x86-64 processor (the target's
-            // baseline). The loads read `d`'s eight floats and the store
-            // writes `out`'s eight labels (`chunks_exact` of 8), both in
+            // baseline). The loads read floats 8k..8k + 8 of `d` and the
+            // store writes labels 8k..8k + 8 of `l` (64 each, k < 8), in
             // their unaligned forms.
             let outside = unsafe {
                 let zero = _mm_setzero_ps();
-                let a = _mm_cmpgt_ps(_mm_loadu_ps(d.as_ptr()), zero);
-                let b = _mm_cmpgt_ps(_mm_loadu_ps(d.as_ptr().add(4)), zero);
+                let p = d.as_ptr().add(8 * k);
+                let a = _mm_cmpgt_ps(_mm_loadu_ps(p), zero);
+                let b = _mm_cmpgt_ps(_mm_loadu_ps(p.add(4)), zero);
                 let packed = _mm_packs_epi32(_mm_castps_si128(a), _mm_castps_si128(b));
                 let labels = _mm_andnot_si128(packed, _mm_set1_epi16(lab as i16));
-                _mm_storeu_si128(out.as_mut_ptr().cast::<__m128i>(), labels);
+                _mm_storeu_si128(l.as_mut_ptr().add(8 * k).cast::<__m128i>(), labels);
                 _mm_movemask_ps(a) | _mm_movemask_ps(b) << 4
             };
             m |= u64::from(!outside as u8) << (8 * k);
-        }
-        let done = ds.len() - d8.remainder().len();
-        for (x, (d, l)) in (done..).zip(d8.remainder().iter().zip(l8.into_remainder())) {
-            #[allow(clippy::neg_cmp_op_on_partial_ord)]
-            let inside = !(*d > 0.0);
-            *l = u16::from(inside) * lab;
-            m |= u64::from(inside) << x;
         }
         *word = m & keep;
     }
