@@ -173,7 +173,6 @@ struct Quad {
 
 /// Triangles with their neighbours: `nbr[t][k]` lies across the edge
 /// from `tris[t][k]` to `tris[t][(k + 1) % 3]` (`NONE` on the outline).
-#[derive(Default)]
 struct Mesh {
     tris: Vec<[usize; 3]>,
     nbr: Vec<[usize; 3]>,

@@ -4,8 +4,8 @@
 //! elsewhere, and the same as bits (bit `x % 64` of word `x / 64` set
 //! where the label is not 0; bits past the row clear).
 //!
-//! Every voxel of a one-segment mesh export passes here once, so it is
-//! the export's one per-voxel pass besides the sampler's. On x86-64 eight
+//! Every voxel of a one-segment mesh export of a fixed mix passes here
+//! once. On x86-64 eight
 //! distances take two SSE2 compares (part of the architecture's baseline,
 //! so no detection): their masks give the eight bits (`movemask`) and,
 //! packed to 16 bits, the eight labels. Elsewhere the portable loops below
