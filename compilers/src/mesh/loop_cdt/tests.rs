@@ -275,3 +275,23 @@ fn inner_points_split_triangles_or_are_left_out() {
     let sum: f64 = tris.iter().map(|t| turn(&pts, *t)).sum();
     assert_eq!(sum, 32.0);
 }
+
+#[test]
+fn the_circle_test_says_yes_only_where_the_exact_one_does() {
+    let c = |x: f64, y: f64| Coord { x, y };
+    let (a, b, cc) = (c(0.0, 0.0), c(1.0, 0.0), c(1.0, 1.0));
+    // Strictly inside, strictly outside, and on the circle of a unit square.
+    assert!(surely_in_circle(a, b, cc, c(0.5, 0.9)));
+    assert!(!surely_in_circle(a, b, cc, c(-0.5, 1.5)));
+    assert!(!surely_in_circle(a, b, cc, c(0.0, 1.0)));
+    // Near the circle the filter may abstain, but never disagrees with
+    // the exact determinant's sign.
+    for i in 0..2000u64 {
+        let t = uniform(3, i) * std::f64::consts::TAU;
+        let r = std::f64::consts::FRAC_1_SQRT_2 * (1.0 + (uniform(5, i) - 0.5) * 1e-14);
+        let d = c(0.5 + r * t.cos(), 0.5 + r * t.sin());
+        if surely_in_circle(a, b, cc, d) {
+            assert!(robust::incircle(a, b, cc, d) > 0.0, "{d:?}");
+        }
+    }
+}
