@@ -64,15 +64,29 @@ fn lipschitz(node: &PNode, b: &Aabb) -> Interval {
     Interval::new(d - r, d + r)
 }
 
-/// A mesh's interval from its bounded distance query: exact (`d ± r`) when
-/// the surface is within `2r` of the centre, else only the side that matters
+/// A mesh's interval: `±(u + r)` when the first triangle of the centre's
+/// candidate list lies within `r` of it at distance `u`; else from the
+/// bounded distance query, exact (`d ± r`) when the surface is within `2r`
+/// of the centre, else only the side that matters
 /// (`[d − r, ∞)` outside, `(−∞, d + r]` inside) from the mesh's coarse grid,
 /// without a closest-triangle search. Samplers ask this for every tile.
 fn mesh_interval(mesh: &crate::trimesh::TriangleMesh, b: &Aabb) -> Interval {
     let r = b.half_diagonal();
     let reach = 2.0 * r + 1e-9;
-    let d = mesh.signed_distance_bound(b.center(), reach);
     let floor = -mesh.bbox().half_diagonal();
+    let c = b.center();
+    // With a triangle within `r` of the centre, `|d| ≤ u ≤ r`: the exact
+    // interval `d ± r` holds zero, so a sampler opens the box whatever `d`
+    // is, and `±(u + r)`, which holds it too, comes without the search for
+    // the nearest triangle and its side.
+    let d = match r
+        .is_finite()
+        .then(|| mesh.signed_distance_unless_within(c, r))
+    {
+        Some(Some(Err(u))) => return Interval::new((-(u + r)).max(floor), u + r),
+        Some(Some(Ok(d))) => d,
+        _ => mesh.signed_distance_bound(c, reach),
+    };
     if d.abs() < reach {
         Interval::new((d - r).max(floor), d + r)
     } else if d > 0.0 {

@@ -55,6 +55,16 @@ const MAX_BLOCK: usize = 160;
 /// Longest list kept; cells that need more fall back to the BVH.
 const MAX_LIST: usize = 40;
 
+/// What [`CandidateGrid::nearest_unless_within`] finds.
+#[derive(Clone, Copy, Debug)]
+pub enum Near {
+    /// The first triangle's squared distance, within the asked radius.
+    Within(f64),
+    /// The nearest triangle's slot and squared distance, and the side
+    /// (as [`CandidateGrid::nearest`]).
+    Nearest(usize, f64, i8),
+}
+
 /// One candidate: the triangle slot and `d(c, t)` rounded down to `f32`.
 #[derive(Clone, Copy, Debug)]
 struct Candidate {
@@ -411,6 +421,29 @@ impl CandidateGrid {
     /// `None` when `p`'s cell keeps no list.
     #[inline]
     pub fn nearest(&self, mesh: &TriangleMesh, p: DVec3) -> Option<(usize, f64, i8)> {
+        match self.walk::<false>(mesh, p, 0.0)? {
+            Near::Nearest(slot, d2, side) => Some((slot, d2, side)),
+            Near::Within(_) => None,
+        }
+    }
+
+    /// As [`Self::nearest`], unless the list's first triangle lies within
+    /// `sqrt(within2)` of `p`: then its squared distance (an upper bound of
+    /// the nearest's), without the walk and the side.
+    #[inline]
+    pub fn nearest_unless_within(
+        &self,
+        mesh: &TriangleMesh,
+        p: DVec3,
+        within2: f64,
+    ) -> Option<Near> {
+        self.walk::<true>(mesh, p, within2)
+    }
+
+    /// [`Self::nearest`], stopping after the first triangle when `EARLY`
+    /// and it lies within `sqrt(within2)`.
+    #[inline(always)]
+    fn walk<const EARLY: bool>(&self, mesh: &TriangleMesh, p: DVec3, within2: f64) -> Option<Near> {
         let (i, xyz) = self.cells.locate(p)?;
         let record = self.records[i];
         let list = &self.items
@@ -423,6 +456,9 @@ impl CandidateGrid {
         let mut slot = first & slot_mask;
         let t1 = &mesh.tris[slot as usize];
         let (mut best, feature) = t1.distance_squared_feature_face_first(p);
+        if EARLY && best <= within2 {
+            return Some(Near::Within(best));
+        }
         let above = t1.n.dot(p - t1.a) > 0.0;
         // The entries that p's place relative to t₁ proves no nearer are
         // skipped unread.
@@ -475,7 +511,7 @@ impl CandidateGrid {
             }
             s => s,
         };
-        Some((slot as usize, best, side))
+        Some(Near::Nearest(slot as usize, best, side))
     }
 
     /// `+1` or `−1` when every point of `p`'s cell is on that side of the

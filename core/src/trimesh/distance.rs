@@ -3,6 +3,7 @@
 use glam::DVec3;
 
 use super::TriangleMesh;
+use super::candidates::Near;
 use super::triangle::Feature;
 use crate::aabb::Aabb;
 use crate::interval::Interval;
@@ -121,13 +122,34 @@ impl TriangleMesh {
     #[inline]
     fn signed_from_candidates(&self, p: DVec3) -> Option<f64> {
         let (slot, d2, side) = self.candidates.as_ref()?.nearest(self, p)?;
-        Some(signed(d2, || {
+        Some(self.signed_from_list(p, slot, d2, side))
+    }
+
+    /// A candidate walk's answer signed: by the side it found, else by
+    /// the nearest triangle's pseudo-normals.
+    #[inline]
+    fn signed_from_list(&self, p: DVec3, slot: usize, d2: f64, side: i8) -> f64 {
+        signed(d2, || {
             if side != 0 {
                 f64::from(side)
             } else {
                 self.sign_at(p, slot)
             }
-        }))
+        })
+    }
+
+    /// Where the candidate grid keeps a list for `p`'s cell: `Ok` with the
+    /// exact signed distance, or `Err(u)` when a triangle lies within
+    /// `within` of `p` at distance `u` (so `|d(p)| ≤ u ≤ within`), found
+    /// without the search for the nearest and its side. `None` elsewhere.
+    pub fn signed_distance_unless_within(&self, p: DVec3, within: f64) -> Option<Result<f64, f64>> {
+        let grid = self.candidates.as_ref()?;
+        Some(
+            match grid.nearest_unless_within(self, p, within * within)? {
+                Near::Within(d2) => Err(d2.sqrt()),
+                Near::Nearest(slot, d2, side) => Ok(self.signed_from_list(p, slot, d2, side)),
+            },
+        )
     }
 
     /// Exact unsigned distance to the surface. NaN for a non-finite `p`.

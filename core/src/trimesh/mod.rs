@@ -32,6 +32,8 @@ mod triangle;
 mod winding;
 
 #[cfg(test)]
+mod bound_tests;
+#[cfg(test)]
 pub(crate) mod tests;
 
 use std::path::{Path, PathBuf};
