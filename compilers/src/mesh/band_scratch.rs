@@ -9,16 +9,25 @@ use std::sync::Mutex;
 /// an earlier band reads as unset.
 #[derive(Default)]
 pub(super) struct Stamped {
-    /// `band << 32 | value`.
+    /// `band << 32 | value`; [`NEVER`] before the first set.
     slot: Vec<u64>,
     band: u64,
 }
 
+/// A fresh slot: band `u32::MAX`, which [`Stamped::begin`] never reaches.
+/// Not 0, so the array is written when made: a slot's first touch is a
+/// read ([`Stamped::get`]), and a read of a zeroed allocation's untouched
+/// page maps the kernel's shared zero page, whose first write then faults
+/// again and flushes the page from the other cores' TLBs (an interrupt to
+/// each, costly in a virtual machine).
+const NEVER: u64 = u64::MAX;
+
 impl Stamped {
     /// Start a band of `len` slots, none set.
     pub fn begin(&mut self, len: usize) {
-        if self.slot.len() != len {
-            self.slot = vec![0; len];
+        if self.slot.len() != len || self.band + 1 >= NEVER >> 32 {
+            self.slot = Vec::new();
+            self.slot = vec![NEVER; len];
             self.band = 0;
         }
         self.band += 1;
@@ -103,5 +112,29 @@ impl<T: Default> Drop for Loan<'_, T> {
         if let Ok(mut free) = self.pool.0.lock() {
             free.push(std::mem::take(&mut self.item));
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Slots read unset until set in the current band, and again after the
+    /// next `begin`; a band count near the fresh slots' stamp starts over.
+    #[test]
+    fn slots_are_set_for_one_band() {
+        let mut s = Stamped::default();
+        s.begin(5);
+        assert_eq!((0..5).map(|i| s.get(i)).collect::<Vec<_>>(), [None; 5]);
+        s.set(2, 7);
+        assert_eq!(s.get(2), Some(7));
+        assert_eq!(s.find_or(2, || 9), 7);
+        assert_eq!(s.find_or(3, || 9), 9);
+        s.begin(5);
+        assert_eq!((s.get(2), s.get(3)), (None, None));
+        s.band = (NEVER >> 32) - 1;
+        s.begin(5);
+        assert_eq!(s.band, 1);
+        assert_eq!((0..5).map(|i| s.get(i)).collect::<Vec<_>>(), [None; 5]);
     }
 }
