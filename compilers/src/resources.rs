@@ -43,14 +43,22 @@ pub fn available_disk(_dir: &Path) -> Option<u64> {
     None
 }
 
-/// Run `f` on a pool of `threads` workers (`None`: the current pool, all
-/// cores by default). Output never depends on the count; only speed does.
+/// Run `f` on a worker of a pool of `threads` workers (`None`: the current
+/// pool, all cores by default). Output never depends on the count; only
+/// speed does.
+///
+/// On a worker, not the calling thread: `f`'s own serial stretches then
+/// leave the other workers the cores (called from outside, a third thread
+/// ran beside two workers that were still spinning for work), and its
+/// joins are a worker's, not injected into the pool and waited for each
+/// time. (`rayon::scope` called from outside the pool runs its closure on
+/// a worker and blocks until it returns; from a worker, in place.)
 pub fn run_with_threads<T: Send>(
     threads: Option<usize>,
     f: impl FnOnce() -> Result<T, ExportError> + Send,
 ) -> Result<T, ExportError> {
     match threads {
-        None => f(),
+        None => rayon::scope(|_| f()),
         Some(n) => {
             check_threads(n)?;
             let pool = rayon::ThreadPoolBuilder::new()
