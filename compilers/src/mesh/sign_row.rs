@@ -12,8 +12,10 @@
 //! do the same, and a test compares the two.
 
 /// Labels and bits of `dist` into `labels` (same length) and `bits`
-/// (`dist.len().div_ceil(64)` words) for label `lab`.
+/// (`dist.len().div_ceil(64)` words) for label `lab`, 0 or 1 (one
+/// segment; the portable bits gather labels of 0 and 1).
 pub(super) fn sign_row(labels: &mut [u16], bits: &mut [u64], dist: &[f32], lab: u16) {
+    debug_assert!(lab <= 1, "label {lab}");
     debug_assert_eq!(labels.len(), dist.len());
     debug_assert_eq!(bits.len(), dist.len().div_ceil(64));
     #[cfg(target_arch = "x86_64")]
@@ -49,14 +51,8 @@ fn sign_row_sse2(labels: &mut [u16], bits: &mut [u64], dist: &[f32], lab: u16) {
             <&[f32; 64]>::try_from(ds),
             <&mut [u16; 64]>::try_from(&mut *ls),
         ) else {
-            let mut m = 0u64;
-            for (x, (d, l)) in ds.iter().zip(ls.iter_mut()).enumerate() {
-                #[allow(clippy::neg_cmp_op_on_partial_ord)]
-                let inside = !(*d > 0.0);
-                *l = u16::from(inside) * lab;
-                m |= u64::from(inside) << x;
-            }
-            *word = m & keep;
+            // The row's last, short word.
+            sign_row_portable(ls, std::slice::from_mut(word), ds, lab);
             continue;
         };
         let mut m = 0u64;
@@ -83,8 +79,8 @@ fn sign_row_sse2(labels: &mut [u16], bits: &mut [u64], dist: &[f32], lab: u16) {
 
 /// [`sign_row`] without vector instructions: the labels eight at a time
 /// as fixed-size arrays (vector compares where the target has them), then
-/// the bits four labels a multiplication.
-#[cfg_attr(target_arch = "x86_64", allow(dead_code))]
+/// the bits four labels a multiplication (also the SSE2 path's short last
+/// word).
 fn sign_row_portable(labels: &mut [u16], bits: &mut [u64], dist: &[f32], lab: u16) {
     sign_labels(labels, dist, lab);
     label_bits(labels, bits);
@@ -93,7 +89,6 @@ fn sign_row_portable(labels: &mut [u16], bits: &mut [u64], dist: &[f32], lab: u1
 /// `lab` into `labels` where `dist` is not above zero (hence the negated
 /// comparisons), 0 elsewhere.
 #[allow(clippy::neg_cmp_op_on_partial_ord)]
-#[cfg_attr(target_arch = "x86_64", allow(dead_code))]
 fn sign_labels(labels: &mut [u16], dist: &[f32], lab: u16) {
     let mut out = labels.chunks_exact_mut(8);
     let mut ds = dist.chunks_exact(8);
@@ -112,7 +107,6 @@ fn sign_labels(labels: &mut [u16], dist: &[f32], lab: u16) {
 /// or 1): four labels a multiplication, read as one 64-bit word whose four
 /// low bits of 16 the product gathers into bits 48..52 (the partial
 /// products below bit 48 fall on distinct bits, so nothing carries in).
-#[cfg_attr(target_arch = "x86_64", allow(dead_code))]
 fn label_bits(labels: &[u16], bits: &mut [u64]) {
     const GATHER: u64 = 1 << 48 | 1 << 33 | 1 << 18 | 1 << 3;
     for (w, chunk) in bits.iter_mut().zip(labels.chunks(64)) {

@@ -14,6 +14,7 @@ use super::pnode::{COORD_SLOTS, D_SLOT, DERIVED_MASK, NAry, PNode, tile_local};
 use super::sdf;
 use crate::aabb::Aabb;
 use crate::interval::Interval;
+use crate::trimesh::Probe;
 
 /// `d(centre) ± half diagonal` for a 1-Lipschitz field.
 #[inline]
@@ -79,13 +80,10 @@ fn mesh_interval(mesh: &crate::trimesh::TriangleMesh, b: &Aabb) -> Interval {
     // interval `d ± r` holds zero, so a sampler opens the box whatever `d`
     // is, and `±(u + r)`, which holds it too, comes without the search for
     // the nearest triangle and its side.
-    let d = match r
-        .is_finite()
-        .then(|| mesh.signed_distance_unless_within(c, r))
-    {
-        Some(Some(Err(u))) => return Interval::new((-(u + r)).max(floor), u + r),
-        Some(Some(Ok(d))) => d,
-        _ => mesh.signed_distance_bound(c, reach),
+    let d = match mesh.signed_distance_unless_within(c, r) {
+        Some(Probe::Within(u)) => return Interval::new((-(u + r)).max(floor), u + r),
+        Some(Probe::Exact(d)) => d,
+        None => mesh.signed_distance_bound(c, reach),
     };
     if d.abs() < reach {
         Interval::new((d - r).max(floor), d + r)

@@ -341,13 +341,7 @@ impl Model {
     /// Signed distance at `p` (negative inside; inside ⇔ ≤ 0).
     #[inline]
     pub fn distance(&self, p: DVec3) -> f64 {
-        // A design that is one imported mesh asks the mesh directly, not
-        // through the tree's `match`, whose prologue saves registers on
-        // every call (samplers ask once a voxel near the surface).
-        match &*self.root {
-            PNode::Mesh { mesh, .. } => mesh.signed_distance(p),
-            root => root.dist(p),
-        }
+        self.root.dist(p)
     }
 
     /// Distance at `p`, and fractions into `fracs` (length `materials().len()`;

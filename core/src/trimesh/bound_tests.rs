@@ -4,6 +4,7 @@
 
 use glam::DVec3;
 
+use super::Probe;
 use super::tests::{Rng, bunny};
 use crate::aabb::Aabb;
 
@@ -60,12 +61,12 @@ fn a_query_stopped_within_its_radius_bounds_the_distance() {
         for within in [0.1, 0.5, 2.0] {
             match m.signed_distance_unless_within(p, within) {
                 // Some triangle at `u ≤ within`, so `|d| ≤ u`.
-                Some(Err(u)) => {
+                Some(Probe::Within(u)) => {
                     stopped += 1;
                     assert!(u <= within && d.abs() <= u, "{p} {within}: {u} vs {d}");
                 }
                 // Otherwise the exact answer, bit for bit.
-                Some(Ok(e)) => {
+                Some(Probe::Exact(e)) => {
                     exact += 1;
                     assert_eq!(e.to_bits(), d.to_bits(), "{p} {within}");
                 }

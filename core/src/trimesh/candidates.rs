@@ -423,6 +423,7 @@ impl CandidateGrid {
     pub fn nearest(&self, mesh: &TriangleMesh, p: DVec3) -> Option<(usize, f64, i8)> {
         match self.walk::<false>(mesh, p, 0.0)? {
             Near::Nearest(slot, d2, side) => Some((slot, d2, side)),
+            // (Never: a walk that may not stop early does not.)
             Near::Within(_) => None,
         }
     }

@@ -4,6 +4,16 @@ use glam::DVec3;
 
 use super::TriangleMesh;
 use super::candidates::Near;
+
+/// What [`TriangleMesh::signed_distance_unless_within`] finds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Probe {
+    /// A triangle lies at this distance, at most the asked one, found
+    /// without the search for the nearest and its side: `|d| ≤` it.
+    Within(f64),
+    /// The exact signed distance.
+    Exact(f64),
+}
 use super::triangle::Feature;
 use crate::aabb::Aabb;
 use crate::interval::Interval;
@@ -138,16 +148,17 @@ impl TriangleMesh {
         })
     }
 
-    /// Where the candidate grid keeps a list for `p`'s cell: `Ok` with the
-    /// exact signed distance, or `Err(u)` when a triangle lies within
-    /// `within` of `p` at distance `u` (so `|d(p)| ≤ u ≤ within`), found
-    /// without the search for the nearest and its side. `None` elsewhere.
-    pub fn signed_distance_unless_within(&self, p: DVec3, within: f64) -> Option<Result<f64, f64>> {
+    /// Where the candidate grid keeps a list for `p`'s cell, the exact
+    /// signed distance, unless a triangle lies within `within` of `p`
+    /// ([`Probe`]); `None` elsewhere.
+    pub fn signed_distance_unless_within(&self, p: DVec3, within: f64) -> Option<Probe> {
         let grid = self.candidates.as_ref()?;
         Some(
             match grid.nearest_unless_within(self, p, within * within)? {
-                Near::Within(d2) => Err(d2.sqrt()),
-                Near::Nearest(slot, d2, side) => Ok(self.signed_from_list(p, slot, d2, side)),
+                Near::Within(d2) => Probe::Within(d2.sqrt()),
+                Near::Nearest(slot, d2, side) => {
+                    Probe::Exact(self.signed_from_list(p, slot, d2, side))
+                }
             },
         )
     }

@@ -24,6 +24,7 @@ mod candidates;
 mod certificate;
 mod coarse;
 mod distance;
+pub use distance::Probe;
 mod formats;
 mod gaps;
 mod grid_cache;
